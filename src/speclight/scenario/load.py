@@ -1,0 +1,194 @@
+"""Read a scenario YAML file into a validated :class:`~speclight.scenario.Scenario`.
+
+Errors are :class:`~speclight.errors.InputError` naming the file and line, the field path,
+the value and what is accepted; misspelt keys get a did-you-mean.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, get_args
+
+import yaml
+from pydantic import BaseModel, ValidationError
+
+from speclight.errors import InputError, did_you_mean
+from speclight.scenario.scenario_model import Scenario
+
+
+@dataclass(frozen=True)
+class LoadedScenario:
+    """A validated scenario, its YAML text and the folder relative paths refer to."""
+
+    scenario: Scenario
+    yaml_text: str
+    source: str
+    base_dir: Path
+
+    def resolve(self, path: str) -> Path:
+        """Resolve a path written in the scenario relative to the scenario's folder."""
+        p = Path(path).expanduser()
+        return p if p.is_absolute() else self.base_dir / p
+
+
+def load_scenario(path: str | Path) -> LoadedScenario:
+    """Read and validate a scenario file.
+
+    Raises
+    ------
+    InputError
+        If the file is missing, is not valid YAML, or a field is invalid.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise InputError(f"cannot read scenario file: {exc.strerror}", source=str(path)) from exc
+    return parse_scenario(text, source=str(path), base_dir=path.resolve().parent)
+
+
+def parse_scenario(text: str, source: str = "<scenario>", base_dir: Path | None = None) -> LoadedScenario:
+    """Validate scenario YAML text (see :func:`load_scenario`)."""
+    try:
+        data = yaml.safe_load(text)
+        root = yaml.compose(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f"{source}:{mark.line + 1}:{mark.column + 1}" if mark else source
+        problem = getattr(exc, "problem", None) or str(exc)
+        raise InputError(f"not valid YAML: {problem}", source=where) from exc
+    if not isinstance(data, dict):
+        raise InputError(
+            f"a scenario is a YAML mapping of sections (name, time, observer, ...), "
+            f"got {type(data).__name__}",
+            source=source,
+        )
+    try:
+        scenario = Scenario.model_validate(data)
+    except ValidationError as exc:
+        raise InputError(_describe(exc, data, root), source=source) from None
+    return LoadedScenario(scenario, text, source, base_dir or Path.cwd())
+
+
+def _data_path(loc: tuple[Any, ...], data: Any) -> tuple[list[Any], Any, bool]:
+    """Keep the parts of a pydantic error location that index the input data.
+
+    Pydantic inserts union-member tags into locations; they are dropped here. Returns the
+    data path, the value found there and whether the full location resolved.
+    """
+    path: list[Any] = []
+    node = data
+    for part in loc:
+        if isinstance(node, dict) and part in node:
+            path.append(part)
+            node = node[part]
+        elif isinstance(node, list) and isinstance(part, int) and 0 <= part < len(node):
+            path.append(part)
+            node = node[part]
+        elif isinstance(node, dict | list):
+            continue  # a union tag or a missing field
+    resolved = bool(loc) and (path[-1:] == [loc[-1]])
+    return path, node, resolved
+
+
+def _line(root: Any, path: list[Any]) -> int | None:
+    node = root
+    line = None
+    for part in path:
+        if isinstance(node, yaml.MappingNode):
+            match = [(k, v) for k, v in node.value if k.value == part]
+            if not match:
+                break
+            key, node = match[0]
+            line = key.start_mark.line + 1
+        elif isinstance(node, yaml.SequenceNode) and isinstance(part, int):
+            node = node.value[part]
+            line = node.start_mark.line + 1
+        else:
+            break
+    return line
+
+
+def _models_in(annotation: Any) -> list[type[BaseModel]]:
+    """The pydantic models an annotation can hold (through unions, lists, dicts, Annotated)."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    found: list[type[BaseModel]] = []
+    for arg in get_args(annotation):
+        found.extend(_models_in(arg))
+    return found
+
+
+def _model_at(loc: tuple[Any, ...]) -> type[BaseModel] | None:
+    """The scenario model that validated the mapping at a pydantic error location."""
+    candidates: list[type[BaseModel]] = [Scenario]
+    for part in loc:
+        by_field = [c for c in candidates if part in c.model_fields]
+        if by_field:
+            candidates = _models_in(by_field[0].model_fields[part].annotation)
+            continue
+        # a union tag: a model's class name or a discriminator value; else a dict/list index
+        tagged = [
+            c
+            for c in candidates
+            if c.__name__ == part
+            or _literal_default(c, "model") == part
+            or part == c.__name__.lower()
+        ]
+        if tagged:
+            candidates = tagged
+    return candidates[0] if len(candidates) == 1 else None
+
+
+def _literal_default(cls: type[BaseModel], field: str) -> Any:
+    info = cls.model_fields.get(field)
+    args = get_args(info.annotation) if info else ()
+    return args[0] if len(args) == 1 else None
+
+
+def _suggest_key(key: str, parent_loc: tuple[Any, ...]) -> str:
+    """Did-you-mean and the accepted keys for an unknown key."""
+    cls = _model_at(parent_loc)
+    if cls is None:
+        return ""
+    fields = list(cls.model_fields)
+    return f"{did_you_mean(key, fields)} (accepted keys here: {', '.join(fields)})"
+
+
+def _describe(exc: ValidationError, data: dict[str, Any], root: Any) -> str:
+    lines: dict[str, list[str]] = {}
+    for err in exc.errors():
+        loc = tuple(err["loc"])
+        path, value, _ = _data_path(loc, data)
+        kind = err["type"]
+        if kind == "extra_forbidden":
+            key = str(loc[-1])
+            parent = path[:-1] if path and path[-1] == key else path
+            message = f"unknown key '{key}'{_suggest_key(key, loc[:-1])}"
+            path = [*parent, key]
+        elif kind == "missing":
+            message = f"missing required field '{loc[-1]}'"
+            path = [*path, loc[-1]] if path[-1:] != [loc[-1]] else path
+        else:
+            msg = err["msg"].removeprefix("Value error, ")
+            shown = "" if isinstance(value, dict) else f" = {value!r}"
+            message = f"{shown}: {msg}" if shown else f": {msg}"
+        field = ".".join(str(p) for p in path) or "(top level)"
+        line = _line(root, [p for p in path])
+        prefix = f"line {line}: " if line else ""
+        text = f"{prefix}{field}{message}" if message.startswith((" =", ":")) else (
+            f"{prefix}{field}: {message}"
+        )
+        lines.setdefault(field, [])
+        if text not in lines[field]:
+            lines[field].append(text)
+    out = []
+    for field, texts in lines.items():
+        if len(texts) > 1:
+            out.append(texts[0] + "".join(f"\n      or {t.split(': ', 1)[-1]}" for t in texts[1:]))
+        else:
+            out.append(texts[0])
+    n = len(out)
+    head = f"{n} invalid field{'s' if n > 1 else ''} in the scenario"
+    return head + "\n  " + "\n  ".join(out)

@@ -1,0 +1,173 @@
+"""Pydantic models of the scenario file (SPEC section 3).
+
+Units are in the field names. Every model forbids unknown keys, so a misspelt key is an
+error (with a did-you-mean added by :mod:`speclight.scenario.load`). The models only
+validate and convert; the physics lives in the stage subpackages.
+"""
+
+from __future__ import annotations
+
+from datetime import UTC, datetime
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+MAX_EPOCHS = 10_000_000
+
+
+class Strict(BaseModel):
+    """Base model: unknown keys are errors, values are validated on assignment."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True, frozen=False)
+
+
+class TimeGrid(Strict):
+    """Uniform UTC time grid; ``stop`` is included when it falls on the grid."""
+
+    start: datetime
+    stop: datetime
+    step_s: float = Field(gt=0, description="Time step [s]")
+
+    @field_validator("start", "stop")
+    @classmethod
+    def _utc(cls, value: datetime) -> datetime:
+        if value.tzinfo is None:
+            return value.replace(tzinfo=UTC)
+        return value.astimezone(UTC)
+
+    @model_validator(mode="after")
+    def _order(self) -> TimeGrid:
+        span_s = (self.stop - self.start).total_seconds()
+        if span_s < 0:
+            raise ValueError(
+                f"stop ({self.stop.isoformat()}) is before start ({self.start.isoformat()}); "
+                "give a stop time after the start time"
+            )
+        if span_s / self.step_s + 1 > MAX_EPOCHS:
+            raise ValueError(
+                f"{span_s / self.step_s + 1:.0f} epochs requested; at most {MAX_EPOCHS} are "
+                "accepted: increase step_s or shorten the window"
+            )
+        return self
+
+
+class Observer(Strict):
+    """Observing site on the WGS84 ellipsoid."""
+
+    latitude_deg: float = Field(ge=-90, le=90)
+    longitude_deg: float = Field(ge=-180, le=360)
+    altitude_m: float = Field(default=0.0, ge=-500, le=9000)
+    min_elevation_deg: float = Field(
+        default=10.0, ge=-90, le=90, description="Epochs below this elevation are flagged [deg]"
+    )
+    refraction: bool = Field(default=False, description="Apply atmospheric refraction to elevation")
+    temperature_C: float = Field(default=10.0, ge=-80, le=60)
+    pressure_mbar: float | None = Field(
+        default=None, ge=0, le=1100, description="Site pressure; default from the altitude [mbar]"
+    )
+
+
+class Telescope(Strict):
+    aperture_diameter_m: float = Field(default=0.43, gt=0, le=100)
+    obstruction_diameter_m: float = Field(default=0.0, ge=0)
+
+    @model_validator(mode="after")
+    def _obstruction(self) -> Telescope:
+        if self.obstruction_diameter_m >= self.aperture_diameter_m:
+            raise ValueError(
+                f"obstruction_diameter_m = {self.obstruction_diameter_m} must be smaller than "
+                f"aperture_diameter_m = {self.aperture_diameter_m}"
+            )
+        return self
+
+
+class Orbit(Strict):
+    """Exactly one source of the target's trajectory."""
+
+    tle: str | None = Field(default=None, description="Two- or three-line element set")
+    tle_file: str | None = Field(default=None, description="File of TLEs; pick one by norad_id")
+    norad_id: int | None = Field(default=None, ge=1, description="Catalogue number in tle_file")
+    cpf_file: str | None = Field(default=None, description="ILRS CPF prediction (v1 or v2)")
+    ephemeris_file: str | None = Field(default=None, description="CSV: time_utc, x, y, z")
+
+    @model_validator(mode="after")
+    def _exactly_one(self) -> Orbit:
+        given = [k for k in ("tle", "tle_file", "cpf_file", "ephemeris_file") if getattr(self, k)]
+        if len(given) != 1:
+            raise ValueError(
+                "give exactly one of tle, tle_file, cpf_file, ephemeris_file "
+                f"(found {', '.join(given) if given else 'none'})"
+            )
+        if self.norad_id is not None and not self.tle_file:
+            raise ValueError("norad_id selects a TLE from tle_file; it needs tle_file")
+        return self
+
+
+Vector3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+Quaternion = Annotated[list[float], Field(min_length=4, max_length=4)]
+
+
+class AxesOrientation(Strict):
+    """Orientation of the body frame: a quaternion or RA/Dec of the body z and x axes."""
+
+    quaternion: Quaternion | None = Field(
+        default=None, description="Body-to-GCRS rotation, scalar first (w, x, y, z)"
+    )
+    z_axis_ra_deg: float | None = None
+    z_axis_dec_deg: float | None = Field(default=None, ge=-90, le=90)
+    x_axis_ra_deg: float | None = None
+    x_axis_dec_deg: float | None = Field(default=None, ge=-90, le=90)
+
+    @model_validator(mode="after")
+    def _one_form(self) -> AxesOrientation:
+        radec = [self.z_axis_ra_deg, self.z_axis_dec_deg, self.x_axis_ra_deg, self.x_axis_dec_deg]
+        if self.quaternion is not None:
+            if any(v is not None for v in radec):
+                raise ValueError("give either quaternion or the z/x axis RA/Dec, not both")
+            norm = sum(c * c for c in self.quaternion) ** 0.5
+            if abs(norm - 1.0) > 1e-6:
+                raise ValueError(f"quaternion {self.quaternion} has norm {norm:.6g}; it must be 1")
+        elif any(v is None for v in radec):
+            raise ValueError(
+                "give quaternion: [w, x, y, z], or all of z_axis_ra_deg, z_axis_dec_deg, "
+                "x_axis_ra_deg, x_axis_dec_deg"
+            )
+        return self
+
+
+class FixedAttitude(AxesOrientation):
+    model: Literal["fixed"]
+
+
+class SpinAttitude(Strict):
+    model: Literal["spin"]
+    spin_axis_ra_deg: float
+    spin_axis_dec_deg: float = Field(ge=-90, le=90)
+    period_s: float = Field(gt=0)
+    initial_phase_deg: float = 0.0
+
+
+class TorqueFreeAttitude(Strict):
+    model: Literal["torque_free"]
+    inertia_kg_m2: list[float] | list[list[float]] = Field(
+        description="Principal moments (3 values) or the full 3x3 tensor in the body frame"
+    )
+    initial_attitude: AxesOrientation
+    angular_velocity_body_rad_s: Vector3
+    rtol: float = Field(default=1e-12, gt=0, lt=1e-3)
+
+    @field_validator("inertia_kg_m2")
+    @classmethod
+    def _shape(cls, value: list[float] | list[list[float]]) -> list[float] | list[list[float]]:
+        ok_vector = len(value) == 3 and all(isinstance(v, float | int) for v in value)
+        ok_matrix = len(value) == 3 and all(isinstance(r, list) and len(r) == 3 for r in value)
+        if not (ok_vector or ok_matrix):
+            raise ValueError(
+                f"{value} is neither 3 principal moments nor a 3x3 tensor [kg m^2]"
+            )
+        return value
+
+
+Attitude = Annotated[
+    FixedAttitude | SpinAttitude | TorqueFreeAttitude, Field(discriminator="model")
+]

@@ -1,0 +1,266 @@
+"""Scenario models for the target, illumination, atmosphere, spectrum, render and instrument.
+
+These are the SPEC section 3 sections that later stages consume. They validate shapes,
+ranges and names here so that a scenario fails early, before any epoch is computed.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import Discriminator, Field, Tag, model_validator
+
+from pydantic import BaseModel
+
+from speclight.scenario.models import Strict, Vector3
+
+BsdfName = Literal["lambertian", "beckmann", "ggx", "plastic", "specular", "measured"]
+ConductorName = Literal["Al", "Ag", "Au"]
+DielectricName = Literal["SiO2", "Si", "GaAs", "Kapton"]
+BuiltinShape = Literal["sphere", "plate", "cube", "cylinder", "box-wing"]
+
+
+class ReflectanceFile(Strict):
+    file: str = Field(description="CSV of wavelength and reflectance (header names the units)")
+
+
+class ReflectancePairs(Strict):
+    wavelength_nm: list[float] = Field(min_length=2)
+    value: list[float] = Field(min_length=2)
+
+    @model_validator(mode="after")
+    def _pairs(self) -> ReflectancePairs:
+        if len(self.wavelength_nm) != len(self.value):
+            raise ValueError(
+                f"wavelength_nm has {len(self.wavelength_nm)} values but value has "
+                f"{len(self.value)}; give one reflectance per wavelength"
+            )
+        if any(b <= a for a, b in zip(self.wavelength_nm, self.wavelength_nm[1:], strict=False)):
+            raise ValueError("wavelength_nm must increase strictly")
+        if any(not 0.0 <= v <= 1.0 for v in self.value):
+            raise ValueError(f"reflectance values must lie in [0, 1], got {self.value}")
+        return self
+
+
+class Conductor(Strict):
+    conductor: ConductorName
+
+
+class Dielectric(Strict):
+    dielectric: DielectricName
+
+
+REFLECTANCE_FORMS = (
+    "a number in [0, 1], {file: table.csv}, {wavelength_nm: [...], value: [...]}, "
+    "{conductor: Al|Ag|Au} or {dielectric: SiO2|Si|GaAs|Kapton}"
+)
+
+
+def _reflectance_form(value: Any) -> str | None:
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        return "number"
+    if isinstance(value, dict):
+        for key, tag in (
+            ("file", "file"),
+            ("wavelength_nm", "pairs"),
+            ("value", "pairs"),
+            ("conductor", "conductor"),
+            ("dielectric", "dielectric"),
+        ):
+            if key in value:
+                return tag
+    if isinstance(value, BaseModel):
+        return {
+            ReflectanceFile: "file",
+            ReflectancePairs: "pairs",
+            Conductor: "conductor",
+            Dielectric: "dielectric",
+        }.get(type(value))
+    return None
+
+
+Reflectance = Annotated[
+    Annotated[float, Tag("number")]
+    | Annotated[ReflectanceFile, Tag("file")]
+    | Annotated[ReflectancePairs, Tag("pairs")]
+    | Annotated[Conductor, Tag("conductor")]
+    | Annotated[Dielectric, Tag("dielectric")],
+    Discriminator(
+        _reflectance_form,
+        custom_error_type="reflectance_form",
+        custom_error_message=f"not a reflectance; give {REFLECTANCE_FORMS}",
+    ),
+]
+
+
+class Material(Strict):
+    """A surface material: a BSDF model and its spectral reflectance."""
+
+    bsdf: BsdfName
+    reflectance: Reflectance = Field(default=1.0)
+    roughness: float | None = Field(
+        default=None, gt=0, le=1, description="Microfacet alpha (beckmann, ggx, plastic)"
+    )
+    diffuse_reflectance: Reflectance | None = Field(
+        default=None, description="Diffuse base of a plastic/coated layer"
+    )
+    file: str | None = Field(default=None, description="Measured BRDF table or RGL .bsdf file")
+
+    @model_validator(mode="after")
+    def _params(self) -> Material:
+        if isinstance(self.reflectance, float) and not 0.0 <= self.reflectance <= 1.0:
+            raise ValueError(f"reflectance = {self.reflectance} must lie in [0, 1]")
+        if self.bsdf in ("beckmann", "ggx", "plastic") and self.roughness is None:
+            raise ValueError(f"bsdf '{self.bsdf}' needs roughness (microfacet alpha, 0 < a <= 1)")
+        if self.bsdf in ("lambertian", "specular", "measured") and self.roughness is not None:
+            raise ValueError(f"bsdf '{self.bsdf}' takes no roughness")
+        if self.bsdf == "measured" and not self.file:
+            raise ValueError("bsdf 'measured' needs file: a BRDF table (.csv) or RGL .bsdf file")
+        if self.bsdf != "measured" and self.file:
+            raise ValueError(f"file is only used by bsdf 'measured', not '{self.bsdf}'")
+        return self
+
+
+class Shape(Strict):
+    """A built-in shape with its dimensions, or a mesh file."""
+
+    builtin: BuiltinShape | None = None
+    mesh_file: str | None = None
+    radius_m: float | None = Field(default=None, gt=0)
+    width_m: float | None = Field(default=None, gt=0)
+    height_m: float | None = Field(default=None, gt=0)
+    length_m: float | None = Field(default=None, gt=0)
+    edge_m: float | None = Field(default=None, gt=0)
+    bus_size_m: Vector3 | None = None
+    wing_span_m: float | None = Field(default=None, gt=0)
+    wing_width_m: float | None = Field(default=None, gt=0)
+    dish_diameter_m: float | None = Field(default=None, gt=0)
+    scale: float = Field(default=1.0, gt=0, description="Mesh units to metres")
+
+    @model_validator(mode="after")
+    def _one(self) -> Shape:
+        if (self.builtin is None) == (self.mesh_file is None):
+            raise ValueError("give exactly one of builtin or mesh_file")
+        needs = {
+            "sphere": ["radius_m"],
+            "plate": ["width_m", "height_m"],
+            "cube": ["edge_m"],
+            "cylinder": ["radius_m", "length_m"],
+            "box-wing": [],
+        }
+        if self.builtin is not None:
+            missing = [k for k in needs[self.builtin] if getattr(self, k) is None]
+            if missing:
+                raise ValueError(f"builtin '{self.builtin}' needs {', '.join(missing)}")
+        return self
+
+
+class Target(Strict):
+    shape: Shape
+    materials: dict[str, Material] = Field(min_length=1)
+
+
+class Laser(Strict):
+    """A ground laser transmitter."""
+
+    name: str
+    latitude_deg: float = Field(ge=-90, le=90)
+    longitude_deg: float = Field(ge=-180, le=360)
+    altitude_m: float = Field(default=0.0, ge=-500, le=9000)
+    wavelength_nm: float = Field(gt=0)
+    linewidth_nm: float = Field(default=0.1, gt=0)
+    spectrum_file: str | None = None
+    power_w: float = Field(gt=0, description="Average optical power [W]")
+    repetition_rate_hz: float = Field(gt=0)
+    divergence_arcsec: float = Field(gt=0, le=36000, description="Full divergence angle [arcsec]")
+
+
+class Illumination(Strict):
+    sun: bool = True
+    solar_disk: bool = Field(default=False, description="Finite 0.53 deg solar disk")
+    lasers: list[Laser] = Field(default_factory=list)
+
+
+class Atmosphere(Strict):
+    model: Literal["none", "spectrl2", "6s", "table"] = "spectrl2"
+    water_vapour_cm: float = Field(default=1.42, ge=0, le=10)
+    ozone_atm_cm: float = Field(default=0.31, ge=0, le=1)
+    aod_500nm: float = Field(default=0.1, ge=0, le=5)
+    angstrom_exponent: float = Field(default=1.14, ge=-1, le=4)
+    atmosphere_profile: str = "MidlatitudeSummer"
+    aerosol_profile: str = "Continental"
+    table_file: str | None = None
+    fallback_to_spectrl2: bool = False
+
+    @model_validator(mode="after")
+    def _table(self) -> Atmosphere:
+        if self.model == "table" and not self.table_file:
+            raise ValueError("model 'table' needs table_file: a CSV of wavelength_nm x airmass")
+        return self
+
+
+class Spectrum(Strict):
+    min_nm: float = Field(default=300.0, ge=200, le=4000)
+    max_nm: float = Field(default=1240.0, ge=200, le=4000)
+    step_nm: float = Field(default=5.0, gt=0, le=500)
+
+    @model_validator(mode="after")
+    def _order(self) -> Spectrum:
+        if self.max_nm < self.min_nm:
+            raise ValueError(f"max_nm = {self.max_nm} must be >= min_nm = {self.min_nm}")
+        return self
+
+
+class Render(Strict):
+    mode: Literal["single", "path"] = "single"
+    resolution_px: int = Field(default=256, ge=8, le=8192)
+    samples_per_pixel: int = Field(default=16, ge=1, le=1_000_000)
+    seed: int = Field(default=0, ge=0)
+    variant: str | None = Field(default=None, description="Force a Mitsuba variant")
+    max_depth: int = Field(default=8, ge=2, le=64, description="Path length limit in path mode")
+    save_images_at: list[int] = Field(
+        default_factory=list, description="Epoch indices whose images and depth maps are saved"
+    )
+
+
+class GaussianBand(Strict):
+    center_nm: float = Field(gt=0)
+    sigma_nm: float = Field(gt=0)
+
+
+class Band(Strict):
+    name: str
+    gaussian: GaussianBand | None = None
+    filter: str | None = Field(default=None, description="speclite filter name, e.g. bessell-V")
+    file: str | None = Field(default=None, description="CSV of wavelength and response")
+
+    @model_validator(mode="after")
+    def _one(self) -> Band:
+        given = [k for k in ("gaussian", "filter", "file") if getattr(self, k) is not None]
+        if len(given) > 1:
+            raise ValueError(f"give one of gaussian, filter, file (found {', '.join(given)})")
+        if not given and not self.name.startswith("G-"):
+            raise ValueError(
+                f"band '{self.name}' needs gaussian, filter or file (or a name G-<centre>/<sigma>)"
+            )
+        return self
+
+
+SpectralCurve = float | str | ReflectanceFile
+
+
+class Noise(Strict):
+    enabled: bool = True
+    seed: int = Field(default=0, ge=0)
+    sky_background_mag_arcsec2: float = Field(default=21.0, ge=10, le=30)
+    aperture_radius_arcsec: float = Field(default=3.0, gt=0)
+    dark_current_e_per_s: float = Field(default=0.0, ge=0)
+    read_noise_e: float = Field(default=0.0, ge=0)
+
+
+class Instrument(Strict):
+    optics_transmission: SpectralCurve = 1.0
+    detector_qe: SpectralCurve = 1.0
+    exposure_s: float = Field(default=1.0, gt=0)
+    bands: list[Band] = Field(default_factory=list)
+    noise: Noise | None = None
