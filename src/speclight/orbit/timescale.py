@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 from skyfield.api import Loader
+from skyfield.data import iers
 from skyfield.timelib import Time, Timescale
 
 
@@ -35,8 +36,18 @@ def _loader() -> Loader:
 
 @functools.cache
 def load_timescale() -> Timescale:
-    """Return the skyfield timescale built from the shipped IERS table (offline)."""
-    return _loader().timescale(builtin=False)
+    """Return the skyfield timescale built from the shipped IERS table (offline).
+
+    The polar-motion table (x_p, y_p from the same ``finals2000A.all``) is installed, so
+    that skyfield's ``itrs`` frame and WGS84 positions include polar motion (a few tenths
+    of an arcsecond, i.e. ~10 m at the Earth's surface); see skyfield's "Polar motion"
+    documentation.
+    """
+    ts = _loader().timescale(builtin=False)
+    with _loader().open("finals2000A.all") as f:
+        finals = iers.parse_x_y_dut1_from_finals_all(f)
+    iers.install_polar_motion_table(ts, finals)
+    return ts
 
 
 @functools.cache

@@ -1,0 +1,342 @@
+"""ILRS Consolidated laser ranging Prediction Format (CPF) files, versions 1 and 2.
+
+Format: Ricklefs et al., *Consolidated Laser Ranging Prediction Format*, Version 1.01
+(ILRS, 2006) and Version 2.00 (ILRS, 2018), https://ilrs.gsfc.nasa.gov/data_and_products/
+formats/cpf.html. Header records H1 (format version, source, target name; v2 adds the
+sub-daily sequence number and a notes field), H2 (COSPAR/SIC/NORAD ids, span, step,
+reference frame; v2 adds target location/dynamics), H3-H5 (accuracy, transponder,
+centre-of-mass offset), H9 (end of header); data records 10 (position), 20 (velocity),
+30-70 (corrections, rotation angles...), 00 (comment), 99 (end). Records are read as
+blank-separated fields, as the ILRS/EDC validation does ("there must be 12 parameters in
+record H1"), which accepts both versions' column layouts.
+
+Supported: Earth-orbiting targets in reference frame 0 (geocentric true body-fixed, i.e.
+ITRF), common-epoch records (direction flag 0). Transmit/receive records (flags 1 and 2,
+used for lunar and deep-space targets) are skipped. The leap-second flag of record 10 is
+not applied: times are taken as UTC at face value (a file spanning a leap second would be
+off by 1 s after it).
+
+Interpolation: 10-point (degree 9) Lagrange in ITRF, as the format's authors recommend; see
+:mod:`speclight.orbit.interpolate`. Then ITRF -> GCRS at each epoch.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from speclight.errors import InputError
+from speclight.orbit.frames import EarthOrientation, TimeLike, as_time, earth_orientation
+from speclight.orbit.interpolate import lagrange_interpolate
+from speclight.orbit.timescale import time_from_utc
+
+MJD0 = np.datetime64("1858-11-17T00:00:00", "ns")
+FRAME_NAMES = {
+    0: "geocentric true body-fixed (ITRF)",
+    1: "geocentric space-fixed, true of date",
+    2: "geocentric space-fixed, mean of date J2000",
+}
+_SKIPPED = {"H3", "H4", "H6", "H7", "H8", "00", "30", "40", "50", "60", "70"}
+
+
+@dataclass(frozen=True)
+class Cpf:
+    """Contents of a CPF file needed to compute positions.
+
+    Attributes
+    ----------
+    path
+        File read.
+    version
+        Format version, 1 or 2.
+    source
+        Ephemeris source (3-letter code of the prediction centre).
+    target_name
+        ILRS target name.
+    cospar_id, sic, norad_id
+        Identifiers as written in H2.
+    start_utc, end_utc
+        Span announced in H2, ``datetime64[ns]`` UTC.
+    step_s
+        Time between table entries [s] (H2).
+    reference_frame
+        0 (only value accepted).
+    com_offset_m
+        Centre-of-mass to reflector offset [m] from H5, or None.
+    times_utc
+        (M,) epochs of the position records, ``datetime64[ns]`` UTC.
+    r_itrf_m
+        (M, 3) positions [m].
+    v_itrf_m_s
+        (M, 3) velocities [m/s] from records 20, or None when the file has none.
+    """
+
+    path: str
+    version: int
+    source: str
+    target_name: str
+    cospar_id: str
+    sic: str
+    norad_id: str
+    start_utc: np.datetime64
+    end_utc: np.datetime64
+    step_s: int
+    reference_frame: int
+    com_offset_m: float | None
+    times_utc: NDArray[np.datetime64]
+    r_itrf_m: NDArray[np.float64]
+    v_itrf_m_s: NDArray[np.float64] | None
+
+
+def _err(path: str, lineno: int, line: str, what: str, fix: str) -> InputError:
+    return InputError(f"line {lineno}: {what}\n  {line}\n{fix}", source=path)
+
+
+def _datetime(fields: list[str]) -> np.datetime64:
+    y, mo, d, h, mi, s = (int(f) for f in fields)
+    return np.datetime64(f"{y:04d}-{mo:02d}-{d:02d}T{h:02d}:{mi:02d}:{s:02d}", "ns")
+
+
+def read_cpf(path: str | Path) -> Cpf:
+    """Read an ILRS CPF prediction file (format version 1 or 2).
+
+    Parameters
+    ----------
+    path
+        The CPF file.
+
+    Returns
+    -------
+    Cpf
+
+    Raises
+    ------
+    InputError
+        Not a CPF file, unsupported version or reference frame, or a malformed record
+        (the message names the file, the line number and the record).
+    """
+    p = str(path)
+    lines = Path(path).read_text().splitlines()
+    head: dict[str, list[str]] = {}
+    times: list[np.datetime64] = []
+    pos: list[list[float]] = []
+    vel: list[list[float]] = []
+    vel_times: list[np.datetime64] = []
+    version = 0
+    for lineno, raw in enumerate(lines, start=1):
+        line = raw.rstrip()
+        if not line.strip():
+            continue
+        rec = line[:2].upper()
+        tok = line.split()
+        try:
+            if rec == "H1":
+                if len(tok) < 3 or tok[1].upper() != "CPF":
+                    raise _err(
+                        p,
+                        lineno,
+                        line,
+                        "H1 record does not start 'H1 CPF'",
+                        "This is not an ILRS CPF file.",
+                    )
+                version = int(tok[2])
+                if version not in (1, 2):
+                    raise _err(
+                        p,
+                        lineno,
+                        line,
+                        f"format version {version} is not supported",
+                        "Accepted: CPF format versions 1 and 2.",
+                    )
+                need = 10 if version == 1 else 11
+                if len(tok) < need:
+                    raise _err(
+                        p,
+                        lineno,
+                        line,
+                        f"H1 has {len(tok)} fields, version {version} needs {need}",
+                        "Expected: H1 CPF version source yyyy mm dd hh sequence "
+                        + ("" if version == 1 else "sub-daily-sequence ")
+                        + "target",
+                    )
+                head["H1"] = tok
+            elif rec == "H2":
+                if len(tok) < 20:
+                    raise _err(
+                        p,
+                        lineno,
+                        line,
+                        f"H2 has {len(tok)} fields, need at least 20",
+                        "Expected: H2 cospar sic norad start(y m d h m s) end(y m d h m"
+                        " s) step tiv target-class reference-frame ...",
+                    )
+                head["H2"] = tok
+            elif rec == "H5":
+                head["H5"] = tok
+            elif rec == "H9":
+                head["H9"] = tok
+            elif rec == "10":
+                if len(tok) != 8:
+                    raise _err(
+                        p,
+                        lineno,
+                        line,
+                        f"position record has {len(tok)} fields, need 8",
+                        "Expected: 10 direction MJD seconds-of-day leap-second x y z.",
+                    )
+                if int(tok[1]) != 0:
+                    continue
+                t = MJD0 + np.timedelta64(int(tok[2]), "D")
+                times.append(t + np.timedelta64(round(float(tok[3]) * 1e9), "ns"))
+                pos.append([float(v) for v in tok[5:8]])
+            elif rec == "20":
+                if len(tok) != 5:
+                    raise _err(
+                        p,
+                        lineno,
+                        line,
+                        f"velocity record has {len(tok)} fields, need 5",
+                        "Expected: 20 direction vx vy vz.",
+                    )
+                if int(tok[1]) != 0:
+                    continue
+                vel.append([float(v) for v in tok[2:5]])
+                vel_times.append(times[-1] if times else MJD0)
+            elif rec == "99":
+                break
+            elif rec not in _SKIPPED:
+                raise _err(
+                    p,
+                    lineno,
+                    line,
+                    f"unknown record type {rec!r}",
+                    "CPF records are H1-H9, 00, 10, 20, 30, 40, 50, 60, 70, 99.",
+                )
+        except ValueError as exc:
+            if isinstance(exc, InputError):
+                raise
+            raise _err(
+                p,
+                lineno,
+                line,
+                f"record {rec} has an unreadable field ({exc})",
+                "Check the record against the CPF format description.",
+            ) from exc
+    for rec in ("H1", "H2"):
+        if rec not in head:
+            raise InputError(f"missing {rec} header record; is this an ILRS CPF file?", source=p)
+    if len(times) < 2:
+        raise InputError(
+            f"{len(times)} position records (type 10, direction 0); need >= 2", source=p
+        )
+    h1, h2 = head["H1"], head["H2"]
+    lineno_h2 = next(i for i, ln in enumerate(lines, 1) if ln[:2].upper() == "H2")
+    try:
+        start, end = _datetime(h2[4:10]), _datetime(h2[10:16])
+        step_s, frame = int(h2[16]), int(h2[19])
+    except ValueError as exc:
+        raise _err(
+            p,
+            lineno_h2,
+            lines[lineno_h2 - 1],
+            f"H2 has an unreadable field ({exc})",
+            "Expected integers for the dates, step and reference frame.",
+        ) from exc
+    if frame != 0:
+        raise _err(
+            p,
+            lineno_h2,
+            lines[lineno_h2 - 1],
+            f"reference frame {frame} ({FRAME_NAMES.get(frame, 'unknown')}) is not supported",
+            "Only frame 0 (geocentric true body-fixed, ITRF), the ILRS default for "
+            "Earth satellites, is read; obtain the frame-0 prediction.",
+        )
+    t_arr = np.array(times, dtype="datetime64[ns]")
+    if np.any(np.diff(t_arr) <= np.timedelta64(0, "ns")):
+        bad = int(np.argmax(np.diff(t_arr) <= np.timedelta64(0, "ns"))) + 1
+        raise InputError(
+            f"position record {bad + 1} ({t_arr[bad]}) is not after the previous one; "
+            "records must be in strictly increasing time order",
+            source=p,
+        )
+    v_arr = None
+    if vel and len(vel) == len(times) and vel_times == times:
+        v_arr = np.array(vel, dtype=np.float64)
+    com = float(head["H5"][1]) if "H5" in head and len(head["H5"]) > 1 else None
+    return Cpf(
+        path=p,
+        version=version,
+        source=h1[3],
+        target_name=h1[9] if version == 1 else h1[10],
+        cospar_id=h2[1],
+        sic=h2[2],
+        norad_id=h2[3],
+        start_utc=start,
+        end_utc=end,
+        step_s=step_s,
+        reference_frame=frame,
+        com_offset_m=com,
+        times_utc=t_arr,
+        r_itrf_m=np.array(pos, dtype=np.float64),
+        v_itrf_m_s=v_arr,
+    )
+
+
+def interpolate_table_m(
+    times_utc: NDArray[np.datetime64],
+    r_m: NDArray[np.float64],
+    t: TimeLike,
+    max_gap_s: float | None = None,
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """Interpolate a table of positions (UTC epochs) at the epochs ``t``, same frame.
+
+    Time differences are taken in TAI from split Julian dates, so they are exact to
+    ~1e-11 s and correct across leap seconds. Returns (N, 3) positions and the ok mask
+    (False, NaN row, outside the table's span, or, if ``max_gap_s`` is given, inside a
+    gap between two records longer than ``max_gap_s`` [s]).
+    """
+    t = as_time(t)
+    tn = time_from_utc(np.asarray(times_utc, dtype="datetime64[ns]"))
+    w0 = float(np.min(tn.whole))
+    x_nodes = ((np.asarray(tn.whole) - w0) + np.asarray(tn.tai_fraction)) * 86400.0
+    x = ((np.asarray(t.whole, dtype=np.float64) - w0) + np.asarray(t.tai_fraction)) * 86400.0
+    x = np.atleast_1d(x)
+    r, ok = lagrange_interpolate(x_nodes, r_m, x)
+    if max_gap_s is not None and x_nodes.size > 1:
+        i = np.clip(np.searchsorted(x_nodes, x, side="right") - 1, 0, x_nodes.size - 2)
+        in_gap = (x_nodes[i + 1] - x_nodes[i]) > max_gap_s
+        ok &= ~in_gap
+        r[~ok] = np.nan
+    return r, ok
+
+
+def cpf_position_gcrs_m(
+    cpf: Cpf, t: TimeLike, orientation: EarthOrientation | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """Target position in the GCRS from a CPF prediction.
+
+    Parameters
+    ----------
+    cpf
+        From :func:`read_cpf`.
+    t
+        Epochs (N), skyfield ``Time`` or UTC ``datetime64``.
+    orientation
+        Precomputed Earth orientation for ``t``.
+
+    Returns
+    -------
+    r_gcrs_m : ndarray
+        (N, 3) [m]; NaN rows outside the file's span and inside gaps longer than 1.5
+        times the step announced in H2.
+    ok : ndarray of bool
+        (N,) True where valid.
+    """
+    # A hole in the table (e.g. records removed around a manoeuvre) is not bridged.
+    max_gap = 1.5 * cpf.step_s if cpf.step_s > 0 else None
+    r_itrf, ok = interpolate_table_m(cpf.times_utc, cpf.r_itrf_m, t, max_gap_s=max_gap)
+    eo = orientation if orientation is not None else earth_orientation(t)
+    return eo.itrs_to_gcrs(r_itrf), ok
