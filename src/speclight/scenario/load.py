@@ -48,7 +48,9 @@ def load_scenario(path: str | Path) -> LoadedScenario:
     return parse_scenario(text, source=str(path), base_dir=path.resolve().parent)
 
 
-def parse_scenario(text: str, source: str = "<scenario>", base_dir: Path | None = None) -> LoadedScenario:
+def parse_scenario(
+    text: str, source: str = "<scenario>", base_dir: Path | None = None
+) -> LoadedScenario:
     """Validate scenario YAML text (see :func:`load_scenario`)."""
     try:
         data = yaml.safe_load(text)
@@ -177,14 +179,16 @@ def _describe(exc: ValidationError, data: dict[str, Any], root: Any) -> str:
         field = ".".join(str(p) for p in path) or "(top level)"
         line = _line(root, [p for p in path])
         prefix = f"line {line}: " if line else ""
-        text = f"{prefix}{field}{message}" if message.startswith((" =", ":")) else (
-            f"{prefix}{field}: {message}"
+        text = (
+            f"{prefix}{field}{message}"
+            if message.startswith((" =", ":"))
+            else (f"{prefix}{field}: {message}")
         )
         lines.setdefault(field, [])
         if text not in lines[field]:
             lines[field].append(text)
     out = []
-    for field, texts in lines.items():
+    for texts in lines.values():
         if len(texts) > 1:
             out.append(texts[0] + "".join(f"\n      or {t.split(': ', 1)[-1]}" for t in texts[1:]))
         else:

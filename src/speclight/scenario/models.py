@@ -154,7 +154,14 @@ class TorqueFreeAttitude(Strict):
     )
     initial_attitude: AxesOrientation
     angular_velocity_body_rad_s: Vector3
-    rtol: float = Field(default=1e-12, gt=0, lt=1e-3)
+    method: Literal["analytic", "ivp"] = Field(
+        default="analytic",
+        description="analytic: Jacobi elliptic closed form; ivp: numerical integration (reference)",
+    )
+    rtol: float = Field(default=1e-12, gt=0, lt=1e-3, description="ivp relative tolerance")
+    atol: float = Field(
+        default=1e-13, gt=0, lt=1e-3, description="ivp absolute tolerance / analytic angle [rad]"
+    )
 
     @field_validator("inertia_kg_m2")
     @classmethod
@@ -162,9 +169,7 @@ class TorqueFreeAttitude(Strict):
         ok_vector = len(value) == 3 and all(isinstance(v, float | int) for v in value)
         ok_matrix = len(value) == 3 and all(isinstance(r, list) and len(r) == 3 for r in value)
         if not (ok_vector or ok_matrix):
-            raise ValueError(
-                f"{value} is neither 3 principal moments nor a 3x3 tensor [kg m^2]"
-            )
+            raise ValueError(f"{value} is neither 3 principal moments nor a 3x3 tensor [kg m^2]")
         return value
 
 

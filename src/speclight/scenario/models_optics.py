@@ -8,9 +8,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import Discriminator, Field, Tag, model_validator
-
-from pydantic import BaseModel
+from pydantic import BaseModel, Discriminator, Field, Tag, model_validator
 
 from speclight.scenario.models import Strict, Vector3
 

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Set up speclight on a fresh machine: system libraries (when root and apt are available),
+# a virtual environment in .venv and the package with its pinned dependency ranges.
+#   bash scripts/setup.sh          # the package and all its engines
+#   bash scripts/setup.sh --dev    # ... plus the test and lint tools
+# Re-running is cheap: nothing is reinstalled unless pyproject.toml changed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+extras="all"
+[[ "${1:-}" == "--dev" ]] && extras="all,dev"
+
+# System libraries: libLLVM-19 for Mitsuba's fast LLVM backend, libgfortran5 for 6S.
+need=()
+ldconfig -p 2>/dev/null | grep -q 'libLLVM-19\.so' || need+=(libllvm19)
+ldconfig -p 2>/dev/null | grep -q 'libgfortran\.so\.5' || need+=(libgfortran5)
+if ((${#need[@]})); then
+    if [[ $(id -u) == 0 ]] && command -v apt-get >/dev/null; then
+        echo "setup: installing ${need[*]} with apt-get" >&2
+        { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${need[@]}"; } \
+            >/dev/null 2>&1 || echo "setup: notice: could not install ${need[*]}; speclight falls back (scalar rendering, SPECTRL2 instead of 6S)" >&2
+    else
+        echo "setup: notice: ${need[*]} missing and apt-get not usable here; speclight falls back (scalar rendering, SPECTRL2 instead of 6S)" >&2
+    fi
+fi
+
+python=${PYTHON:-python3}
+"$python" -c 'import sys; sys.exit(sys.version_info < (3, 11))' || {
+    echo "setup: speclight needs Python 3.11 or newer ($python is $("$python" -V 2>&1))" >&2
+    exit 1
+}
+[[ -x .venv/bin/python ]] || "$python" -m venv .venv
+
+stamp=.venv/.speclight-installed
+want="$extras $(sha256sum pyproject.toml | cut -c1-16)"
+if [[ ! -f $stamp || "$(cat "$stamp")" != "$want" ]]; then
+    echo "setup: installing speclight[$extras] into .venv (first time takes a few minutes)" >&2
+    .venv/bin/python -m pip install -q --disable-pip-version-check --upgrade pip >/dev/null
+    .venv/bin/python -m pip install -q --disable-pip-version-check -e ".[$extras]"
+    echo "$want" >"$stamp"
+fi

@@ -1,0 +1,172 @@
+"""Geometry and attitude stage of the pipeline: scenario in, per-epoch arrays out."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from speclight import attitude as att
+from speclight import orbit
+from speclight.errors import InputError
+from speclight.orbit.timescale import time_from_utc
+from speclight.scenario import LoadedScenario
+from speclight.scenario.models import (
+    AxesOrientation,
+    FixedAttitude,
+    SpinAttitude,
+    TimeGrid,
+    TorqueFreeAttitude,
+)
+from speclight.simulate import variables as v
+
+AU_M = 149_597_870_700.0
+
+
+@dataclass
+class Geometry:
+    """Per-epoch geometry of one scenario (SI units, GCRS unless named otherwise)."""
+
+    time_utc: NDArray[np.datetime64]
+    t_s: NDArray[np.float64]
+    r_target_gcrs_m: NDArray[np.float64]
+    orbit_ok: NDArray[np.bool_]
+    range_m: NDArray[np.float64]
+    azimuth_deg: NDArray[np.float64]
+    elevation_deg: NDArray[np.float64]
+    phase_angle_deg: NDArray[np.float64]
+    sunlit_fraction: NDArray[np.float64]
+    sun_distance_m: NDArray[np.float64]
+    quaternion_body_to_gcrs: NDArray[np.float64]
+    sun_direction_body: NDArray[np.float64]
+    observer_direction_body: NDArray[np.float64]
+    phase_vector_body: NDArray[np.float64]
+    flags: NDArray[np.uint8]
+
+    @property
+    def observable(self) -> NDArray[np.bool_]:
+        """Epochs whose target position is known and is above the minimum elevation."""
+        bad = v.FLAG_ORBIT_FAILED | v.FLAG_BELOW_MIN_ELEVATION
+        return (self.flags & bad) == 0
+
+
+def standard_pressure_mbar(altitude_m: float) -> float:
+    """Pressure of the ICAO standard atmosphere at ``altitude_m`` [mbar].
+
+    ``p = 1013.25 (1 - 2.25577e-5 h)^5.25588`` (ICAO Doc 7488, troposphere).
+    """
+    return 1013.25 * (1.0 - 2.25577e-5 * altitude_m) ** 5.25588
+
+
+def time_grid(grid: TimeGrid) -> NDArray[np.datetime64]:
+    """UTC epochs from ``start`` to ``stop`` (included when on the grid) every ``step_s``."""
+    start = np.datetime64(grid.start.replace(tzinfo=None), "ns")
+    span_s = (grid.stop - grid.start).total_seconds()
+    n = int(np.floor(span_s / grid.step_s + 1e-9)) + 1
+    offsets_ns = np.rint(np.arange(n) * grid.step_s * 1e9).astype("timedelta64[ns]")
+    return start + offsets_ns
+
+
+def _target_positions(loaded: LoadedScenario, t: object) -> tuple[NDArray, NDArray]:
+    cfg = loaded.scenario.orbit
+    if cfg.tle is not None:
+        tle = orbit.parse_tle(cfg.tle, source=f"{loaded.source}: orbit.tle")
+        return orbit.tle_position_gcrs_m(tle, t)
+    if cfg.tle_file is not None:
+        tle = orbit.read_tle_file(loaded.resolve(cfg.tle_file), norad_id=cfg.norad_id)
+        return orbit.tle_position_gcrs_m(tle, t)
+    if cfg.cpf_file is not None:
+        cpf = orbit.read_cpf(loaded.resolve(cfg.cpf_file))
+        return orbit.cpf_position_gcrs_m(cpf, t)
+    assert cfg.ephemeris_file is not None
+    eph = orbit.read_ephemeris_csv(loaded.resolve(cfg.ephemeris_file))
+    return orbit.ephemeris_position_gcrs_m(eph, t)
+
+
+def _orientation(o: AxesOrientation) -> NDArray[np.float64]:
+    if o.quaternion is not None:
+        return np.asarray(o.quaternion, dtype=float)
+    assert o.z_axis_ra_deg is not None and o.z_axis_dec_deg is not None
+    assert o.x_axis_ra_deg is not None and o.x_axis_dec_deg is not None
+    return att.frame_from_axes_radec(
+        o.z_axis_ra_deg, o.z_axis_dec_deg, o.x_axis_ra_deg, o.x_axis_dec_deg
+    )
+
+
+def attitude_quaternions(
+    cfg: FixedAttitude | SpinAttitude | TorqueFreeAttitude, t_s: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Body-to-GCRS quaternions (N, 4) for the scenario's attitude model."""
+    if isinstance(cfg, FixedAttitude):
+        return np.broadcast_to(_orientation(cfg), (t_s.size, 4)).copy()
+    if isinstance(cfg, SpinAttitude):
+        return att.spin_attitude(
+            t_s, cfg.spin_axis_ra_deg, cfg.spin_axis_dec_deg, cfg.period_s, cfg.initial_phase_deg
+        )
+    q, _ = att.torque_free_attitude(
+        t_s,
+        np.asarray(cfg.inertia_kg_m2, dtype=float),
+        _orientation(cfg.initial_attitude),
+        np.asarray(cfg.angular_velocity_body_rad_s, dtype=float),
+        method=cfg.method,
+        rtol=cfg.rtol,
+        atol=cfg.atol,
+    )
+    return q
+
+
+def compute_geometry(loaded: LoadedScenario) -> Geometry:
+    """Orbit, observer, Sun, shadow and attitude for every epoch of the scenario."""
+    sc = loaded.scenario
+    time_utc = time_grid(sc.time)
+    t = time_from_utc(time_utc)
+    t_s = (time_utc - time_utc[0]) / np.timedelta64(1, "s")
+    r_target, ok = _target_positions(loaded, t)
+    site = orbit.Site(sc.observer.latitude_deg, sc.observer.longitude_deg, sc.observer.altitude_m)
+    geo = orbit.compute_geometry(
+        t,
+        r_target,
+        site,
+        refraction=sc.observer.refraction,
+        temperature_C=sc.observer.temperature_C,
+        pressure_mbar=(
+            sc.observer.pressure_mbar
+            if sc.observer.pressure_mbar is not None
+            else standard_pressure_mbar(sc.observer.altitude_m)
+        ),
+    )
+    q = attitude_quaternions(sc.attitude, t_s)
+    sun_b, obs_b, phase_b = att.body_directions(
+        q, geo.sun_direction_gcrs, geo.observer_direction_gcrs
+    )
+    flags = np.zeros(t_s.size, dtype=np.uint8)
+    flags[~ok] |= v.FLAG_ORBIT_FAILED
+    with np.errstate(invalid="ignore"):
+        flags[~(geo.elevation_deg >= sc.observer.min_elevation_deg)] |= v.FLAG_BELOW_MIN_ELEVATION
+        flags[geo.sunlit_fraction <= 0.0] |= v.FLAG_IN_SHADOW
+        flags[(geo.sunlit_fraction > 0.0) & (geo.sunlit_fraction < 1.0)] |= v.FLAG_PENUMBRA
+    if not np.any(ok):
+        raise InputError(
+            "the orbit gives no valid position in the time window (outside the CPF/ephemeris "
+            "span, or SGP4 failed at every epoch)",
+            source=loaded.source,
+            field="time",
+        )
+    return Geometry(
+        time_utc=time_utc,
+        t_s=t_s,
+        r_target_gcrs_m=r_target,
+        orbit_ok=ok,
+        range_m=geo.range_m,
+        azimuth_deg=geo.azimuth_deg,
+        elevation_deg=geo.elevation_deg,
+        phase_angle_deg=geo.phase_angle_deg,
+        sunlit_fraction=geo.sunlit_fraction,
+        sun_distance_m=geo.sun_distance_m,
+        quaternion_body_to_gcrs=q,
+        sun_direction_body=sun_b,
+        observer_direction_body=obs_b,
+        phase_vector_body=phase_b,
+        flags=flags,
+    )

@@ -1,0 +1,143 @@
+"""The command line of SPEC section 2: outputs, exit codes and messages."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+from typer.testing import CliRunner
+
+from speclight.cli import app
+from speclight.scenario import example_text
+
+runner = CliRunner()
+
+GEOMETRY_VARIABLES = [
+    "range",
+    "azimuth",
+    "elevation",
+    "phase_angle",
+    "sunlit",
+    "sun_direction_body",
+    "observer_direction_body",
+    "phase_vector_body",
+]
+
+
+def _short_scenario(tmp_path: Path, name: str = "calsphere", **time: str) -> Path:
+    data = yaml.safe_load(example_text(name))
+    data["time"].update(time)
+    path = tmp_path / "scenario.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def test_example_lists_and_prints() -> None:
+    listed = runner.invoke(app, ["example"])
+    assert listed.exit_code == 0
+    assert {"box-wing", "calsphere", "lcs1"} <= set(listed.stdout.split())
+    printed = runner.invoke(app, ["example", "lcs1"])
+    assert printed.exit_code == 0
+    assert yaml.safe_load(printed.stdout)["name"] == "lcs1-pass"
+
+
+def test_unknown_example_exits_2() -> None:
+    result = runner.invoke(app, ["example", "box_wing"])
+    assert result.exit_code == 2
+    assert "did you mean 'box-wing'" in result.stderr
+
+
+def test_simulate_edited_copy_writes_geometry(tmp_path: Path) -> None:
+    scenario = _short_scenario(tmp_path, stop="2020-02-29T21:15:00Z", step_s=10.0)
+    out = tmp_path / "out.nc"
+    result = runner.invoke(app, ["simulate", str(scenario), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    ds = xr.open_dataset(out)
+    assert ds.sizes["time"] == 13
+    for name in GEOMETRY_VARIABLES:
+        assert "units" in ds[name].attrs and "long_name" in ds[name].attrs
+    # unit vectors are unit vectors (a property of the definition, not of the code)
+    norms = np.linalg.norm(ds["observer_direction_body"].values, axis=1)
+    np.testing.assert_allclose(norms, 1.0, atol=1e-12)
+    assert "lcs1" not in ds.attrs["scenario_yaml"] and "calsphere" in ds.attrs["scenario_yaml"]
+    assert ds.attrs["speclight_version"]
+    ds.close()
+
+
+def test_existing_output_needs_force(tmp_path: Path) -> None:
+    scenario = _short_scenario(tmp_path, stop="2020-02-29T21:13:10Z", step_s=5.0)
+    out = tmp_path / "out.nc"
+    out.write_text("precious")
+    refused = runner.invoke(app, ["simulate", str(scenario), "-o", str(out)])
+    assert refused.exit_code == 2
+    assert "--force" in refused.stderr
+    assert out.read_text() == "precious"
+    forced = runner.invoke(app, ["simulate", str(scenario), "-o", str(out), "--force"])
+    assert forced.exit_code == 0, forced.output
+    assert xr.open_dataset(out).sizes["time"] == 3
+
+
+def test_bad_scenario_exits_2_without_traceback(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(example_text("lcs1").replace("step_s: 2.0", "step_s: 0"))
+    out = tmp_path / "out.nc"
+    result = runner.invoke(app, ["simulate", str(bad), "-o", str(out)])
+    assert result.exit_code == 2
+    assert "time.step_s = 0" in result.stderr
+    assert "Traceback" not in result.output
+    assert not out.exists() and not list(tmp_path.glob(".out.nc*"))
+
+
+def test_window_without_visibility_succeeds_and_says_so(tmp_path: Path) -> None:
+    # Calsphere 4A is 45-54 deg below Stuttgart's horizon from 12:00 to 12:05 UTC that day
+    # (checked with skyfield directly); the run must still succeed and tell the user.
+    scenario = _short_scenario(
+        tmp_path, start="2020-02-29T12:00:00Z", stop="2020-02-29T12:05:00Z", step_s=30.0
+    )
+    out = tmp_path / "out.nc"
+    result = runner.invoke(app, ["simulate", str(scenario), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "never both sunlit and above the minimum elevation" in result.stdout
+    ds = xr.open_dataset(out)
+    assert np.all(ds["elevation"].values < 10.0)
+    assert np.all(ds["flags"].values & 2)
+
+
+def test_info_reports_versions_and_coverage() -> None:
+    result = runner.invoke(app, ["info"])
+    assert result.exit_code == 0, result.output
+    assert "skyfield" in result.stdout and "eop_measured_until" in result.stdout
+
+
+def test_console_script_entry_point(tmp_path: Path) -> None:
+    # The installed console script, run as a user would.
+    exe = Path(sys.executable).with_name("speclight")
+    if not exe.exists():
+        pytest.skip("speclight console script not installed in this environment")
+    result = subprocess.run([str(exe), "example", "calsphere"], capture_output=True, text=True)
+    assert result.returncode == 0 and "CALSPHERE 4A" in result.stdout
+
+
+def test_plot_writes_png_and_refuses_overwrite(tmp_path: Path) -> None:
+    pytest.importorskip("matplotlib")
+    scenario = _short_scenario(tmp_path, stop="2020-02-29T21:14:00Z", step_s=10.0)
+    out = tmp_path / "out.nc"
+    assert runner.invoke(app, ["simulate", str(scenario), "-o", str(out)]).exit_code == 0
+    fig = tmp_path / "fig.png"
+    first = runner.invoke(app, ["plot", str(out), "-o", str(fig)])
+    assert first.exit_code == 0, first.output
+    assert fig.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    again = runner.invoke(app, ["plot", str(out), "-o", str(fig)])
+    assert again.exit_code == 2 and "--force" in again.stderr
+
+
+def test_plot_rejects_a_file_that_is_not_a_dataset(tmp_path: Path) -> None:
+    junk = tmp_path / "junk.nc"
+    junk.write_text("not netcdf")
+    result = runner.invoke(app, ["plot", str(junk), "-o", str(tmp_path / "f.png")])
+    assert result.exit_code == 2 and "cannot read" in result.stderr

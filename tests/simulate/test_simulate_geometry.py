@@ -1,0 +1,70 @@
+"""The geometry stage of the pipeline, end to end from scenario text to dataset."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import yaml
+
+from speclight.errors import InputError
+from speclight.scenario import example_text, parse_scenario
+from speclight.simulate import simulate
+from speclight.simulate.geometry import time_grid
+
+
+def _scenario(name: str = "lcs1", **changes: object) -> str:
+    data = yaml.safe_load(example_text(name))
+    data.update(changes)
+    return yaml.safe_dump(data, sort_keys=False)
+
+
+def test_time_grid_includes_stop_on_grid_only() -> None:
+    loaded = parse_scenario(example_text("lcs1"))
+    grid = time_grid(loaded.scenario.time)
+    assert grid.size == 21 * 60 // 2 + 1
+    assert str(grid[-1]) == "2020-07-18T01:38:00.000000000"
+
+
+@pytest.mark.parametrize(
+    "attitude",
+    [
+        {
+            "model": "fixed",
+            "z_axis_ra_deg": 10,
+            "z_axis_dec_deg": 20,
+            "x_axis_ra_deg": 100,
+            "x_axis_dec_deg": 0,
+        },
+        {"model": "spin", "spin_axis_ra_deg": 30, "spin_axis_dec_deg": 45, "period_s": 12},
+        {
+            "model": "torque_free",
+            "inertia_kg_m2": [1.0, 2.0, 3.0],
+            "initial_attitude": {"quaternion": [1, 0, 0, 0]},
+            "angular_velocity_body_rad_s": [0.1, 0.3, 0.05],
+        },
+    ],
+)
+def test_body_frame_preserves_the_phase_angle(attitude: dict[str, object]) -> None:
+    # A rotation preserves angles: the angle between the body-frame Sun and observer
+    # directions must equal the phase angle computed in GCRS, for any attitude model.
+    ds = simulate(parse_scenario(_scenario(attitude=attitude))).dataset
+    sun = ds["sun_direction_body"].values
+    obs = ds["observer_direction_body"].values
+    angle = np.degrees(np.arccos(np.clip(np.sum(sun * obs, axis=1), -1, 1)))
+    np.testing.assert_allclose(angle, ds["phase_angle"].values, atol=1e-8)
+    bisector = (sun + obs) / np.linalg.norm(sun + obs, axis=1, keepdims=True)
+    np.testing.assert_allclose(ds["phase_vector_body"].values, bisector, atol=1e-12)
+
+
+def test_shadow_flags_follow_sunlit_fraction() -> None:
+    ds = simulate(parse_scenario(example_text("calsphere"))).dataset
+    sunlit, flags = ds["sunlit"].values, ds["flags"].values
+    assert np.any(sunlit == 0) and np.any(sunlit == 1), "the example crosses the shadow edge"
+    np.testing.assert_array_equal((flags & 4) > 0, sunlit <= 0)
+    np.testing.assert_array_equal((flags & 8) > 0, (sunlit > 0) & (sunlit < 1))
+
+
+def test_tle_checksum_error_names_scenario_field() -> None:
+    text = example_text("lcs1").replace("0  9994", "0  9995")
+    with pytest.raises(InputError, match=r"orbit\.tle.*checksum"):
+        simulate(parse_scenario(text, source="my.yaml"))
