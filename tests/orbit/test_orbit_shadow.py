@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from importlib.resources import files
 
 import numpy as np
 import pytest
@@ -19,7 +20,7 @@ import pytest
 from speclight.orbit import read_tle_file, sun_position_gcrs_m, sunlit_fraction, tle_position_gcrs_m
 from speclight.orbit.shadow import disk_overlap_fraction
 
-TLE_FILE = "/work/shared/data/tle/calibration_spheres.tle"
+TLE_FILE = str(files("speclight") / "data" / "tle" / "calibration_spheres.tle")
 R_EARTH_M = 6_378_137.0
 R_SUN_M = 695_700_000.0
 #: Bisection resolution for event times.

@@ -7,6 +7,8 @@ References: the TLE column layout and checksum rule of Vallado et al. (2006), AI
 
 from __future__ import annotations
 
+from importlib.resources import files
+
 import numpy as np
 import pytest
 from sgp4.api import Satrec
@@ -17,7 +19,7 @@ from speclight.orbit import parse_tle, read_tle_file, read_tles, tle_position_gc
 from speclight.orbit.frames import as_time
 from speclight.orbit.timescale import load_timescale
 
-TLE_FILE = "/work/shared/data/tle/calibration_spheres.tle"
+TLE_FILE = str(files("speclight") / "data" / "tle" / "calibration_spheres.tle")
 L1 = "1 01361U 65034C   20199.53569372  .00000028  00000-0  25492-2 0  9994"
 L2 = "2 01361  32.1395 267.1291 0005455 248.0922 111.8996  9.89297492995906"
 LCS4_L1 = "1 05398U 71067E   17237.19596243  .00000191  00000-0  60767-4 0  9996"
