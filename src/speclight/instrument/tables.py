@@ -1,0 +1,176 @@
+"""Reading user tables of spectral curves: CSV parsing and unit detection.
+
+Format: a text file with two or more columns separated by commas, semicolons, tabs or
+spaces; lines starting with ``#`` are comments; an optional header line names the columns.
+The first column is the wavelength, the others values.
+
+Units are taken from the header when it names them (``wavelength_nm``, ``wavelength_um``,
+``qe_percent``, ``transmission_fraction``, ``%``...). When it does not, they are inferred:
+wavelengths below 30 are micrometres (no optical table in nm has all its wavelengths below
+30 nm, and none in micrometres reaches 30 um), values above 1.5 are percent (a fraction
+cannot exceed 1). An inference is announced with a :class:`UserWarning` saying what was
+assumed; a header that contradicts its values is an error.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from speclight.errors import InputError
+
+#: Wavelengths whose maximum is below this are read as micrometres when the header is silent.
+UM_THRESHOLD = 30.0
+#: Values whose maximum exceeds this are read as percent when the header is silent.
+PERCENT_THRESHOLD = 1.5
+
+_SPLIT = re.compile(r"[,;\t ]+")
+
+
+def read_table(path: str | Path, field: str) -> tuple[list[str] | None, NDArray[np.float64]]:
+    """Read a numeric table; return the header names (or None) and the data (n, k).
+
+    Raises
+    ------
+    InputError
+        If the file is missing, a row is not numeric, the column counts differ or there
+        are fewer than 2 rows or 2 columns.
+    """
+    p = Path(path).expanduser()
+    if not p.is_file():
+        raise InputError(f"table file {str(p)!r} does not exist", source=str(p), field=field)
+    header: list[str] | None = None
+    rows: list[list[float]] = []
+    for lineno, raw in enumerate(p.read_text(encoding="utf-8-sig").splitlines(), start=1):
+        line = raw.strip()
+        if not line or line.startswith("#"):
+            continue
+        parts = [c.strip().strip('"') for c in _SPLIT.split(line) if c.strip()]
+        try:
+            values = [float(c) for c in parts]
+        except ValueError:
+            if header is None and not rows:
+                header = parts
+                continue
+            raise InputError(
+                f"line {lineno} {line!r} is not numeric; expected columns like "
+                "'wavelength_nm,value'",
+                source=str(p),
+                field=field,
+            ) from None
+        if rows and len(values) != len(rows[0]):
+            raise InputError(
+                f"line {lineno} has {len(values)} columns, earlier lines {len(rows[0])}",
+                source=str(p),
+                field=field,
+            )
+        rows.append(values)
+    data = np.asarray(rows, dtype=np.float64)
+    if data.ndim != 2 or data.shape[0] < 2 or data.shape[1] < 2:
+        raise InputError(
+            "a table needs at least 2 rows of 'wavelength, value' columns",
+            source=str(p),
+            field=field,
+        )
+    if header is not None and len(header) != data.shape[1]:
+        header = None
+    return header, data
+
+
+def _unit_in(name: str, tokens: tuple[str, ...]) -> bool:
+    words = re.split(r"[^a-z%µ]+", name.lower())
+    return any(t in words for t in tokens)
+
+
+def wavelength_to_nm(
+    values: NDArray[np.float64], name: str | None, source: str, field: str
+) -> NDArray[np.float64]:
+    """Convert a wavelength column to nm, from its header name or its magnitude."""
+    says_um = name is not None and _unit_in(name, ("um", "µm", "micron", "microns", "micrometre"))
+    says_nm = name is not None and _unit_in(name, ("nm", "nanometre", "nanometer"))
+    top = float(np.nanmax(values))
+    if says_nm and top < UM_THRESHOLD:
+        raise InputError(
+            f"the wavelength column {name!r} says nm but its values "
+            f"{np.nanmin(values):g}..{top:g} look like micrometres; rename the column to "
+            "'wavelength_um' or multiply the wavelengths by 1000",
+            source=source,
+            field=field,
+        )
+    if says_um and top >= UM_THRESHOLD:
+        raise InputError(
+            f"the wavelength column {name!r} says micrometres but its values "
+            f"{np.nanmin(values):g}..{top:g} look like nm; rename the column to "
+            "'wavelength_nm' or divide the wavelengths by 1000",
+            source=source,
+            field=field,
+        )
+    if says_um:
+        return values * 1000.0
+    if says_nm:
+        return values
+    if top < UM_THRESHOLD:
+        warnings.warn(
+            f"{source}: wavelengths {np.nanmin(values):g}..{top:g} have no unit in the "
+            f"header and are all below {UM_THRESHOLD:g}, so they are read as micrometres "
+            "(x1000 to nm); name the column 'wavelength_nm' or 'wavelength_um' to say so",
+            UserWarning,
+            stacklevel=3,
+        )
+        return values * 1000.0
+    return values
+
+
+def value_to_fraction(
+    values: NDArray[np.float64], name: str | None, source: str, field: str
+) -> NDArray[np.float64]:
+    """Convert a value column (efficiency, transmission) to a fraction 0..1."""
+    says_pct = name is not None and (
+        "%" in name or _unit_in(name, ("percent", "pct", "percentage"))
+    )
+    says_frac = name is not None and _unit_in(name, ("fraction", "frac"))
+    top = float(np.nanmax(values))
+    if says_frac and top > PERCENT_THRESHOLD:
+        raise InputError(
+            f"the column {name!r} says fraction but reaches {top:g}; if these are percent, "
+            "rename it with '_percent' or divide by 100",
+            source=source,
+            field=field,
+        )
+    if says_pct:
+        out = values / 100.0
+    elif says_frac:
+        out = values
+    elif top > PERCENT_THRESHOLD:
+        warnings.warn(
+            f"{source}: values reach {top:g} and the header gives no unit, so they are read "
+            "as percent (/100); name the column '..._percent' or '..._fraction' to say so",
+            UserWarning,
+            stacklevel=3,
+        )
+        out = values / 100.0
+    else:
+        out = values
+    if np.any(out < 0) or np.any(out > 1.0 + 1e-6):
+        raise InputError(
+            f"values {np.nanmin(out):g}..{np.nanmax(out):g} (as a fraction) must lie in 0..1",
+            source=source,
+            field=field,
+        )
+    return out
+
+
+def sort_unique(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
+    """Sort by wavelength and average rows that share a wavelength (digitised curves)."""
+    order = np.argsort(x, kind="stable")
+    xs, ys = x[order], y[order]
+    ux, inverse = np.unique(xs, return_inverse=True)
+    if ux.size == xs.size:
+        return xs, ys
+    sums = np.zeros(ux.size)
+    np.add.at(sums, inverse, ys)
+    return ux, sums / np.bincount(inverse)
