@@ -1,0 +1,251 @@
+"""Public entry point of the render stage: :func:`render_intensity`."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from speclight.errors import InputError
+from speclight.render.raycast import Caster, MitsubaCaster, NumpyCaster
+from speclight.render.result import RenderResult
+from speclight.render.variant import choose_variant
+from speclight.target.geometry import Target
+
+RenderMode = Literal["single", "path"]
+MIN_RESOLUTION_PX = 8
+
+
+def _unit_rows(
+    a: ArrayLike, name: str, n: int | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    x = np.asarray(a, dtype=float)
+    if x.ndim == 1 and x.shape == (3,):
+        x = x[None, :]
+    if x.ndim != 2 or x.shape[1] != 3 or (n is not None and len(x) != n):
+        want = f"({n}, 3)" if n is not None else "(N, 3)"
+        raise InputError(f"{name} must have shape {want}, got {x.shape}", field=name)
+    norm = np.linalg.norm(x, axis=1)
+    ok = np.isfinite(norm) & (norm > 0)
+    out = np.where(ok[:, None], x / np.where(ok, norm, 1.0)[:, None], np.nan)
+    return out, ok
+
+
+def make_caster(target: Target, variant: str) -> Caster:
+    """The ray caster for a variant: Mitsuba for llvm/cuda variants, numpy otherwise."""
+    if variant.startswith(("llvm_", "cuda_")):
+        return MitsubaCaster(target, variant)
+    return NumpyCaster(target)
+
+
+def render_intensity(
+    target: Target,
+    sun_dir_body: ArrayLike,
+    observer_dir_body: ArrayLike,
+    solar_irradiance_W_m2_nm: ArrayLike,
+    wavelength_nm: ArrayLike,
+    *,
+    mode: RenderMode = "single",
+    resolution_px: int = 256,
+    samples_per_pixel: int = 16,
+    seed: int = 0,
+    variant: str | None = None,
+    workers: int | None = None,
+    progress: bool = False,
+    keep_images_for: Iterable[int] | None = None,
+) -> RenderResult:
+    """Radiant intensity of a sunlit target toward an observer, per epoch and wavelength.
+
+    Parameters
+    ----------
+    target
+        The target (body frame).
+    sun_dir_body, observer_dir_body
+        (N, 3) unit vectors in the body frame from the target to the Sun / to the observer.
+    solar_irradiance_W_m2_nm
+        (N, L) solar spectral irradiance at the target [W m-2 nm-1] (bin averages); shadowing
+        by the Earth is applied by the caller.
+    wavelength_nm
+        (L,) bin centres [nm].
+    mode
+        ``single`` (one bounce with self-shadowing, exact in wavelength, the default) or
+        ``path`` (multi-bounce Monte Carlo path tracing with Mitsuba's spectral variant).
+    resolution_px
+        Image size (square) covering the target's bounding sphere.
+    samples_per_pixel
+        Path mode: samples per pixel. Single mode casts one ray through each pixel centre.
+    seed
+        Path mode: random seed (the result is reproducible for a given seed and variant).
+    variant
+        Mitsuba variant or ``None``/``"auto"`` (see :func:`speclight.render.choose_variant`);
+        ``"numpy"`` or a ``scalar_*`` variant casts single-mode rays with numpy.
+    workers
+        Single mode with the numpy caster: number of processes over blocks of epochs.
+        Dr.Jit variants are already parallel over all cores and ignore it.
+    progress
+        Show a progress bar (on a terminal).
+    keep_images_for
+        Epoch indices whose hyperspectral radiance image and depth map are returned.
+
+    Returns
+    -------
+    RenderResult
+        ``intensity_W_sr_nm`` (N, L) = sum over pixels of radiance x pixel area, NaN rows for
+        epochs whose inputs are not finite.
+    """
+    if mode not in ("single", "path"):
+        raise InputError(f"render.mode = '{mode}' must be 'single' or 'path'", field="render.mode")
+    if int(resolution_px) < MIN_RESOLUTION_PX:
+        raise InputError(
+            f"render.resolution_px = {resolution_px} must be >= {MIN_RESOLUTION_PX}",
+            field="render.resolution_px",
+        )
+    wl = np.asarray(wavelength_nm, dtype=float).ravel()
+    sun, ok_s = _unit_rows(sun_dir_body, "sun_dir_body")
+    obs, ok_o = _unit_rows(observer_dir_body, "observer_dir_body", len(sun))
+    e = np.asarray(solar_irradiance_W_m2_nm, dtype=float)
+    if e.ndim == 1:
+        e = np.broadcast_to(e, (len(sun), len(wl)))
+    if e.shape != (len(sun), len(wl)):
+        raise InputError(
+            f"solar_irradiance_W_m2_nm must have shape (N, L) = ({len(sun)}, {len(wl)}), "
+            f"got {e.shape}",
+            field="solar_irradiance_W_m2_nm",
+        )
+    ok = ok_s & ok_o & np.all(np.isfinite(e), axis=1)
+    keep = sorted(int(k) for k in (keep_images_for or ()))
+    for k in keep:
+        if not 0 <= k < len(sun):
+            raise InputError(
+                f"keep_images_for index {k} is outside 0..{len(sun) - 1}", field="keep_images_for"
+            )
+    valid = np.flatnonzero(ok)
+    remap = {int(g): j for j, g in enumerate(valid)}
+    keep_local = [remap[k] for k in keep if k in remap]
+    intensity = np.full((len(sun), len(wl)), np.nan)
+    std = np.full((len(sun), len(wl)), np.nan)
+    images = {}
+    if mode == "single":
+        chosen = choose_variant(variant, spectral=False)
+        n_workers = int(workers or 1)
+        if n_workers > 1 and not chosen.startswith(("llvm_", "cuda_")) and len(valid) > 1:
+            # Dr.Jit variants already use every core; the numpy caster runs one process per
+            # worker on contiguous blocks of epochs (Mitsuba scenes are never pickled).
+            inten, imgs = _single_in_processes(
+                target,
+                sun[valid],
+                obs[valid],
+                e[valid],
+                wl,
+                int(resolution_px),
+                keep_local,
+                n_workers,
+            )
+            used = "numpy"
+        else:
+            caster = make_caster(target, chosen)
+            from speclight.render.single import render_single
+
+            with _progress(progress, len(valid)) as advance:
+                inten, imgs = render_single(
+                    target,
+                    sun[valid],
+                    obs[valid],
+                    e[valid],
+                    wl,
+                    caster,
+                    int(resolution_px),
+                    keep_local,
+                    on_batch=advance,
+                )
+            used = caster.name
+        intensity[valid] = inten
+        std[valid] = 0.0
+    else:
+        chosen = choose_variant(variant, spectral=True)
+        from speclight.render.path import render_path
+
+        with _progress(progress, len(valid)) as advance:
+            inten, err, imgs = render_path(
+                target,
+                sun[valid],
+                obs[valid],
+                e[valid],
+                wl,
+                chosen,
+                int(resolution_px),
+                int(samples_per_pixel),
+                int(seed),
+                keep_local,
+                on_epoch=advance,
+            )
+        intensity[valid] = inten
+        std[valid] = err
+        used = chosen
+    for j, img in imgs.items():
+        g = int(valid[j])
+        img.epoch = g
+        images[g] = img
+    return RenderResult(intensity, std, ok, used, mode, images)
+
+
+def _single_chunk(args: tuple) -> tuple:
+    from speclight.render.raycast import NumpyCaster
+    from speclight.render.single import render_single
+
+    target, sun, obs, e, wl, res, keep = args
+    return render_single(target, sun, obs, e, wl, NumpyCaster(target), res, keep)
+
+
+def _single_in_processes(
+    target: Target,
+    sun: NDArray[np.float64],
+    obs: NDArray[np.float64],
+    e: NDArray[np.float64],
+    wl: NDArray[np.float64],
+    res: int,
+    keep: list[int],
+    workers: int,
+) -> tuple[NDArray[np.float64], dict]:
+    import itertools
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
+    bounds = np.linspace(0, len(sun), min(workers, len(sun)) + 1).astype(int)
+    jobs = []
+    for a, b in itertools.pairwise(bounds):
+        local = [k - a for k in keep if a <= k < b]
+        jobs.append((target, sun[a:b], obs[a:b], e[a:b], wl, res, local))
+    with ProcessPoolExecutor(len(jobs), mp_context=mp.get_context("spawn")) as pool:
+        parts = list(pool.map(_single_chunk, jobs))
+    images = {}
+    for a, (_, imgs) in zip(bounds[:-1], parts, strict=True):
+        for k, img in imgs.items():
+            images[int(a) + k] = img
+    return np.concatenate([p[0] for p in parts]), images
+
+
+class _progress:
+    """Context manager giving an ``advance(n)`` callback; a rich bar on a terminal if asked."""
+
+    def __init__(self, show: bool, total: int) -> None:
+        import sys
+
+        self.show = show and sys.stderr.isatty()
+        self.total = total
+
+    def __enter__(self):  # type: ignore[no-untyped-def]
+        if not self.show:
+            return lambda n: None
+        from rich.progress import Progress
+
+        self.bar = Progress(transient=True)
+        self.bar.start()
+        task = self.bar.add_task("rendering", total=self.total)
+        return lambda n: self.bar.advance(task, n)
+
+    def __exit__(self, *exc: object) -> None:
+        if self.show:
+            self.bar.stop()

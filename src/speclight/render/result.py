@@ -1,0 +1,58 @@
+"""What a render returns."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+
+@dataclass
+class RenderImage:
+    """Hyperspectral image and depth map of one epoch, orthographic view along the line of sight.
+
+    ``radiance_W_m2_sr_nm`` (H, W, L) is the reflected radiance in each pixel;
+    ``depth_m`` (H, W) the distance along the line of sight behind the plane through the target
+    centre that faces the observer (NaN where the pixel misses the target), so the range to a
+    pixel is ``range_m + depth_m``; ``part_index`` (H, W) the part seen (-1: none).
+    Row 0 is the top of the image; ``up_body`` and ``right_body`` are the body-frame directions
+    of the image axes; ``pixel_size_m`` is the pixel pitch [m].
+    """
+
+    epoch: int
+    radiance_W_m2_sr_nm: NDArray[np.float64]
+    depth_m: NDArray[np.float64]
+    part_index: NDArray[np.int64]
+    pixel_size_m: float
+    right_body: NDArray[np.float64]
+    up_body: NDArray[np.float64]
+
+
+@dataclass
+class RenderResult:
+    """Radiant intensity of the target toward the observer.
+
+    Attributes
+    ----------
+    intensity_W_sr_nm
+        (N, L) radiant intensity [W sr-1 nm-1]; NaN rows where the epoch's inputs were NaN.
+    intensity_std_W_sr_nm
+        (N, L) Monte Carlo standard error of ``intensity_W_sr_nm`` [W sr-1 nm-1]; zero in
+        ``single`` mode, whose only error is the pixel discretisation.
+    ok
+        (N,) True where the epoch was rendered.
+    variant
+        Ray-casting engine: a Mitsuba variant name, or ``"numpy"``.
+    mode
+        ``single`` or ``path``.
+    images
+        Epoch index -> :class:`RenderImage` for the epochs asked for in ``keep_images_for``.
+    """
+
+    intensity_W_sr_nm: NDArray[np.float64]
+    intensity_std_W_sr_nm: NDArray[np.float64]
+    ok: NDArray[np.bool_]
+    variant: str
+    mode: str
+    images: dict[int, RenderImage] = field(default_factory=dict)

@@ -1,0 +1,204 @@
+"""Single-scattering render: one bounce of sunlight, with self-shadowing, evaluated exactly.
+
+For each epoch an orthographic grid of rays (one per pixel centre) is cast along the line of
+sight; each hit is tested for shadow by a ray towards the Sun, and the BRDF is evaluated for
+the Sun and observer directions. Every model factorises into geometric weights times spectral
+factors (see :mod:`speclight.render.models`), so one ray cast per epoch gives all
+wavelengths, without noise in wavelength:
+
+    I(lambda) = E(lambda) * sum_c w_c * R_c(lambda)      [W sr-1 nm-1]
+
+with ``w_c = sum_pixels A_pix * f cos(theta_i) / R_c`` [m² sr-1] per channel c. The microfacet
+Fresnel term depends on the half-angle, the same for all pixels of an epoch, so it is exact.
+A smooth mirror (``specular``, smooth ``plastic`` coat) reflects the solar disk (uniform,
+angular radius :data:`~speclight.illumination.SOLAR_ANGULAR_RADIUS_RAD`): a pixel whose mirror
+direction falls inside the disk shows the radiance ``R * E / Omega_sun``. Surfaces are
+two-sided (thin sheets reflect on both faces with the same material).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from speclight.render import models
+from speclight.render.camera import image_axes, primary_rays
+from speclight.render.raycast import Caster
+from speclight.render.result import RenderImage
+from speclight.target.geometry import Target
+
+F64 = NDArray[np.float64]
+I64 = NDArray[np.int64]
+
+
+@dataclass
+class _Kept:
+    """Pixel data of one kept epoch: contributions (pixel, channel, weight) and geometry."""
+
+    pixel: I64
+    channel: I64
+    weight: F64
+    part: I64
+    depth_m: F64
+    right: F64
+    up: F64
+
+
+class _Layout:
+    """Channel layout: main channel m for material m, then K*K channels per plastic."""
+
+    def __init__(self, target: Target) -> None:
+        self.mats = list(target.materials)
+        self.part_mat = target.part_material_index
+        self.block: dict[int, int] = {}
+        c = len(self.mats)
+        for k, m in enumerate(self.mats):
+            if m.bsdf == "plastic":
+                self.block[k] = c
+                c += models.PLASTIC_NODES**2
+        self.n_channels = c
+
+
+def _pixel_contributions(
+    layout: _Layout, mat: I64, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mirror_ok: F64
+) -> tuple[I64, I64, F64]:
+    """(pixel position in the input, channel, weight [sr-1]) of every contribution."""
+    rows, chans, weights = [], [], []
+    for k, m in enumerate(layout.mats):
+        sel = np.flatnonzero(mat == k)
+        if sel.size == 0:
+            continue
+        w = models.main_weight(m, cos_i[sel], cos_o[sel], cos_h[sel], cos_d[sel], mirror_ok[sel])
+        rows.append(sel)
+        chans.append(np.full(sel.size, k))
+        weights.append(w)
+        if k in layout.block:
+            idx, bw = models.bilinear_nodes(cos_i[sel], cos_o[sel])
+            rows.append(np.repeat(sel, 4))
+            chans.append((layout.block[k] + idx).ravel())
+            weights.append((bw * (cos_i[sel] / np.pi)[:, None]).ravel())
+    if not rows:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
+    return np.concatenate(rows), np.concatenate(chans), np.concatenate(weights)
+
+
+def geometric_weights(
+    target: Target,
+    sun_dir: F64,
+    obs_dir: F64,
+    caster: Caster,
+    resolution_px: int,
+    keep: Iterable[int] = (),
+    rays_per_batch: int = 1_000_000,
+    on_batch: Callable[[int], None] | None = None,
+) -> tuple[F64, dict[int, _Kept], float, _Layout]:
+    """Channel weights w (N, C) [m² sr-1], kept pixel data, pixel pitch [m] and the layout."""
+    layout = _Layout(target)
+    centre, radius = target.bounding_sphere()
+    n_ep, n_ch = len(sun_dir), layout.n_channels
+    pixels = resolution_px * resolution_px
+    batch = max(1, rays_per_batch // pixels)
+    keep_set = set(keep)
+    w = np.zeros((n_ep, n_ch))
+    kept: dict[int, _Kept] = {}
+    pixel_area = (2.0 * radius / resolution_px) ** 2
+    for a in range(0, n_ep, batch):
+        s, o = sun_dir[a : a + batch], obs_dir[a : a + batch]
+        b = len(s)
+        origin, direction, pixel_area = primary_rays(centre, radius, o, resolution_px)
+        hits = caster.intersect(origin, direction)
+        ep = np.repeat(np.arange(b), pixels)
+        n = hits.normal
+        cos_o = np.einsum("mk,mk->m", n, o[ep])
+        flip = np.where(cos_o < 0, -1.0, 1.0)  # thin sheets reflect on both faces
+        n = n * flip[:, None]
+        cos_o = cos_o * flip
+        cos_i = np.einsum("mk,mk->m", n, s[ep])
+        idx = np.flatnonzero(hits.hit & (cos_i > 0) & (cos_o > 0))
+        pos = origin[idx] + hits.t_m[idx, None] * direction[idx]
+        idx = idx[~caster.occluded(pos, s[ep[idx]], n[idx])]
+        e_idx = ep[idx]
+        half = s + o
+        norm = np.linalg.norm(half, axis=1, keepdims=True)
+        half = np.where(norm > 1e-12, half / np.maximum(norm, 1e-300), s)  # phase 180 deg
+        cos_h = np.einsum("mk,mk->m", n[idx], half[e_idx])
+        cos_d = np.einsum("mk,mk->m", s, half)[e_idx]
+        mirror = 2.0 * cos_o[idx, None] * n[idx] - o[e_idx]
+        mirror_ok = (np.einsum("mk,mk->m", mirror, s[e_idx]) >= models.SUN_COS).astype(float)
+        mat = layout.part_mat[hits.part[idx]]
+        rows, chans, px_w = _pixel_contributions(
+            layout, mat, cos_i[idx], cos_o[idx], cos_h, cos_d, mirror_ok
+        )
+        flat = e_idx[rows] * n_ch + chans
+        w[a : a + b] = (np.bincount(flat, px_w, minlength=b * n_ch) * pixel_area).reshape(b, n_ch)
+        for e in keep_set.intersection(range(a, a + b)):
+            j = e - a
+            sel = e_idx[rows] == j
+            right, up = image_axes(o[j : j + 1])
+            sl = slice(j * pixels, (j + 1) * pixels)
+            kept[e] = _Kept(
+                pixel=idx[rows[sel]] - j * pixels,
+                channel=chans[sel],
+                weight=px_w[sel] * pixel_area,
+                part=hits.part[sl].copy(),
+                depth_m=hits.t_m[sl] - 2.0 * radius,
+                right=right[0],
+                up=up[0],
+            )
+        if on_batch is not None:
+            on_batch(b)
+    return w, kept, float(np.sqrt(pixel_area)), layout
+
+
+def render_single(
+    target: Target,
+    sun_dir: F64,
+    obs_dir: F64,
+    irradiance: F64,
+    wavelength_nm: F64,
+    caster: Caster,
+    resolution_px: int,
+    keep: Iterable[int] = (),
+    on_batch: Callable[[int], None] | None = None,
+) -> tuple[F64, dict[int, RenderImage]]:
+    """Intensity (N, L) [W sr-1 nm-1] of valid epochs and the kept images (see module doc)."""
+    for m in target.materials:
+        if m.bsdf not in models.SUPPORTED:
+            raise NotImplementedError(f"bsdf '{m.bsdf}' is not supported in single mode")
+    keep = list(keep)
+    w, kept, pitch, layout = geometric_weights(
+        target, sun_dir, obs_dir, caster, resolution_px, keep, on_batch=on_batch
+    )
+    cos_half = np.sqrt(np.clip(0.5 * (1.0 + np.einsum("nk,nk->n", sun_dir, obs_dir)), 0.0, 1.0))
+    n_mat = len(layout.mats)
+    main = [models.main_factor(m, cos_half, wavelength_nm) for m in layout.mats]
+    blocks = {k: models.plastic_factor(layout.mats[k], wavelength_nm) for k in layout.block}
+    total = sum(w[:, k, None] * main[k] for k in range(n_mat))
+    for k, start in layout.block.items():
+        total = total + w[:, start : start + blocks[k].shape[0]] @ blocks[k]
+    intensity = irradiance * total
+    images: dict[int, RenderImage] = {}
+    for e, kp in kept.items():
+        factor = np.zeros((layout.n_channels, len(wavelength_nm)))
+        for k in range(n_mat):
+            factor[k] = main[k][e]
+        for k, start in layout.block.items():
+            factor[start : start + blocks[k].shape[0]] = blocks[k]
+        pixels = resolution_px * resolution_px
+        spec = np.zeros((pixels, len(wavelength_nm)))
+        np.add.at(spec, kp.pixel, kp.weight[:, None] * factor[kp.channel])
+        images[e] = RenderImage(
+            epoch=e,
+            radiance_W_m2_sr_nm=(spec * irradiance[e] / pitch**2).reshape(
+                resolution_px, resolution_px, -1
+            ),
+            depth_m=kp.depth_m.reshape(resolution_px, resolution_px),
+            part_index=kp.part.reshape(resolution_px, resolution_px),
+            pixel_size_m=pitch,
+            right_body=kp.right,
+            up_body=kp.up,
+        )
+    return intensity, images

@@ -1,0 +1,168 @@
+"""Built-in target shapes: sphere, plate, cube, cylinder (rocket body) and a box-wing satellite.
+
+Every builder returns a :class:`~speclight.target.geometry.Target` in the body frame [m] and
+takes ``materials``: one :class:`Material` for all parts or a mapping part name -> material.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+from numpy.typing import NDArray
+
+from speclight.errors import InputError
+from speclight.target.geometry import Part, Target, assign_materials
+from speclight.target.materials import Material
+
+Materials = Material | Mapping[str, Material]
+Mesh = tuple[NDArray[np.float64], NDArray[np.int64]]
+CUBE_FACES: tuple[str, ...] = ("+x", "-x", "+y", "-y", "+z", "-z")
+
+
+def _positive(name: str, value: float) -> float:
+    v = float(value)
+    if not (np.isfinite(v) and v > 0):
+        raise InputError(f"{name} = {value!r} must be a finite number > 0", field=f"shape.{name}")
+    return v
+
+
+def _quad(p0, p1, p2, p3) -> Mesh:  # type: ignore[no-untyped-def]
+    """Two triangles of the quad p0 p1 p2 p3 (counter-clockwise seen from the front)."""
+    return np.array([p0, p1, p2, p3], dtype=float), np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def _merge(meshes: list[Mesh]) -> Mesh:
+    verts, faces, off = [], [], 0
+    for v, f in meshes:
+        verts.append(v)
+        faces.append(f + off)
+        off += len(v)
+    return np.vstack(verts), np.vstack(faces)
+
+
+def _build(meshes: dict[str, Mesh], materials: Materials) -> Target:
+    mats = assign_materials(list(meshes), materials)
+    return Target(tuple(Part(n, v, f, mats[n]) for n, (v, f) in meshes.items()))
+
+
+def uv_sphere_mesh(radius_m: float, n_lat: int = 24, n_lon: int = 48) -> Mesh:
+    """Latitude-longitude triangulation of a sphere [m] with outward orientation."""
+    theta = np.linspace(0.0, np.pi, n_lat + 1)[1:-1]
+    phi = np.linspace(0.0, 2 * np.pi, n_lon, endpoint=False)
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    ring = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1).reshape(-1, 3)
+    v = np.vstack([[0, 0, 1], ring, [0, 0, -1]]) * radius_m
+    idx = lambda i, j: 1 + i * n_lon + (j % n_lon)  # noqa: E731
+    f = [[0, idx(0, j), idx(0, j + 1)] for j in range(n_lon)]
+    for i in range(n_lat - 2):
+        for j in range(n_lon):
+            a, b, c, d = idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)
+            f += [[a, b, c], [a, c, d]]
+    south = len(v) - 1
+    f += [[south, idx(n_lat - 2, j + 1), idx(n_lat - 2, j)] for j in range(n_lon)]
+    return v, np.array(f)
+
+
+def sphere(radius_m: float, materials: Materials) -> Target:
+    """Sphere of ``radius_m`` [m] centred on the origin, one part ``body``, traced exactly."""
+    r = _positive("radius_m", radius_m)
+    mats = assign_materials(["body"], materials)
+    v, f = uv_sphere_mesh(r)
+    return Target((Part("body", v, f, mats["body"], sphere_radius_m=r),))
+
+
+def plate(width_m: float, height_m: float, materials: Materials) -> Target:
+    """Flat rectangle in the x-y plane (width along x, height along y), normal +z, part ``plate``.
+
+    The plate is a thin sheet: both faces reflect with the same material.
+    """
+    w, h = _positive("width_m", width_m) / 2, _positive("height_m", height_m) / 2
+    return _build({"plate": _quad((-w, -h, 0), (w, -h, 0), (w, h, 0), (-w, h, 0))}, materials)
+
+
+def _box_faces(half: NDArray[np.float64], centre: NDArray[np.float64]) -> dict[str, Mesh]:
+    out: dict[str, Mesh] = {}
+    for axis in range(3):
+        for sign, label in ((1.0, "+"), (-1.0, "-")):
+            u, w = (axis + 1) % 3, (axis + 2) % 3
+            corners = []
+            for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+                p = np.zeros(3)
+                p[axis] = sign * half[axis]
+                p[u] = a * half[u] * sign
+                p[w] = b * half[w]
+                corners.append(centre + p)
+            out[label + "xyz"[axis]] = _quad(*corners)
+    return out
+
+
+def cube(edge_m: float, materials: Materials) -> Target:
+    """Cube of edge ``edge_m`` [m] centred on the origin; parts ``+x -x +y -y +z -z``."""
+    e = _positive("edge_m", edge_m) / 2
+    faces = _box_faces(np.full(3, e), np.zeros(3))
+    return _build({k: faces[k] for k in CUBE_FACES}, materials)
+
+
+def cylinder(radius_m: float, length_m: float, materials: Materials, segments: int = 96) -> Target:
+    """Closed cylinder (rocket body) along z centred on the origin; parts ``side top bottom``."""
+    r, h = _positive("radius_m", radius_m), _positive("length_m", length_m) / 2
+    phi = np.linspace(0, 2 * np.pi, segments, endpoint=False)
+    ring = np.stack([r * np.cos(phi), r * np.sin(phi)], -1)
+    n = segments
+    side_v = np.vstack([np.c_[ring, np.full(n, -h)], np.c_[ring, np.full(n, h)]])
+    side_f = np.array(
+        [[[j, (j + 1) % n, n + (j + 1) % n], [j, n + (j + 1) % n, n + j]] for j in range(n)]
+    )
+    top_v = np.vstack([[0, 0, h], np.c_[ring, np.full(n, h)]])
+    top_f = np.array([[0, 1 + j, 1 + (j + 1) % n] for j in range(n)])
+    bot_v = np.vstack([[0, 0, -h], np.c_[ring, np.full(n, -h)]])
+    bot_f = np.array([[0, 1 + (j + 1) % n, 1 + j] for j in range(n)])
+    return _build(
+        {"side": (side_v, side_f.reshape(-1, 3)), "top": (top_v, top_f), "bottom": (bot_v, bot_f)},
+        materials,
+    )
+
+
+def box_wing(
+    materials: Materials,
+    bus_size_m: tuple[float, float, float] = (1.0, 1.0, 1.5),
+    wing_span_m: float = 3.0,
+    wing_width_m: float = 1.2,
+    wing_gap_m: float = 0.2,
+    dish_radius_m: float = 0.4,
+    dish_depth_m: float = 0.1,
+) -> Target:
+    """Box-wing satellite: bus, two solar wings and a parabolic antenna dish.
+
+    The bus is a box centred on the origin; the wings are thin plates in the y-z plane
+    (normals ±x) reaching out along ±y from a gap beside the ±y bus faces, so wing and bus
+    face form concave corners; the dish opens towards -z below the bus (nadir).
+    Parts: ``bus``, ``wing_+y``, ``wing_-y``, ``antenna``.
+    """
+    half = np.array([_positive("bus_size_m", s) for s in bus_size_m]) / 2
+    span, width = _positive("wing_span_m", wing_span_m), _positive("wing_width_m", wing_width_m) / 2
+    gap = float(wing_gap_m)
+    bus = _merge(list(_box_faces(half, np.zeros(3)).values()))
+    y0, y1 = half[1] + gap, half[1] + gap + span
+    wp = _quad((0, y0, -width), (0, y1, -width), (0, y1, width), (0, y0, width))
+    wm = _quad((0, -y0, width), (0, -y1, width), (0, -y1, -width), (0, -y0, -width))
+    # Paraboloid dish z = z0 + depth * (rho / R)^2, apex touching the bus bottom.
+    R, d = _positive("dish_radius_m", dish_radius_m), _positive("dish_depth_m", dish_depth_m)
+    nr, nphi = 8, 32
+    rho = np.linspace(0, R, nr + 1)[1:]
+    phi = np.linspace(0, 2 * np.pi, nphi, endpoint=False)
+    rr, pp = np.meshgrid(rho, phi, indexing="ij")
+    z0 = -half[2] - d - 1e-3
+    ring = np.stack([rr * np.cos(pp), rr * np.sin(pp), z0 + d * (1 - (rr / R) ** 2)], -1)
+    dv = np.vstack([[0, 0, z0 + d], ring.reshape(-1, 3)])
+    idx = lambda i, j: 1 + i * nphi + (j % nphi)  # noqa: E731
+    df = [[0, idx(0, j + 1), idx(0, j)] for j in range(nphi)]
+    for i in range(nr - 1):
+        for j in range(nphi):
+            df += [
+                [idx(i, j), idx(i, j + 1), idx(i + 1, j + 1)],
+                [idx(i, j), idx(i + 1, j + 1), idx(i + 1, j)],
+            ]
+    meshes = {"bus": bus, "wing_+y": wp, "wing_-y": wm, "antenna": (dv, np.array(df))}
+    return _build(meshes, materials)
