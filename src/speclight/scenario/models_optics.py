@@ -8,14 +8,14 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, Discriminator, Field, Tag, model_validator
+from pydantic import BaseModel, Discriminator, Field, Tag, field_validator, model_validator
 
 from speclight.scenario.models import Strict, Vector3
 
 BsdfName = Literal["lambertian", "beckmann", "ggx", "plastic", "specular", "measured"]
 ConductorName = Literal["Al", "Ag", "Au"]
 DielectricName = Literal["SiO2", "Si", "GaAs", "Kapton"]
-BuiltinShape = Literal["sphere", "plate", "cube", "cylinder", "box-wing"]
+BuiltinShape = Literal["sphere", "plate", "cube", "cylinder", "box_wing"]
 
 
 class ReflectanceFile(Strict):
@@ -95,35 +95,69 @@ class Material(Strict):
     """A surface material: a BSDF model and its spectral reflectance."""
 
     bsdf: BsdfName
-    reflectance: Reflectance = Field(default=1.0)
+    reflectance: Reflectance = Field(
+        default=1.0,
+        description="Albedo (lambertian, measured scale) or Fresnel reflectance (microfacet, "
+        "specular); for plastic the coat's dielectric",
+    )
     roughness: float | None = Field(
-        default=None, gt=0, le=1, description="Microfacet alpha (beckmann, ggx, plastic)"
+        default=None, gt=0, le=1, description="Microfacet alpha (beckmann, ggx; plastic coat)"
     )
     diffuse_reflectance: Reflectance | None = Field(
         default=None, description="Diffuse base of a plastic/coated layer"
     )
-    file: str | None = Field(default=None, description="Measured BRDF table or RGL .bsdf file")
+    brdf_table: str | None = Field(
+        default=None,
+        description="Measured BRDF: a shipped table name or a CSV file "
+        "(columns phi_i theta_i phi_o theta_o brdf)",
+    )
 
     @model_validator(mode="after")
     def _params(self) -> Material:
         if isinstance(self.reflectance, float) and not 0.0 <= self.reflectance <= 1.0:
             raise ValueError(f"reflectance = {self.reflectance} must lie in [0, 1]")
-        if self.bsdf in ("beckmann", "ggx", "plastic") and self.roughness is None:
+        if self.bsdf in ("beckmann", "ggx") and self.roughness is None:
             raise ValueError(f"bsdf '{self.bsdf}' needs roughness (microfacet alpha, 0 < a <= 1)")
         if self.bsdf in ("lambertian", "specular", "measured") and self.roughness is not None:
             raise ValueError(f"bsdf '{self.bsdf}' takes no roughness")
-        if self.bsdf == "measured" and not self.file:
-            raise ValueError("bsdf 'measured' needs file: a BRDF table (.csv) or RGL .bsdf file")
-        if self.bsdf != "measured" and self.file:
-            raise ValueError(f"file is only used by bsdf 'measured', not '{self.bsdf}'")
+        if self.bsdf == "plastic" and self.diffuse_reflectance is None:
+            raise ValueError("bsdf 'plastic' needs diffuse_reflectance (the base under the coat)")
+        if self.bsdf == "measured" and not self.brdf_table:
+            raise ValueError("bsdf 'measured' needs brdf_table: a shipped table name or a CSV file")
+        if self.bsdf != "measured" and self.brdf_table:
+            raise ValueError(f"brdf_table is only used by bsdf 'measured', not '{self.bsdf}'")
         return self
 
 
+_SHAPE_SIZES: dict[str, tuple[str, ...]] = {
+    "sphere": ("radius_m",),
+    "plate": ("width_m", "height_m"),
+    "cube": ("edge_m",),
+    "cylinder": ("radius_m", "length_m"),
+    "box_wing": (
+        "bus_size_m",
+        "wing_span_m",
+        "wing_width_m",
+        "wing_gap_m",
+        "dish_radius_m",
+        "dish_depth_m",
+    ),
+}
+_SHAPE_REQUIRED: dict[str, tuple[str, ...]] = {
+    "sphere": ("radius_m",),
+    "plate": ("width_m", "height_m"),
+    "cube": ("edge_m",),
+    "cylinder": ("radius_m", "length_m"),
+    "box_wing": (),
+}
+
+
 class Shape(Strict):
-    """A built-in shape with its dimensions, or a mesh file."""
+    """A built-in shape with its dimensions, or a mesh file (OBJ, or PLY files one per part)."""
 
     builtin: BuiltinShape | None = None
-    mesh_file: str | None = None
+    mesh_file: str | list[str] | None = None
+    scale_m_per_unit: float = Field(default=1.0, gt=0, description="Mesh units to metres")
     radius_m: float | None = Field(default=None, gt=0)
     width_m: float | None = Field(default=None, gt=0)
     height_m: float | None = Field(default=None, gt=0)
@@ -132,30 +166,44 @@ class Shape(Strict):
     bus_size_m: Vector3 | None = None
     wing_span_m: float | None = Field(default=None, gt=0)
     wing_width_m: float | None = Field(default=None, gt=0)
-    dish_diameter_m: float | None = Field(default=None, gt=0)
-    scale: float = Field(default=1.0, gt=0, description="Mesh units to metres")
+    wing_gap_m: float | None = Field(default=None, ge=0)
+    dish_radius_m: float | None = Field(default=None, gt=0)
+    dish_depth_m: float | None = Field(default=None, gt=0)
+
+    @field_validator("builtin", mode="before")
+    @classmethod
+    def _alias(cls, value: Any) -> Any:
+        return "box_wing" if value == "box-wing" else value
 
     @model_validator(mode="after")
     def _one(self) -> Shape:
         if (self.builtin is None) == (self.mesh_file is None):
             raise ValueError("give exactly one of builtin or mesh_file")
-        needs = {
-            "sphere": ["radius_m"],
-            "plate": ["width_m", "height_m"],
-            "cube": ["edge_m"],
-            "cylinder": ["radius_m", "length_m"],
-            "box-wing": [],
-        }
-        if self.builtin is not None:
-            missing = [k for k in needs[self.builtin] if getattr(self, k) is None]
-            if missing:
-                raise ValueError(f"builtin '{self.builtin}' needs {', '.join(missing)}")
+        sizes = [k for k in _SHAPE_FIELDS if getattr(self, k) is not None]
+        if self.builtin is None:
+            if sizes:
+                raise ValueError(f"{', '.join(sizes)} apply to builtin shapes, not mesh_file")
+            return self
+        missing = [k for k in _SHAPE_REQUIRED[self.builtin] if getattr(self, k) is None]
+        if missing:
+            raise ValueError(f"builtin '{self.builtin}' needs {', '.join(missing)}")
+        extra = [k for k in sizes if k not in _SHAPE_SIZES[self.builtin]]
+        if extra:
+            raise ValueError(
+                f"builtin '{self.builtin}' takes {', '.join(_SHAPE_SIZES[self.builtin])}, "
+                f"not {', '.join(extra)}"
+            )
         return self
+
+
+_SHAPE_FIELDS = sorted({k for sizes in _SHAPE_SIZES.values() for k in sizes})
 
 
 class Target(Strict):
     shape: Shape
-    materials: dict[str, Material] = Field(min_length=1)
+    materials: dict[str, Material] = Field(
+        min_length=1, description="Part name -> material; '*' covers the parts not named"
+    )
 
 
 class Laser(Strict):
@@ -182,11 +230,14 @@ class Illumination(Strict):
 class Atmosphere(Strict):
     model: Literal["none", "spectrl2", "6s", "table"] = "spectrl2"
     water_vapour_cm: float = Field(default=1.42, ge=0, le=10)
-    ozone_atm_cm: float = Field(default=0.31, ge=0, le=1)
+    ozone_atm_cm: float = Field(default=0.344, ge=0, le=1)
     aod_500nm: float = Field(default=0.1, ge=0, le=5)
     angstrom_exponent: float = Field(default=1.14, ge=-1, le=4)
-    atmosphere_profile: str = "MidlatitudeSummer"
-    aerosol_profile: str = "Continental"
+    atmosphere_profile: str = Field(
+        default="user",
+        description="6S gas profile; 'user' takes water_vapour_cm and ozone_atm_cm",
+    )
+    aerosol_profile: str = "continental"
     table_file: str | None = None
     fallback_to_spectrl2: bool = False
 

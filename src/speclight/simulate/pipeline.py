@@ -11,6 +11,13 @@ from speclight.scenario import LoadedScenario
 from speclight.simulate import variables as v
 from speclight.simulate.dataset import geometry_dataset, global_attributes
 from speclight.simulate.geometry import Geometry, compute_geometry
+from speclight.simulate.radiometry import (
+    atmosphere_transmission,
+    instrument_response,
+    wavelength_grid_nm,
+)
+from speclight.simulate.reflection import render_reflection
+from speclight.simulate.spectral_dataset import add_images, add_spectral
 
 
 @dataclass
@@ -56,7 +63,23 @@ def simulate(loaded: LoadedScenario, progress: bool = False) -> SimulationResult
     SimulationResult
         The dataset of SPEC section 4 and notes for the user.
     """
+    sc = loaded.scenario
     geo = compute_geometry(loaded)
-    ds = geometry_dataset(geo)
-    ds.attrs.update(global_attributes(loaded))
-    return SimulationResult(dataset=ds, geometry=geo, notes=_visibility_notes(geo))
+    wavelength_nm = wavelength_grid_nm(sc.spectrum)
+    reflection = render_reflection(loaded, geo, wavelength_nm, progress=progress)
+    elevation = np.where(geo.observable, geo.elevation_deg, np.nan)
+    transmission = atmosphere_transmission(loaded, wavelength_nm, elevation)
+    radiometry = None
+    if reflection.intensity_W_sr_nm is not None:
+        radiometry = instrument_response(
+            loaded, wavelength_nm, reflection.intensity_W_sr_nm, transmission, geo.range_m
+        )
+    ds = geometry_dataset(geo)  # after rendering: render failures set flag bits
+    ds = add_spectral(ds, wavelength_nm, reflection, transmission, radiometry)
+    ds = add_images(ds, reflection.images)
+    extra = {"render_mode": sc.render.mode, "atmosphere_model": sc.atmosphere.model}
+    if reflection.variant:
+        extra["render_variant"] = reflection.variant
+    ds.attrs.update(global_attributes(loaded, extra))
+    notes = _visibility_notes(geo)
+    return SimulationResult(dataset=ds, geometry=geo, notes=notes)

@@ -45,6 +45,20 @@ VARIABLES: dict[str, VariableInfo] = {
     "spectral_flux": VariableInfo("W nm-1", "spectral power entering the telescope aperture"),
     "count_rate": VariableInfo("s-1", "detected photo-electrons per second in each band"),
     "ab_magnitude": VariableInfo("mag", "AB magnitude of the in-band irradiance at the aperture"),
+    "intensity_std": VariableInfo(
+        "W sr-1 nm-1", "Monte Carlo standard error of the intensity (0 in single mode)"
+    ),
+    "count_rate_measured": VariableInfo(
+        "s-1", "simulated background-subtracted measurement of the count rate (noisy)"
+    ),
+    "band_response": VariableInfo("1", "relative spectral response of each band"),
+    "optics_transmission": VariableInfo("1", "transmission of the telescope optics"),
+    "detector_qe": VariableInfo("1", "detector quantum efficiency"),
+    "image_radiance": VariableInfo("W m-2 sr-1 nm-1", "reflected spectral radiance per pixel"),
+    "image_depth": VariableInfo(
+        "m", "distance along the line of sight behind the plane through the target centre"
+    ),
+    "image_part": VariableInfo("1", "index of the target part seen in each pixel (-1: none)"),
 }
 
 # Bits of the ``flags`` variable (CF flag_masks / flag_meanings).

@@ -1,0 +1,162 @@
+"""Radiometry stage of the pipeline: atmosphere and instrument, from the scenario."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from speclight import atmosphere, instrument
+from speclight.instrument.curves import DETECTOR_PRESETS
+from speclight.scenario import LoadedScenario
+from speclight.scenario.models_optics import ReflectanceFile, Spectrum
+
+F64 = NDArray[np.float64]
+
+# Atmosphere parameters that each model takes (scenario names are the model's names).
+_ATMOSPHERE_KEYS: dict[str, tuple[str, ...]] = {
+    "none": (),
+    "spectrl2": ("water_vapour_cm", "ozone_atm_cm", "aod_500nm", "angstrom_exponent"),
+    "6s": (
+        "water_vapour_cm",
+        "ozone_atm_cm",
+        "aod_500nm",
+        "angstrom_exponent",
+        "atmosphere_profile",
+        "aerosol_profile",
+        "fallback_to_spectrl2",
+    ),
+    "table": ("table_file",),
+}
+
+
+def wavelength_grid_nm(spectrum: Spectrum) -> F64:
+    """Bin centres from ``min_nm`` to ``max_nm`` (included when on the grid) [nm]."""
+    n = int(np.floor((spectrum.max_nm - spectrum.min_nm) / spectrum.step_nm + 1e-9)) + 1
+    return np.asarray(spectrum.min_nm + spectrum.step_nm * np.arange(n), dtype=np.float64)
+
+
+def atmosphere_transmission(loaded: LoadedScenario, wavelength_nm: F64, elevation_deg: F64) -> F64:
+    """Direct-beam transmission (N, L) for the scenario's atmosphere model."""
+    cfg = loaded.scenario.atmosphere
+    params: dict[str, Any] = {k: getattr(cfg, k) for k in _ATMOSPHERE_KEYS[cfg.model]}
+    if "table_file" in params:
+        params["table_file"] = loaded.resolve(params["table_file"])
+    return atmosphere.transmission(
+        cfg.model, wavelength_nm, elevation_deg, loaded.scenario.observer.altitude_m, **params
+    )
+
+
+def _curve_spec(loaded: LoadedScenario, spec: float | str | ReflectanceFile) -> Any:
+    if isinstance(spec, ReflectanceFile):
+        return loaded.resolve(spec.file)
+    if isinstance(spec, str) and spec.lower() not in DETECTOR_PRESETS:
+        return loaded.resolve(spec)  # a table file; spectral_curve explains a bad name
+    return spec
+
+
+def _bands(loaded: LoadedScenario) -> list[instrument.Band]:
+    out: list[instrument.Band] = []
+    for band in loaded.scenario.instrument.bands:
+        if band.gaussian is not None:
+            out.append(
+                instrument.gaussian_band(band.gaussian.center_nm, band.gaussian.sigma_nm, band.name)
+            )
+        elif band.filter is not None:
+            out.append(instrument.filter_band(band.filter, band.name))
+        elif band.file is not None:
+            out.append(instrument.table_band(loaded.resolve(band.file), band.name))
+        else:
+            parsed = instrument.parse_band(band.name)
+            out.append(parsed)
+    return out
+
+
+@dataclass
+class Radiometry:
+    """Instrument-side results (SPEC section 4) and the curves that produced them."""
+
+    band_names: list[str]
+    spectral_flux_W_nm: F64
+    count_rate_per_s: F64
+    ab_magnitude: F64
+    count_rate_measured_per_s: F64 | None
+    band_response: F64
+    optics: F64
+    qe: F64
+
+
+def instrument_response(
+    loaded: LoadedScenario,
+    wavelength_nm: F64,
+    intensity_W_sr_nm: F64,
+    transmission: F64,
+    range_m: F64,
+) -> Radiometry:
+    """Spectral flux at the aperture, band count rates, AB magnitudes and noisy rates."""
+    sc = loaded.scenario
+    area = instrument.aperture_area_m2(
+        sc.telescope.aperture_diameter_m, sc.telescope.obstruction_diameter_m
+    )
+    optics = instrument.spectral_curve(
+        _curve_spec(loaded, sc.instrument.optics_transmission),
+        wavelength_nm,
+        field="instrument.optics_transmission",
+    )
+    qe = instrument.spectral_curve(
+        _curve_spec(loaded, sc.instrument.detector_qe),
+        wavelength_nm,
+        field="instrument.detector_qe",
+    )
+    bands = _bands(loaded)
+    response = (
+        instrument.band_response(bands, wavelength_nm)
+        if bands
+        else np.zeros((0, wavelength_nm.size))
+    )
+    flux = instrument.spectral_flux_W_nm(intensity_W_sr_nm, transmission, area, range_m)
+    rate = instrument.count_rate_per_s(flux, wavelength_nm, optics, qe, response)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        mag = instrument.ab_magnitude(flux, area, wavelength_nm, response)
+    measured = None
+    noise = sc.instrument.noise
+    if noise is not None and noise.enabled and bands:
+        sky = instrument.sky_count_rate_per_s(
+            noise.sky_background_mag_arcsec2,
+            area,
+            wavelength_nm,
+            optics,
+            qe,
+            response,
+            background_aperture_radius_arcsec=noise.aperture_radius_arcsec,
+        )
+        finite = np.isfinite(rate)
+        measured = np.full_like(rate, np.nan)
+        measured[finite] = instrument.simulate_measurement(
+            rate[finite],
+            sc.instrument.exposure_s,
+            sky_count_rate_per_s=np.broadcast_to(sky, rate.shape)[finite],
+            dark_current_e_per_s=noise.dark_current_e_per_s,
+            read_noise_e=noise.read_noise_e,
+            seed=noise.seed,
+        )
+    return Radiometry(
+        band_names=[b.name for b in bands],
+        spectral_flux_W_nm=flux,
+        count_rate_per_s=rate,
+        ab_magnitude=mag,
+        count_rate_measured_per_s=measured,
+        band_response=response,
+        optics=optics,
+        qe=qe,
+    )
+
+
+__all__ = [
+    "Radiometry",
+    "atmosphere_transmission",
+    "instrument_response",
+    "wavelength_grid_nm",
+]
