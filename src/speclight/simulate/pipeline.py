@@ -77,7 +77,7 @@ def simulate(loaded: LoadedScenario, progress: bool = False) -> SimulationResult
     ds = geometry_dataset(geo)  # after rendering: render failures set flag bits
     ds = add_spectral(ds, wavelength_nm, reflection, transmission, radiometry)
     ds = add_images(ds, reflection.images)
-    extra = {"render_mode": sc.render.mode, "atmosphere_model": sc.atmosphere.model}
+    extra: dict[str, str] = {"render_mode": sc.render.mode, "atmosphere_model": sc.atmosphere.model}
     if reflection.variant:
         extra["render_variant"] = reflection.variant
     ds.attrs.update(global_attributes(loaded, extra))
