@@ -272,6 +272,9 @@ class Render(Strict):
     )
 
 
+SpectralCurve = float | str | ReflectanceFile
+
+
 class GaussianBand(Strict):
     center_nm: float = Field(gt=0)
     sigma_nm: float = Field(gt=0)
@@ -282,6 +285,9 @@ class Band(Strict):
     gaussian: GaussianBand | None = None
     filter: str | None = Field(default=None, description="speclite filter name, e.g. bessell-V")
     file: str | None = Field(default=None, description="CSV of wavelength and response")
+    detector_qe: SpectralCurve | None = Field(
+        default=None, description="This band's detector, if not instrument.detector_qe"
+    )
 
     @model_validator(mode="after")
     def _one(self) -> Band:
@@ -293,9 +299,6 @@ class Band(Strict):
                 f"band '{self.name}' needs gaussian, filter or file (or a name G-<centre>/<sigma>)"
             )
         return self
-
-
-SpectralCurve = float | str | ReflectanceFile
 
 
 class Noise(Strict):

@@ -105,11 +105,23 @@ def instrument_response(
         wavelength_nm,
         field="instrument.optics_transmission",
     )
-    qe = instrument.spectral_curve(
+    common_qe = instrument.spectral_curve(
         _curve_spec(loaded, sc.instrument.detector_qe),
         wavelength_nm,
         field="instrument.detector_qe",
     )
+    qe = np.array(
+        [
+            common_qe
+            if band.detector_qe is None
+            else instrument.spectral_curve(
+                _curve_spec(loaded, band.detector_qe),
+                wavelength_nm,
+                field=f"instrument.bands.{i}.detector_qe",
+            )
+            for i, band in enumerate(sc.instrument.bands)
+        ]
+    ).reshape(-1, wavelength_nm.size)
     bands = _bands(loaded)
     response = (
         instrument.band_response(bands, wavelength_nm)
@@ -117,7 +129,9 @@ def instrument_response(
         else np.zeros((0, wavelength_nm.size))
     )
     flux = instrument.spectral_flux_W_nm(intensity_W_sr_nm, transmission, area, range_m)
-    rate = instrument.count_rate_per_s(flux, wavelength_nm, optics, qe, response)
+    # Each band's own detector: fold its QE into the response (the integrand is a product).
+    ones = np.ones(wavelength_nm.size)
+    rate = instrument.count_rate_per_s(flux, wavelength_nm, optics, ones, response * qe)
     with np.errstate(divide="ignore", invalid="ignore"):
         mag = instrument.ab_magnitude(flux, area, wavelength_nm, response)
     measured = None
@@ -128,8 +142,8 @@ def instrument_response(
             area,
             wavelength_nm,
             optics,
-            qe,
-            response,
+            ones,
+            response * qe,
             background_aperture_radius_arcsec=noise.aperture_radius_arcsec,
         )
         finite = np.isfinite(rate)

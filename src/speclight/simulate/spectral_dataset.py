@@ -51,7 +51,7 @@ def add_spectral(
         v.attrs("band_response"),
     )
     ds["optics_transmission"] = ("wavelength", radiometry.optics, v.attrs("optics_transmission"))
-    ds["detector_qe"] = ("wavelength", radiometry.qe, v.attrs("detector_qe"))
+    ds["detector_qe"] = (("band", "wavelength"), radiometry.qe, v.attrs("detector_qe"))
     return ds
 
 
