@@ -13,7 +13,9 @@ from speclight.simulate.geometry import time_grid
 
 
 def _scenario(name: str = "lcs1", **changes: object) -> str:
+    """A built-in scenario without its target: geometry only, nothing rendered."""
     data = yaml.safe_load(example_text(name))
+    data.pop("target")
     data.update(changes)
     return yaml.safe_dump(data, sort_keys=False)
 
@@ -57,7 +59,7 @@ def test_body_frame_preserves_the_phase_angle(attitude: dict[str, object]) -> No
 
 
 def test_shadow_flags_follow_sunlit_fraction() -> None:
-    ds = simulate(parse_scenario(example_text("calsphere"))).dataset
+    ds = simulate(parse_scenario(_scenario("calsphere"))).dataset
     sunlit, flags = ds["sunlit"].values, ds["flags"].values
     assert np.any(sunlit == 0) and np.any(sunlit == 1), "the example crosses the shadow edge"
     np.testing.assert_array_equal((flags & 4) > 0, sunlit <= 0)
