@@ -92,3 +92,18 @@ def test_band_outside_the_wavelength_grid_is_input_error() -> None:
     instrument = {"bands": [{"name": "G-1500/20", "gaussian": {"center_nm": 1500, "sigma_nm": 20}}]}
     with pytest.raises(InputError, match=r"G-1500/20"):
         simulate(parse_scenario(_calsphere(instrument=instrument)))
+
+
+def test_saved_images_integrate_to_the_intensity(tmp_path) -> None:
+    # Radiant intensity of an orthographic view = sum of radiance x pixel area
+    # (definition of radiant intensity from radiance over the projected area).
+    text = _calsphere(render={"resolution_px": 64, "save_images_at": [3, 5]})
+    ds = simulate(parse_scenario(text)).dataset
+    assert list(ds["image_time"].values) == list(ds["time"].values[[3, 5]])
+    pixel_area = ds["image_pixel_size"].values[:, None] ** 2
+    summed = ds["image_radiance"].sum(dim=("y", "x")).values * pixel_area
+    np.testing.assert_allclose(summed, ds["intensity"].values[[3, 5]], rtol=1e-5)
+    depth = ds["image_depth"].values
+    on_target = np.isfinite(depth)
+    # the sphere's visible surface lies within one radius in front of its centre
+    assert np.all((depth[on_target] >= -0.18 - 1e-6) & (depth[on_target] <= 1e-6))

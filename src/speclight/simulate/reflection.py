@@ -90,4 +90,6 @@ def render_reflection(
         geo.flags[failed] |= v.FLAG_RENDER_FAILED
         variant = result.variant
         images = {int(idx[k]): image for k, image in result.images.items()}
+        for epoch, image in images.items():  # penumbra: as the intensity
+            image.radiance_W_m2_sr_nm = image.radiance_W_m2_sr_nm * sunlit[epoch]
     return Reflection(solar, intensity, std, variant, images)
