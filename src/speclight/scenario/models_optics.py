@@ -223,7 +223,6 @@ class Laser(Strict):
 
 class Illumination(Strict):
     sun: bool = True
-    solar_disk: bool = Field(default=False, description="Finite 0.53 deg solar disk")
     lasers: list[Laser] = Field(default_factory=list)
 
 
@@ -266,7 +265,6 @@ class Render(Strict):
     samples_per_pixel: int = Field(default=16, ge=1, le=1_000_000)
     seed: int = Field(default=0, ge=0)
     variant: str | None = Field(default=None, description="Force a Mitsuba variant")
-    max_depth: int = Field(default=8, ge=2, le=64, description="Path length limit in path mode")
     save_images_at: list[int] = Field(
         default_factory=list, description="Epoch indices whose images and depth maps are saved"
     )
