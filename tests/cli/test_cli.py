@@ -141,3 +141,14 @@ def test_plot_rejects_a_file_that_is_not_a_dataset(tmp_path: Path) -> None:
     junk.write_text("not netcdf")
     result = runner.invoke(app, ["plot", str(junk), "-o", str(tmp_path / "f.png")])
     assert result.exit_code == 2 and "cannot read" in result.stderr
+
+
+def test_stage_errors_name_the_scenario_file(tmp_path: Path) -> None:
+    data = yaml.safe_load(example_text("calsphere"))
+    data["time"].update(stop="2020-02-29T21:16:00Z", step_s=60.0)
+    data["render"]["variant"] = "llvm_ad_foo"
+    path = tmp_path / "s.yaml"
+    path.write_text(yaml.safe_dump(data))
+    result = runner.invoke(app, ["simulate", str(path), "-o", str(tmp_path / "o.nc")])
+    assert result.exit_code == 2
+    assert f"{path}: render.variant: render variant 'llvm_ad_foo' is not available" in result.stderr

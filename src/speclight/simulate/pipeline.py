@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
+from speclight.errors import InputError
 from speclight.scenario import LoadedScenario
 from speclight.simulate import variables as v
 from speclight.simulate.dataset import geometry_dataset, global_attributes
@@ -63,6 +64,15 @@ def simulate(loaded: LoadedScenario, progress: bool = False) -> SimulationResult
     SimulationResult
         The dataset of SPEC section 4 and notes for the user.
     """
+    try:
+        return _simulate(loaded, progress)
+    except InputError as exc:
+        if exc.source is None:  # say which scenario the bad field is in
+            raise InputError(exc.message, source=loaded.source, field=exc.field) from exc
+        raise
+
+
+def _simulate(loaded: LoadedScenario, progress: bool) -> SimulationResult:
     sc = loaded.scenario
     geo = compute_geometry(loaded)
     wavelength_nm = wavelength_grid_nm(sc.spectrum)
