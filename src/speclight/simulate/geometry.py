@@ -68,13 +68,19 @@ def time_grid(grid: TimeGrid) -> NDArray[np.datetime64]:
     return start + offsets_ns
 
 
-def _target_positions(loaded: LoadedScenario, t: object) -> tuple[NDArray, NDArray]:
+def _target_positions(
+    loaded: LoadedScenario, t: object, time_utc: NDArray[np.datetime64]
+) -> tuple[NDArray, NDArray]:
     cfg = loaded.scenario.orbit
     if cfg.tle is not None:
         tle = orbit.parse_tle(cfg.tle, source=f"{loaded.source}: orbit.tle")
         return orbit.tle_position_gcrs_m(tle, t)
     if cfg.tle_file is not None:
-        tle = orbit.read_tle_file(loaded.resolve(cfg.tle_file), norad_id=cfg.norad_id)
+        # of several element sets of the object, the one nearest the middle of the window
+        middle = time_utc[0] + (time_utc[-1] - time_utc[0]) / 2
+        tle = orbit.read_tle_file(
+            loaded.resolve(cfg.tle_file), norad_id=cfg.norad_id, near_epoch=middle
+        )
         return orbit.tle_position_gcrs_m(tle, t)
     if cfg.cpf_file is not None:
         cpf = orbit.read_cpf(loaded.resolve(cfg.cpf_file))
@@ -122,7 +128,7 @@ def compute_geometry(loaded: LoadedScenario) -> Geometry:
     time_utc = time_grid(sc.time)
     t = time_from_utc(time_utc)
     t_s = (time_utc - time_utc[0]) / np.timedelta64(1, "s")
-    r_target, ok = _target_positions(loaded, t)
+    r_target, ok = _target_positions(loaded, t, time_utc)
     site = orbit.Site(sc.observer.latitude_deg, sc.observer.longitude_deg, sc.observer.altitude_m)
     geo = orbit.compute_geometry(
         t,
