@@ -108,8 +108,8 @@ class Material(Strict):
     )
     brdf_table: str | None = Field(
         default=None,
-        description="Measured BRDF: a shipped table name or a CSV file "
-        "(columns phi_i theta_i phi_o theta_o brdf)",
+        description="Measured BRDF: a shipped table name, a CSV file "
+        "(columns phi_i theta_i phi_o theta_o brdf) or a spectral RGL .bsdf file",
     )
 
     @model_validator(mode="after")
