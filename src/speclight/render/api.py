@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Literal
 
 import numpy as np
@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 from speclight.errors import InputError
 from speclight.render.raycast import Caster, MitsubaCaster, NumpyCaster
 from speclight.render.result import RenderResult
+from speclight.render.rgl import is_rgl
 from speclight.render.variant import choose_variant
 from speclight.target.geometry import Target
 
@@ -55,6 +56,7 @@ def render_intensity(
     workers: int | None = None,
     progress: bool = False,
     keep_images_for: Iterable[int] | None = None,
+    on_hits: Callable[..., None] | None = None,
 ) -> RenderResult:
     """Radiant intensity of a sunlit target toward an observer, per epoch and wavelength.
 
@@ -88,6 +90,11 @@ def render_intensity(
         Show a progress bar (on a terminal).
     keep_images_for
         Epoch indices whose hyperspectral radiance image and depth map are returned.
+    on_hits
+        Single mode: ``on_hits(epochs, origin, direction, hits, caster)`` is called after
+        each batch's primary ray cast with the batch's epoch indices (into the inputs), so
+        that laser ranging (:mod:`speclight.render.ranging`) reuses the rays. It forces the
+        in-process caster (``workers`` is ignored). Path mode ignores it.
 
     Returns
     -------
@@ -128,9 +135,11 @@ def render_intensity(
     std = np.full((len(sun), len(wl)), np.nan)
     images = {}
     if mode == "single":
-        chosen = choose_variant(variant, spectral=False)
+        # RGL materials are evaluated in a spectral variant: cast rays in it too (no switching).
+        chosen = choose_variant(variant, spectral=any(is_rgl(m) for m in target.materials))
         n_workers = int(workers or 1)
-        if n_workers > 1 and not chosen.startswith(("llvm_", "cuda_")) and len(valid) > 1:
+        multi = n_workers > 1 and on_hits is None
+        if multi and not chosen.startswith(("llvm_", "cuda_")) and len(valid) > 1:
             # Dr.Jit variants already use every core; the numpy caster runs one process per
             # worker on contiguous blocks of epochs (Mitsuba scenes are never pickled).
             inten, imgs = _single_in_processes(
@@ -159,6 +168,7 @@ def render_intensity(
                     int(resolution_px),
                     keep_local,
                     on_batch=advance,
+                    on_hits=None if on_hits is None else _global_epochs(on_hits, valid),
                 )
             used = caster.name
         intensity[valid] = inten
@@ -189,6 +199,15 @@ def render_intensity(
         img.epoch = g
         images[g] = img
     return RenderResult(intensity, std, ok, used, mode, images)
+
+
+def _global_epochs(on_hits: Callable[..., None], valid: NDArray[np.int64]) -> Callable[..., None]:
+    """Wrap ``on_hits`` so that it receives epoch indices into the caller's inputs."""
+
+    def call(epochs: NDArray[np.int64], *rest: object) -> None:
+        on_hits(valid[epochs], *rest)
+
+    return call
 
 
 def _single_chunk(args: tuple) -> tuple:

@@ -19,7 +19,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.illumination.solar import SOLAR_ANGULAR_RADIUS_RAD
+from speclight.render import rgl
 from speclight.render.brdf import microfacet_weight
+from speclight.render.rgl import is_rgl
 from speclight.target.brdf_table import load_brdf_table
 from speclight.target.materials import Material
 from speclight.target.optical_constants import fresnel_reflectance
@@ -41,6 +43,8 @@ def main_weight(m: Material, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mir
         return mirror_ok / SUN_SOLID_ANGLE_SR
     if m.bsdf == "plastic":
         return microfacet_weight(cos_i, cos_o, cos_h, float(m.roughness or 0.0), "beckmann")
+    if is_rgl(m):  # non-factorising: all its light goes through its block channels
+        return np.zeros_like(cos_i)
     if m.bsdf == "measured":
         table = load_brdf_table(str(m.brdf_table))
         th = np.degrees(np.arccos(np.clip(cos_h, -1.0, 1.0)))
@@ -53,6 +57,8 @@ def main_factor(m: Material, cos_half_phase: F64, wavelength_nm: F64) -> F64:
     """Spectral factor (N, L) of a material's main channel for epochs' half-phase cosines."""
     refl = m.reflectance
     n = len(cos_half_phase)
+    if is_rgl(m):
+        return np.zeros((n, len(wavelength_nm)))
     if m.bsdf == "measured":
         table = load_brdf_table(str(m.brdf_table))
         ref = refl.evaluate(np.array([table.wavelength_nm]))[0] if refl.kind != "constant" else 1.0
@@ -81,7 +87,12 @@ def plastic_nodes() -> F64:
 
 
 def plastic_factor(m: Material, wavelength_nm: F64) -> F64:
-    """Spectral factors (K*K, L) of a plastic's diffuse channels at the (cos_i, cos_o) nodes."""
+    """Spectral factors (K*K, L) of a plastic's diffuse channels at the (cos_i, cos_o) nodes.
+
+    Given an RGL material, the factors of its block instead (see :func:`block_factor`).
+    """
+    if is_rgl(m):
+        return block_factor(m, wavelength_nm)
     assert m.diffuse_reflectance is not None
     eta = m.reflectance.eta(wavelength_nm).real
     c = plastic_nodes()
@@ -108,3 +119,56 @@ def bilinear_nodes(cos_i: F64, cos_o: F64) -> tuple[NDArray[np.int64], F64]:
     )
     w = np.stack([(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy], axis=1)
     return idx, w
+
+
+def block_size(m: Material) -> int:
+    """Number of extra (block) channels of a material: 0 unless plastic or RGL measured.
+
+    Blocks hold what does not factorise into one weight times one spectral factor: the
+    plastic's diffuse base binned in (cos_i, cos_o), and an RGL material's BRDF at its file's
+    wavelength nodes (:mod:`speclight.render.rgl`); each block channel has an
+    epoch-independent spectral factor (:func:`block_factor`).
+    """
+    if m.bsdf == "plastic":
+        return PLASTIC_NODES**2
+    if is_rgl(m):
+        return rgl.node_count(m)
+    return 0
+
+
+def block_weights(
+    m: Material, cos_i: F64, cos_o: F64, cos_d: F64
+) -> tuple[NDArray[np.int64], NDArray[np.int64], F64]:
+    """(row into the inputs, channel within the block, weight [sr-1]) of a material's block."""
+    if m.bsdf == "plastic":
+        idx, bw = bilinear_nodes(cos_i, cos_o)
+        rows = np.repeat(np.arange(len(cos_i)), 4)
+        return rows, idx.ravel(), (bw * (cos_i / np.pi)[:, None]).ravel()
+    if is_rgl(m):
+        w = rgl.pixel_weights(m, cos_i, cos_o, cos_d)  # (P, W)
+        rows = np.repeat(np.arange(len(cos_i)), w.shape[1])
+        return rows, np.tile(np.arange(w.shape[1]), len(cos_i)), w.ravel()
+    empty = np.zeros(0, np.int64)
+    return empty, empty, np.zeros(0)
+
+
+def block_factor(m: Material, wavelength_nm: F64) -> F64:
+    """Spectral factors (block_size, L) of a material's block channels [1]."""
+    if is_rgl(m):
+        return rgl.hat_factor(m, wavelength_nm)
+    return plastic_factor(m, wavelength_nm)
+
+
+#: Primary rays per single-mode batch without RGL materials.
+RAYS_PER_BATCH = 1_000_000
+#: Pixel contributions (pixel, channel, weight) held at once in a single-mode batch with RGL
+#: materials (about 40 bytes each).
+CONTRIBUTIONS_PER_BATCH = 4_000_000
+
+
+def rays_per_batch(materials: tuple[Material, ...] | list[Material]) -> int:
+    """Primary rays per single-mode batch: :data:`RAYS_PER_BATCH`, fewer with RGL materials
+    (one contribution per pixel and wavelength node of the file) so that a batch holds about
+    :data:`CONTRIBUTIONS_PER_BATCH`; at least one epoch is always cast at once."""
+    nodes = max((rgl.node_count(m) for m in materials if is_rgl(m)), default=0)
+    return min(RAYS_PER_BATCH, CONTRIBUTIONS_PER_BATCH // (1 + nodes))

@@ -14,7 +14,8 @@ radiance integrated over bin k; dividing by the bin width gives the bin-averaged
 which is scaled by the epoch's solar spectrum (bin averages) afterwards.
 
 The sample budget is split in ``K`` passes with independent seeds; their spread gives the
-standard error of the mean per bin. Measured BRDF tables are not available in this mode.
+standard error of the mean per bin. Measured lab BRDF tables are not available in this mode;
+RGL ``.bsdf`` measured materials use Mitsuba's ``measured`` plugin (:mod:`.rgl`).
 A smooth mirror (``specular``, smooth plastic coat) lit by the directional
 (point) Sun reflects no light toward a given observer in this mode (a delta BSDF meets a delta
 light); the single-scattering mode models its glint with the finite solar disk.
@@ -37,6 +38,7 @@ from speclight.errors import InputError
 from speclight.illumination.solar import bin_edges_nm
 from speclight.render.camera import image_axes, primary_rays
 from speclight.render.result import RenderImage
+from speclight.render.rgl import is_rgl, path_bsdf
 from speclight.render.variant import activate
 from speclight.target.geometry import Target
 from speclight.target.materials import Material
@@ -99,10 +101,13 @@ def _bsdf(m: Material, lo: float, hi: float) -> dict[str, Any]:
         }
         if m.roughness is not None:
             inner.update(distribution="beckmann", alpha=float(m.roughness))
+    elif is_rgl(m):
+        inner = path_bsdf(m)  # Mitsuba's 'measured' plugin on the RGL .bsdf file
     else:
         raise InputError(
             f"material '{m.name}': bsdf '{m.bsdf}' is not supported in render.mode 'path' yet "
-            "(path supports lambertian, beckmann, ggx, specular, plastic); use render.mode "
+            "(path supports lambertian, beckmann, ggx, specular, plastic and measured RGL "
+            ".bsdf files); use render.mode "
             "'single'",
             field="render.mode",
         )

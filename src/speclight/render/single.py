@@ -13,7 +13,9 @@ Fresnel term depends on the half-angle, the same for all pixels of an epoch, so 
 A smooth mirror (``specular``, smooth ``plastic`` coat) reflects the solar disk (uniform,
 angular radius :data:`~speclight.illumination.SOLAR_ANGULAR_RADIUS_RAD`): a pixel whose mirror
 direction falls inside the disk shows the radiance ``R * E / Omega_sun``. Surfaces are
-two-sided (thin sheets reflect on both faces with the same material).
+two-sided (thin sheets reflect on both faces with the same material). RGL measured materials
+(``.bsdf``) do not factorise: Mitsuba's ``measured`` plugin is evaluated per pixel at the
+file's wavelength nodes, one channel per node (:mod:`speclight.render.rgl`).
 """
 
 from __future__ import annotations
@@ -48,7 +50,11 @@ class _Kept:
 
 
 class _Layout:
-    """Channel layout: main channel m for material m, then K*K channels per plastic."""
+    """Channel layout: main channel m for material m, then a block per plastic or RGL material.
+
+    Blocks (:func:`speclight.render.models.block_size`) carry what does not factorise: K*K
+    channels of a plastic's diffuse base, one channel per wavelength node of an RGL file.
+    """
 
     def __init__(self, target: Target) -> None:
         self.mats = list(target.materials)
@@ -56,9 +62,10 @@ class _Layout:
         self.block: dict[int, int] = {}
         c = len(self.mats)
         for k, m in enumerate(self.mats):
-            if m.bsdf == "plastic":
+            extra = models.block_size(m)  # plastic base, RGL wavelength nodes
+            if extra:
                 self.block[k] = c
-                c += models.PLASTIC_NODES**2
+                c += extra
         self.n_channels = c
 
 
@@ -76,10 +83,10 @@ def _pixel_contributions(
         chans.append(np.full(sel.size, k))
         weights.append(w)
         if k in layout.block:
-            idx, bw = models.bilinear_nodes(cos_i[sel], cos_o[sel])
-            rows.append(np.repeat(sel, 4))
-            chans.append((layout.block[k] + idx).ravel())
-            weights.append((bw * (cos_i[sel] / np.pi)[:, None]).ravel())
+            r, c, bw = models.block_weights(m, cos_i[sel], cos_o[sel], cos_d[sel])
+            rows.append(sel[r])
+            chans.append(layout.block[k] + c)
+            weights.append(bw)
     if not rows:
         return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
     return np.concatenate(rows), np.concatenate(chans), np.concatenate(weights)
@@ -94,8 +101,14 @@ def geometric_weights(
     keep: Iterable[int] = (),
     rays_per_batch: int = 1_000_000,
     on_batch: Callable[[int], None] | None = None,
+    on_hits: Callable[..., None] | None = None,
 ) -> tuple[F64, dict[int, _Kept], float, _Layout]:
-    """Channel weights w (N, C) [m² sr-1], kept pixel data, pixel pitch [m] and the layout."""
+    """Channel weights w (N, C) [m² sr-1], kept pixel data, pixel pitch [m] and the layout.
+
+    ``on_hits(epochs, origin, direction, hits, caster)``, if given, is called after each
+    batch's primary ray cast with the batch's epoch indices (so that other lights, e.g.
+    lasers for ranging, reuse the rays: :mod:`speclight.render.ranging`).
+    """
     layout = _Layout(target)
     centre, radius = target.bounding_sphere()
     n_ep, n_ch = len(sun_dir), layout.n_channels
@@ -110,6 +123,8 @@ def geometric_weights(
         b = len(s)
         origin, direction, pixel_area = primary_rays(centre, radius, o, resolution_px)
         hits = caster.intersect(origin, direction)
+        if on_hits is not None:
+            on_hits(np.arange(a, a + b), origin, direction, hits, caster)
         ep = np.repeat(np.arange(b), pixels)
         n = hits.normal
         cos_o = np.einsum("mk,mk->m", n, o[ep])
@@ -163,6 +178,7 @@ def render_single(
     resolution_px: int,
     keep: Iterable[int] = (),
     on_batch: Callable[[int], None] | None = None,
+    on_hits: Callable[..., None] | None = None,
 ) -> tuple[F64, dict[int, RenderImage]]:
     """Intensity (N, L) [W sr-1 nm-1] of valid epochs and the kept images (see module doc)."""
     for m in target.materials:
@@ -170,12 +186,20 @@ def render_single(
             raise NotImplementedError(f"bsdf '{m.bsdf}' is not supported in single mode")
     keep = list(keep)
     w, kept, pitch, layout = geometric_weights(
-        target, sun_dir, obs_dir, caster, resolution_px, keep, on_batch=on_batch
+        target,
+        sun_dir,
+        obs_dir,
+        caster,
+        resolution_px,
+        keep,
+        rays_per_batch=models.rays_per_batch(target.materials),
+        on_batch=on_batch,
+        on_hits=on_hits,
     )
     cos_half = np.sqrt(np.clip(0.5 * (1.0 + np.einsum("nk,nk->n", sun_dir, obs_dir)), 0.0, 1.0))
     n_mat = len(layout.mats)
     main = [models.main_factor(m, cos_half, wavelength_nm) for m in layout.mats]
-    blocks = {k: models.plastic_factor(layout.mats[k], wavelength_nm) for k in layout.block}
+    blocks = {k: models.block_factor(layout.mats[k], wavelength_nm) for k in layout.block}
     total = sum(w[:, k, None] * main[k] for k in range(n_mat))
     for k, start in layout.block.items():
         total = total + w[:, start : start + blocks[k].shape[0]] @ blocks[k]

@@ -219,6 +219,13 @@ class Laser(Strict):
     power_w: float = Field(gt=0, description="Average optical power [W]")
     repetition_rate_hz: float = Field(gt=0)
     divergence_arcsec: float = Field(gt=0, le=36000, description="Full divergence angle [arcsec]")
+    pointing_offset_arcsec: float = Field(
+        default=0.0, ge=0, le=3600, description="Angle between the beam axis and the target"
+    )
+    beam_profile: Literal["gaussian", "tophat"] = "gaussian"
+    min_elevation_deg: float = Field(
+        default=0.0, ge=-5, le=90, description="The transmitter's own horizon limit [deg]"
+    )
 
 
 class Illumination(Strict):

@@ -17,6 +17,7 @@ from speclight.simulate.radiometry import (
     instrument_response,
     wavelength_grid_nm,
 )
+from speclight.simulate.ranging_stage import laser_ranging, prepare_ranging
 from speclight.simulate.reflection import render_reflection
 from speclight.simulate.spectral_dataset import add_images, add_spectral
 
@@ -76,7 +77,14 @@ def _simulate(loaded: LoadedScenario, progress: bool) -> SimulationResult:
     sc = loaded.scenario
     geo = compute_geometry(loaded)
     wavelength_nm = wavelength_grid_nm(sc.spectrum)
-    reflection = render_reflection(loaded, geo, wavelength_nm, progress=progress)
+    setup = prepare_ranging(loaded, geo, wavelength_nm)  # None without lasers; sets flags
+    reflection = render_reflection(
+        loaded,
+        geo,
+        wavelength_nm,
+        progress=progress,
+        on_hits=setup.on_hits_for if setup is not None else None,
+    )
     elevation = np.where(geo.observable, geo.elevation_deg, np.nan)
     transmission = atmosphere_transmission(loaded, wavelength_nm, elevation)
     radiometry = None
@@ -84,7 +92,10 @@ def _simulate(loaded: LoadedScenario, progress: bool) -> SimulationResult:
         radiometry = instrument_response(
             loaded, wavelength_nm, reflection.intensity_W_sr_nm, transmission, geo.range_m
         )
-    ds = geometry_dataset(geo)  # after rendering: render failures set flag bits
+    ranging = None
+    if setup is not None:
+        ranging = laser_ranging(loaded, geo, wavelength_nm, setup, transmission, radiometry)
+    ds = geometry_dataset(geo)  # after rendering and ranging: they set flag bits
     ds = add_spectral(ds, wavelength_nm, reflection, transmission, radiometry)
     ds = add_images(ds, reflection.images)
     extra: dict[str, str] = {"render_mode": sc.render.mode, "atmosphere_model": sc.atmosphere.model}
@@ -92,4 +103,7 @@ def _simulate(loaded: LoadedScenario, progress: bool) -> SimulationResult:
         extra["render_variant"] = reflection.variant
     ds.attrs.update(global_attributes(loaded, extra))
     notes = _visibility_notes(geo)
+    if ranging is not None:
+        ds = ranging.add_to(ds)
+        notes += ranging.notes
     return SimulationResult(dataset=ds, geometry=geo, notes=notes)

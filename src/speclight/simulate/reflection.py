@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -40,12 +41,17 @@ class Reflection:
 
 
 def render_reflection(
-    loaded: LoadedScenario, geo: Geometry, wavelength_nm: F64, progress: bool = False
+    loaded: LoadedScenario,
+    geo: Geometry,
+    wavelength_nm: F64,
+    progress: bool = False,
+    on_hits: Callable[[NDArray[np.int64]], Callable[..., None]] | None = None,
 ) -> Reflection:
     """Render the sunlit, observable epochs; unlit epochs get 0, unobservable ones NaN.
 
     Epochs in the Earth's penumbra are rendered with the full Sun and scaled by the visible
-    fraction of the solar disk.
+    fraction of the solar disk. ``on_hits(epochs)`` gives a callback that sees the render's
+    primary ray hits (laser ranging reuses them).
     """
     sc = loaded.scenario
     solar = solar_irradiance_W_m2_nm(wavelength_nm, geo.sun_distance_m / AU_M)
@@ -79,6 +85,7 @@ def render_reflection(
             variant=sc.render.variant,
             progress=progress,
             keep_images_for=keep or None,
+            on_hits=None if on_hits is None else on_hits(idx),
         )
         scale = sunlit[idx, None]
         intensity[idx] = result.intensity_W_sr_nm * scale

@@ -67,6 +67,7 @@ FLAG_BELOW_MIN_ELEVATION = 2
 FLAG_IN_SHADOW = 4
 FLAG_PENUMBRA = 8
 FLAG_RENDER_FAILED = 16
+FLAG_LASER_BELOW_HORIZON = 32
 
 FLAG_MEANINGS = {
     FLAG_ORBIT_FAILED: "orbit_failed",
@@ -74,6 +75,7 @@ FLAG_MEANINGS = {
     FLAG_IN_SHADOW: "in_earth_shadow",
     FLAG_PENUMBRA: "in_penumbra",
     FLAG_RENDER_FAILED: "render_failed",
+    FLAG_LASER_BELOW_HORIZON: "laser_below_horizon",
 }
 
 

@@ -7,6 +7,7 @@ from typing import Literal, get_args
 
 from speclight.errors import InputError, did_you_mean
 from speclight.target.reflectance import Reflectance
+from speclight.target.rgl_file import check_rgl_material, is_rgl_path
 
 BsdfName = Literal["lambertian", "beckmann", "ggx", "plastic", "specular", "measured"]
 BSDF_NAMES: tuple[str, ...] = get_args(BsdfName)
@@ -38,6 +39,9 @@ class Material:
     brdf_table
         Shipped table name or path of the measured BRDF table for ``measured``; its
         ``reflectance`` scales it by ``R(lambda) / R(table wavelength)`` (1 for a constant).
+        A path ending in ``.bsdf`` is an RGL measured material (Mitsuba's ``measured``
+        plugin, :mod:`speclight.target.rgl_file`): isotropic files only, checked on creation;
+        its ``reflectance`` must be a constant scale factor in (0, 1] (1: as measured).
     """
 
     name: str
@@ -96,3 +100,5 @@ class Material:
                 "bsdf 'measured' needs brdf_table (a BRDF table file)",
                 field=f"{field}.brdf_table",
             )
+        if self.bsdf == "measured" and is_rgl_path(self.brdf_table):
+            check_rgl_material(str(self.brdf_table), self.reflectance, field)

@@ -1,0 +1,178 @@
+"""Multi-bounce laser returns at their full optical path length (``render.mode: path``).
+
+Mitsuba's integrators return radiance, not the distribution of path lengths (its core has no
+transient/time-gated rendering), so the interreflections are traced here: a Monte Carlo path
+tracer in numpy over the same ray caster (Mitsuba's ``ray_intersect``/``ray_test`` or the
+numpy one), started from the receiver's primary hits of :mod:`speclight.render.ranging`.
+
+Estimator (Kajiya 1986, "The rendering equation", doi:10.1145/15886.15902; Veach 1997, PhD
+thesis, Stanford, ch. 3 and 16). From the first hit ``p1`` (seen along ``o``), a direction
+``w`` is drawn from the cosine-weighted hemisphere about the normal (pdf cos/pi), giving the
+next vertex ``p2`` where the ray hits; the path throughput is multiplied by
+``f(w, v) cos / pdf = pi f(w, v)`` (spectral, on the laser's support wavelengths); at each
+vertex ``p_j`` (``j >= 2``) the laser is sampled directly (next-event estimation: a shadow
+ray towards the directional laser) and contributes ``throughput x f(l, v_j) cos_l x E``,
+times the pixel area, at the one-way range offset
+
+    delta = (-(p1 - c) . o + sum_i |p_{i+1} - p_i| - (p_j - c) . l) / 2
+
+(receiver plane and transmitter plane through the centre of mass ``c``). The one-bounce term
+(``j = 1``) is the exact single-scattering one of :mod:`speclight.render.ranging`, so the sum
+over bounces is unbiased for the full multi-bounce return. Paths stop after ``max_depth - 1``
+surface vertices (Mitsuba's ``max_depth`` convention, camera segment included). Limitation:
+cosine sampling cannot follow the delta reflection of smooth mirrors (``specular``, a smooth
+``plastic`` coat), so light that reaches the receiver through a mirror bounce of a smooth
+surface is missed (as with a point light in Mitsuba's path mode); glossy surfaces are
+followed, with more noise the smoother they are.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from speclight.render import models
+from speclight.render.raycast import Caster
+from speclight.render.single import _Layout, _pixel_contributions
+
+if TYPE_CHECKING:
+    from speclight.render.ranging import LaserLight, RangingAccumulator, _View
+
+F64 = NDArray[np.float64]
+I64 = NDArray[np.int64]
+
+
+def _dot(a: F64, b: F64) -> F64:
+    return np.asarray(np.einsum("mk,mk->m", a, b))
+
+
+def fcos_spectral(
+    layout: _Layout,
+    plastic: dict[int, F64],
+    wavelength_nm: F64,
+    part_material: I64,
+    n: F64,
+    to_light: F64,
+    to_viewer: F64,
+) -> F64:
+    """``f(to_light, to_viewer) cos(theta_light)`` (M, S) [sr-1] on the given wavelengths.
+
+    ``n`` faces ``to_viewer`` (two-sided surfaces); zero where the light is behind.
+    """
+    m_count, s_count = len(n), len(wavelength_nm)
+    out = np.zeros((m_count, s_count))
+    cos_i, cos_o = _dot(n, to_light), _dot(n, to_viewer)
+    ok = np.flatnonzero((cos_i > 0) & (cos_o > 0))
+    if ok.size == 0:
+        return out
+    s, v, nn = to_light[ok], to_viewer[ok], n[ok]
+    half = s + v
+    half /= np.maximum(np.linalg.norm(half, axis=1, keepdims=True), 1e-300)
+    cos_h, cos_d = _dot(nn, half), _dot(s, half)
+    mirror = 2.0 * cos_o[ok, None] * nn - v
+    mirror_ok = (_dot(mirror, s) >= models.SUN_COS).astype(float)
+    rows, chans, w = _pixel_contributions(
+        layout, part_material[ok], cos_i[ok], cos_o[ok], cos_h, cos_d, mirror_ok
+    )
+    for c, m in enumerate(layout.mats):
+        sel = np.flatnonzero(chans == c)
+        if sel.size:
+            r = rows[sel]
+            out[ok[r]] += w[sel, None] * models.main_factor(m, cos_d[r], wavelength_nm)
+    for c, start in layout.block.items():
+        sel = np.flatnonzero((chans >= start) & (chans < start + plastic[c].shape[0]))
+        if sel.size:
+            vals = w[sel, None] * plastic[c][chans[sel] - start]
+            for j in range(s_count):
+                out[:, j] += np.bincount(ok[rows[sel]], vals[:, j], minlength=m_count)
+    return out
+
+
+def _cosine_hemisphere(n: F64, rng: np.random.Generator) -> F64:
+    """Directions (M, 3) drawn with pdf cos(theta)/pi about the unit normals ``n``."""
+    u1, u2 = rng.random(len(n)), rng.random(len(n))
+    r, phi = np.sqrt(u1), 2.0 * np.pi * u2
+    x, y, z = r * np.cos(phi), r * np.sin(phi), np.sqrt(np.maximum(0.0, 1.0 - u1))
+    a = np.where((np.abs(n[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    t = np.cross(n, a)
+    t /= np.linalg.norm(t, axis=1, keepdims=True)
+    b = np.cross(n, t)
+    return np.asarray(x[:, None] * t + y[:, None] * b + z[:, None] * n)
+
+
+def _offset_origin(pos: F64, n: F64) -> F64:
+    """Start secondary rays off the surface, like Mitsuba's ``spawn_ray`` offset."""
+    scale = (1.0 + np.abs(pos).max(axis=1, keepdims=True)) * 2e-5
+    return np.asarray(pos + scale * n)
+
+
+def add_multibounce(
+    acc: RangingAccumulator,
+    k: int,
+    light: LaserLight,
+    v: _View,
+    s_dir: F64,
+    lit_ep: NDArray[np.bool_],
+    caster: Caster,
+    pixel_area_m2: float,
+) -> None:
+    """Add the returns of bounces 2..max_depth-1 of light ``k`` to the accumulator."""
+    sup = light.support
+    wl = acc.wl[sup]
+    plastic = {c: f[:, sup] for c, f in acc._plastic.items()}
+    e_slot = light.irradiance_W_m2_nm[v.epochs]  # (b, S)
+    start = np.flatnonzero(lit_ep[v.ep])
+    if start.size == 0:
+        return
+    part_mat = acc.layout.part_mat
+    spp = max(1, int(acc.samples_per_pixel))
+    nb = len(acc.edges) - 1
+    width = (acc.edges[-1] - acc.edges[0]) / nb
+    b, n_s = len(v.epochs), sup.size
+    seed = np.random.SeedSequence([acc.seed, int(v.epochs[0]), k])
+    for child in seed.spawn(spp):
+        rng = np.random.default_rng(child)
+        slot = v.ep[start]
+        pos = v.origin[v.hit[start]] - v.t[start, None] * v.o[slot]
+        n, view = v.n[start], v.o[slot]
+        mat = part_mat[v.part[start]]
+        path = -v.rel_o[start]  # receiver plane -> p1
+        through = np.ones((start.size, n_s))
+        for _ in range(2, acc.max_depth):
+            w = _cosine_hemisphere(n, rng)
+            fc = fcos_spectral(acc.layout, plastic, wl, mat, n, w, view)
+            through = through * fc * np.pi / np.maximum(_dot(n, w), 1e-12)[:, None]
+            hits = caster.intersect(_offset_origin(pos, n), w)
+            keep = np.flatnonzero(hits.hit & np.any(through > 0, axis=1))
+            if keep.size == 0:
+                break
+            slot, through, w = slot[keep], through[keep], w[keep]
+            t = hits.t_m[keep]
+            pos = pos[keep] + t[:, None] * w
+            path = path[keep] + t
+            view = -w
+            n = hits.normal[keep]
+            n = n * np.where(_dot(n, view) < 0, -1.0, 1.0)[:, None]
+            mat = part_mat[hits.part[keep]]
+            # next-event estimation towards the laser
+            s = s_dir[slot]
+            lit = np.flatnonzero(_dot(n, s) > 0)
+            if lit.size:
+                blocked = caster.occluded(pos[lit], s[lit], n[lit])
+                lit = lit[~blocked]
+            if lit.size:
+                fl = fcos_spectral(acc.layout, plastic, wl, mat[lit], n[lit], s[lit], view[lit])
+                value = through[lit] * fl * e_slot[slot[lit]] * (pixel_area_m2 / spp)
+                delta = 0.5 * (path[lit] - _dot(pos[lit] - acc.com, s[lit]))
+                bins = np.clip(((delta - acc.edges[0]) / width).astype(np.int64), 0, nb - 1)
+                flat_m = slot[lit, None] * n_s + np.arange(n_s)[None, :]
+                h = np.bincount(
+                    (flat_m * nb + bins[:, None]).ravel(), value.ravel(), minlength=b * n_s * nb
+                )
+                acc.hist[k][v.epochs] += h.reshape(b, n_s, nb)
+                mom = np.bincount(
+                    flat_m.ravel(), (value * delta[:, None]).ravel(), minlength=b * n_s
+                )
+                acc.moment[k][v.epochs] += mom.reshape(b, n_s)

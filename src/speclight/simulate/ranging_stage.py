@@ -1,0 +1,381 @@
+"""Active illumination and laser ranging stage of the pipeline (lasers from the scenario).
+
+Use from :func:`speclight.simulate.pipeline.simulate`::
+
+    setup = prepare_ranging(loaded, geo, wavelength_nm)           # None without lasers
+    # optional, for speed in single mode: reuse the Sun render's primary rays
+    #   render_intensity(..., on_hits=setup.on_hits_for(idx))     # idx: epochs rendered
+    ranging = laser_ranging(loaded, geo, wavelength_nm, setup, transmission, radiometry)
+    ds = ranging.add_to(ds)
+
+Per laser and epoch: the transmitter's own range, elevation and body-frame direction
+(:mod:`speclight.ranging.transmitter`); the beam irradiance at the target from the full
+divergence and range (:mod:`speclight.illumination.laser`); the uplink transmission at the
+transmitter's elevation from its own altitude; the line shape on the grid. The target is
+rendered with each laser as light source (:mod:`speclight.render.ranging`), and the return is
+carried to the receiver with the downlink transmission, aperture and band response
+(:mod:`speclight.ranging.link`). A laser below its transmitter's horizon contributes nothing at
+that epoch and sets :data:`FLAG_LASER_BELOW_HORIZON`; the run goes on. In ``render.mode: path``
+the interreflections are added at their full optical path length
+(:mod:`speclight.render.ranging_path`, Monte Carlo with ``render.samples_per_pixel`` and
+``render.seed``); single mode is single scattering, exact.
+
+Optional laser fields read when the scenario model has them (defaults in brackets):
+``pointing_offset_arcsec`` [0], ``beam_profile`` ['gaussian'], ``min_elevation_deg`` [0].
+The centre of mass is the body-frame origin.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from numpy.typing import NDArray
+
+from speclight import atmosphere, instrument, orbit
+from speclight.errors import InputError
+from speclight.illumination import laser as lz
+from speclight.illumination.solar import bin_edges_nm
+from speclight.orbit.timescale import time_from_utc
+from speclight.ranging import band_histograms, transmitter_geometry
+from speclight.ranging.link import C_M_S, H_J_S
+from speclight.render.path import MAX_DEPTH as PATH_MAX_DEPTH
+from speclight.render.ranging import LaserLight, RangingAccumulator
+from speclight.scenario import LoadedScenario
+from speclight.simulate.geometry import Geometry
+from speclight.simulate.radiometry import _ATMOSPHERE_KEYS, Radiometry
+from speclight.simulate.reflection import build_target
+from speclight.simulate.variables import FLAG_LASER_BELOW_HORIZON
+
+F64 = NDArray[np.float64]
+#: Line-shape values below this fraction of the peak are outside the laser's support.
+SUPPORT_THRESHOLD = 1e-9
+#: Smallest fraction of a laser line's energy that must fall inside the spectrum grid.
+MIN_LINE_FRACTION = 0.99
+RANGE_BINS = 200
+
+
+@dataclass
+class LaserSetup:
+    """One laser: name, pulse rate [Hz], geometry (N,), irradiance (N,) [W m-2] at the target
+    after the uplink, and the light for the render."""
+
+    name: str
+    repetition_rate_hz: float
+    range_m: F64
+    elevation_deg: F64
+    above_horizon: NDArray[np.bool_]
+    irradiance_W_m2: F64
+    light: LaserLight
+
+
+@dataclass
+class RangingSetup:
+    """Lasers and the render accumulator of one run."""
+
+    lasers: list[LaserSetup]
+    accumulator: RangingAccumulator
+
+    def on_hits_for(self, epochs: NDArray[np.int64]) -> Callable[..., None]:
+        """``on_hits`` callback for a render of ``geo`` epochs ``epochs`` (in that order)."""
+        index = np.asarray(epochs, dtype=np.int64)
+
+        def call(local: NDArray[np.int64], *rest: Any) -> None:
+            self.accumulator(index[local], *rest)
+
+        return call
+
+
+def _atmosphere_params(loaded: LoadedScenario) -> dict[str, Any]:
+    cfg = loaded.scenario.atmosphere
+    params: dict[str, Any] = {k: getattr(cfg, k) for k in _ATMOSPHERE_KEYS[cfg.model]}
+    if "table_file" in params:
+        params["table_file"] = loaded.resolve(params["table_file"])
+    return params
+
+
+def _line_shape(loaded: LoadedScenario, cfg: Any, wl: F64, where: str) -> F64:
+    if cfg.spectrum_file:
+        x, y = lz.read_laser_spectrum(loaded.resolve(cfg.spectrum_file))
+        shape = lz.table_line_per_nm(wl, x, y)
+    else:
+        shape = lz.gaussian_line_per_nm(wl, cfg.wavelength_nm, cfg.linewidth_nm)
+    frac = lz.line_fraction_in_grid(shape, wl)
+    if frac < MIN_LINE_FRACTION:
+        raise InputError(
+            f"only {100 * frac:.3g} % of the line at {cfg.wavelength_nm:g} nm falls inside the "
+            f"spectrum grid {wl[0]:g}..{wl[-1]:g} nm; widen spectrum.min_nm/max_nm",
+            source=loaded.source,
+            field=f"{where}.wavelength_nm",
+        )
+    return shape
+
+
+def _laser(loaded: LoadedScenario, geo: Geometry, wl: F64, k: int, t: Any) -> LaserSetup:
+    cfg = loaded.scenario.illumination.lasers[k]
+    where = f"illumination.lasers[{k}]"
+    try:
+        power = lz.check_power_w(cfg.power_w, field=f"{where}.power_w")
+        rate = lz.check_repetition_rate_hz(cfg.repetition_rate_hz, f"{where}.repetition_rate_hz")
+        theta = lz.check_divergence_arcsec(
+            cfg.divergence_arcsec, cfg.wavelength_nm, f"{where}.divergence_arcsec"
+        )
+    except InputError as err:
+        raise InputError(err.message, source=loaded.source, field=err.field) from None
+    site = orbit.Site(cfg.latitude_deg, cfg.longitude_deg, cfg.altitude_m)
+    tx = transmitter_geometry(site, t, geo.r_target_gcrs_m, geo.quaternion_body_to_gcrs)
+    min_el = float(getattr(cfg, "min_elevation_deg", 0.0) or 0.0)
+    with np.errstate(invalid="ignore"):
+        up = geo.orbit_ok & (tx.elevation_deg > min_el)
+    offset = float(getattr(cfg, "pointing_offset_arcsec", 0.0) or 0.0) * lz.ARCSEC_RAD
+    profile: lz.BeamProfile = getattr(cfg, "beam_profile", "gaussian") or "gaussian"
+    beam = lz.beam_irradiance_W_m2(power, theta, tx.range_m, offset, profile)
+    shape = _line_shape(loaded, cfg, wl, where)
+    support = np.flatnonzero(shape > SUPPORT_THRESHOLD * shape.max())
+    elev = np.where(up, tx.elevation_deg, np.nan)
+    t_up = np.zeros((len(elev), support.size))
+    if np.any(up):
+        full = atmosphere.transmission(
+            loaded.scenario.atmosphere.model,
+            wl,
+            elev[up],
+            cfg.altitude_m,
+            **_atmosphere_params(loaded),
+        )
+        t_up[up] = full[:, support]
+    spectral = np.where(up[:, None], beam[:, None] * shape[support][None, :] * t_up, 0.0)
+    lo, hi = bin_edges_nm(wl, 1.0 if wl.size == 1 else None)
+    irradiance = np.where(geo.orbit_ok, spectral @ (hi - lo)[support], np.nan)
+    direction = np.where(up[:, None], tx.direction_body, np.nan)
+    return LaserSetup(
+        cfg.name,
+        rate,
+        tx.range_m,
+        tx.elevation_deg,
+        up,
+        irradiance,
+        LaserLight(direction, support, spectral),
+    )
+
+
+def prepare_ranging(
+    loaded: LoadedScenario, geo: Geometry, wavelength_nm: F64, range_bins: int = RANGE_BINS
+) -> RangingSetup | None:
+    """Lasers' geometry and irradiance, and the accumulator; ``None`` without lasers/target.
+
+    Sets :data:`FLAG_LASER_BELOW_HORIZON` in ``geo.flags`` where a laser is below its horizon.
+    """
+    sc = loaded.scenario
+    if not sc.illumination.lasers or sc.target is None:
+        return None
+    t = time_from_utc(geo.time_utc)
+    lasers = [_laser(loaded, geo, wavelength_nm, k, t) for k in range(len(sc.illumination.lasers))]
+    for laser in lasers:
+        geo.flags[geo.orbit_ok & ~laser.above_horizon] |= FLAG_LASER_BELOW_HORIZON
+    target = build_target(loaded)
+    obs = np.where(geo.observable[:, None], geo.observer_direction_body, np.nan)
+    com = np.zeros(3)
+    centre, radius = target.bounding_sphere()
+    r_max = float(np.linalg.norm(centre - com) + radius) * 1.001
+    path = sc.render.mode == "path"
+    # one bounce lies within +-r_max; interreflections come later: the last bin of
+    # [-r_max, 3 r_max] in path mode collects the (rare) longer paths
+    n_bins = int(range_bins) * (2 if path else 1)
+    edges = np.linspace(-r_max, (3.0 if path else 1.0) * r_max, n_bins + 1)
+    acc = RangingAccumulator(
+        target,
+        obs,
+        [la.light for la in lasers],
+        wavelength_nm,
+        edges,
+        com,
+        max_depth=int(getattr(sc.render, "max_depth", PATH_MAX_DEPTH)) if path else 2,
+        samples_per_pixel=sc.render.samples_per_pixel,
+        seed=sc.render.seed,
+    )
+    return RangingSetup(lasers, acc)
+
+
+@dataclass
+class RangingResult:
+    """Laser illumination and ranging outputs (arrays; :meth:`add_to` writes the variables)."""
+
+    laser_names: list[str]
+    band_names: list[str]
+    range_bin_edges_m: F64
+    laser_range_m: F64  # (N, K)
+    laser_elevation_deg: F64  # (N, K)
+    laser_irradiance_W_m2: F64  # (N, K)
+    laser_intensity_W_sr_nm: F64  # (N, L)
+    return_per_pulse: F64  # (N, K, B)
+    return_rate_per_s: F64  # (N, B)
+    range_histogram_per_s: F64  # (N, B, bins)
+    range_offset_m: F64  # (N, B)
+    notes: list[str] = field(default_factory=list)
+
+    def add_to(self, ds: xr.Dataset) -> xr.Dataset:
+        """The dataset with the laser and ranging variables (CF units and long names)."""
+        edges = self.range_bin_edges_m
+        ds = ds.assign_coords(
+            laser=("laser", np.array(self.laser_names, dtype=str)),
+            range_bin=("range_bin", 0.5 * (edges[1:] + edges[:-1])),
+        )
+        ds["laser"].attrs["long_name"] = "laser transmitter"
+        ds["range_bin"].attrs.update(
+            units="m",
+            long_name="one-way range offset from the centre of mass (bin centre), "
+            "negative = in front",
+            bounds="range_bin_bounds",
+        )
+        ds["range_bin_bounds"] = (("range_bin", "nv"), np.stack([edges[:-1], edges[1:]], 1))
+        tl, tb = ("time", "laser"), ("time", "band")
+        ds["laser_range"] = (tl, self.laser_range_m, _a("m", "transmitter-to-target distance"))
+        ds["laser_elevation"] = (
+            tl,
+            self.laser_elevation_deg,
+            _a("degree", "elevation of the target above the transmitter's horizon"),
+        )
+        ds["laser_irradiance"] = (
+            tl,
+            self.laser_irradiance_W_m2,
+            _a("W m-2", "laser irradiance at the target (mean power, after the uplink)"),
+        )
+        ds["laser_intensity"] = (
+            ("time", "wavelength"),
+            self.laser_intensity_W_sr_nm,
+            _a("W sr-1 nm-1", "radiant intensity of the target toward the observer from lasers"),
+        )
+        if self.band_names:
+            ds["return_photons_per_pulse"] = (
+                ("time", "laser", "band"),
+                self.return_per_pulse,
+                _a("1", "detected return photo-electrons per laser pulse"),
+            )
+            ds["return_rate"] = (
+                tb,
+                self.return_rate_per_s,
+                _a("s-1", "detected laser return photo-electrons per second, all lasers"),
+            )
+            ds["range_histogram"] = (
+                ("time", "band", "range_bin"),
+                self.range_histogram_per_s,
+                _a("s-1", "detected laser return photo-electrons per second per range bin"),
+            )
+            ds["range_offset"] = (
+                tb,
+                self.range_offset_m,
+                _a("m", "mean return range minus range to the centre of mass (one-way)"),
+            )
+        return ds
+
+
+def _a(units: str, long_name: str) -> dict[str, str]:
+    return {"units": units, "long_name": long_name}
+
+
+def laser_ranging(
+    loaded: LoadedScenario,
+    geo: Geometry,
+    wavelength_nm: F64,
+    setup: RangingSetup,
+    transmission: F64,
+    radiometry: Radiometry | None,
+) -> RangingResult:
+    """Finish the laser render and carry the returns to the receiver (module docstring).
+
+    Parameters
+    ----------
+    loaded, geo, wavelength_nm
+        The run's scenario, geometry and grid [nm].
+    setup
+        From :func:`prepare_ranging` (its accumulator may already hold the shared-ray epochs).
+    transmission
+        (N, L) downlink transmission target -> observer [1].
+    radiometry
+        The instrument curves (band response, optics, QE); ``None``: no band outputs.
+    """
+    from speclight.render.api import make_caster
+    from speclight.render.variant import choose_variant
+
+    sc = loaded.scenario
+    acc = setup.accumulator
+    if np.any(acc.active & ~acc.rendered):
+        caster = make_caster(acc.target, choose_variant(sc.render.variant, spectral=False))
+        acc.finish(caster, sc.render.resolution_px)
+    rr = acc.result()
+    n, n_wl, k_las = geo.t_s.size, wavelength_nm.size, len(setup.lasers)
+    obs = geo.observable
+    intensity = np.zeros((n, n_wl))
+    bands = radiometry.band_names if radiometry is not None else []
+    n_b, n_bins = len(bands), len(rr.bin_edges_m) - 1
+    per_pulse = np.zeros((n, k_las, n_b))
+    hist = np.zeros((n, n_b, n_bins))
+    moment = np.zeros((n, n_b))
+    total = np.zeros((n, n_b))
+    if radiometry is not None:
+        area = instrument.aperture_area_m2(
+            sc.telescope.aperture_diameter_m, sc.telescope.obstruction_diameter_m
+        )
+        # electrons per joule per bin x width (B, L), as instrument.photometry.photon_kernel
+        # but with the per-band detector QE the pipeline uses
+        kernel = (
+            radiometry.band_response
+            * radiometry.optics[None, :]
+            * np.broadcast_to(radiometry.qe, radiometry.band_response.shape)
+            * (wavelength_nm * 1e-9 / (H_J_S * C_M_S) * instrument.bin_widths_nm(wavelength_nm))
+        )
+    for k, laser in enumerate(setup.lasers):
+        sup = laser.light.support
+        i_k = rr.intensity_W_sr_nm(k)
+        intensity[:, sup] += i_k
+        if radiometry is None:
+            continue
+        with np.errstate(invalid="ignore"):
+            down = np.where(obs[:, None], transmission[:, sup], 0.0)
+            down = np.nan_to_num(down) * area / np.where(obs, geo.range_m, 1.0)[:, None] ** 2
+        conv = down[:, :, None] * kernel[:, sup].T[None, :, :]  # (N, S, B) [s-1 per W sr-1 nm-1]
+        rate = np.einsum("ns,nsb->nb", i_k, conv)
+        per_pulse[:, k] = rate / laser.repetition_rate_hz
+        hist += band_histograms(rr.histogram[k], conv)
+        moment += np.einsum("ns,nsb->nb", rr.moment_m[k], conv)
+        total += rate
+    with np.errstate(invalid="ignore", divide="ignore"):
+        offset = np.where(total > 0, moment / total, np.nan)
+    nan_rows = ~obs
+    intensity[nan_rows] = np.nan
+    per_pulse[nan_rows] = np.nan
+    hist[nan_rows] = np.nan
+    total[nan_rows] = np.nan
+    offset[nan_rows] = np.nan
+    notes = []
+    below = [la.name for la in setup.lasers if np.any(obs & geo.orbit_ok & ~la.above_horizon)]
+    if below:
+        notes.append(
+            f"laser(s) {', '.join(below)} below the transmitter's horizon at some observable "
+            "epochs (flag laser_below_horizon): no return from them there"
+        )
+    if sc.render.mode == "path" and any(
+        m.bsdf == "specular" or (m.bsdf == "plastic" and m.roughness is None)
+        for m in acc.target.materials
+    ):
+        notes.append(
+            "laser ranging in render.mode 'path' does not follow the mirror reflection of "
+            "smooth (specular, smooth plastic) surfaces between bounces"
+        )
+    return RangingResult(
+        laser_names=[la.name for la in setup.lasers],
+        band_names=list(bands),
+        range_bin_edges_m=rr.bin_edges_m,
+        laser_range_m=np.stack([la.range_m for la in setup.lasers], axis=1),
+        laser_elevation_deg=np.stack([la.elevation_deg for la in setup.lasers], axis=1),
+        laser_irradiance_W_m2=np.stack([la.irradiance_W_m2 for la in setup.lasers], axis=1),
+        laser_intensity_W_sr_nm=intensity,
+        return_per_pulse=per_pulse,
+        return_rate_per_s=total,
+        range_histogram_per_s=hist,
+        range_offset_m=offset,
+        notes=notes,
+    )
