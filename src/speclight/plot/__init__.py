@@ -1,5 +1,5 @@
-"""Figures of a speclight dataset (matplotlib, imported lazily)."""
+"""Figures of a speclight dataset (matplotlib, imported lazily by the figure builders)."""
 
-from speclight.plot.figures import plot_dataset, plot_file
+from speclight.plot.figures import KINDS, plot_dataset, plot_file, plot_files
 
-__all__ = ["plot_dataset", "plot_file"]
+__all__ = ["KINDS", "plot_dataset", "plot_file", "plot_files"]

@@ -1,80 +1,231 @@
-"""``speclight plot``: the figures a user looks at after a run."""
+"""``speclight plot``: which figures a dataset gets, and writing them safely.
+
+``plot_file(pass.nc, pass.png)`` writes the overview ``pass.png`` (light curves,
+spectrogram, geometry: all on one UTC time axis) and, beside it, one file per other
+figure the dataset can fill: ``pass-chain.png`` (one epoch through the radiometric
+chain, on a wavelength axis), ``pass-images.png`` (saved images) and
+``pass-ranging.png`` (range histograms and offsets). Every file is rendered to a
+temporary name first and moved into place only when all have rendered; none is
+written if any target exists and ``force`` is not set.
+
+To add a figure, append a :class:`FigureKind` to :data:`FIGURES`.
+"""
 
 from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import xarray as xr
 
-from speclight.errors import InputError
+from speclight.errors import InputError, did_you_mean
+from speclight.plot.chain import chain_figure
+from speclight.plot.images import images_figure
+from speclight.plot.overview import overview_figure
+from speclight.plot.ranging import has_ranging, ranging_figure
+from speclight.plot.selection import (
+    check_dataset,
+    has_images,
+    has_spectra,
+    resolve_band,
+    resolve_epoch,
+)
+from speclight.plot.style import DPI
 
 
-def _pyplot() -> Any:
-    try:
-        import matplotlib
-    except ImportError as exc:
+@dataclass(frozen=True)
+class Choices:
+    """Resolved plot options: the epoch to follow and the band of the images."""
+
+    epoch: int | None
+    epoch_reason: str
+    band: str | None
+
+
+@dataclass(frozen=True)
+class FigureKind:
+    """One figure: its name, file-name suffix, when it applies and how it is built."""
+
+    name: str
+    suffix: str
+    applies: Callable[[xr.Dataset, Choices], bool]
+    build: Callable[[xr.Dataset, Choices], Any]
+
+
+FIGURES: tuple[FigureKind, ...] = (
+    FigureKind("overview", "", lambda ds, c: True, lambda ds, c: overview_figure(ds, c.epoch)),
+    FigureKind(
+        "chain",
+        "-chain",
+        lambda ds, c: has_spectra(ds) and c.epoch is not None,
+        lambda ds, c: chain_figure(ds, c.epoch or 0, c.epoch_reason),
+    ),
+    FigureKind("images", "-images", lambda ds, c: has_images(ds),
+               lambda ds, c: images_figure(ds, c.band)),
+    FigureKind("ranging", "-ranging", lambda ds, c: has_ranging(ds),
+               lambda ds, c: ranging_figure(ds, c.epoch)),
+)
+KINDS = tuple(f.name for f in FIGURES)
+
+
+def _choices(ds: xr.Dataset, epoch: int | str | None, band: str | None) -> Choices:
+    index = resolve_epoch(ds, epoch)
+    reason = "brightest observable epoch" if epoch is None else "chosen with --epoch"
+    return Choices(index, reason, resolve_band(ds, band) if has_images(ds) else band)
+
+
+def _kinds(kinds: Sequence[str] | None) -> list[FigureKind]:
+    if kinds is None:
+        return list(FIGURES)
+    for k in kinds:
+        if k not in KINDS:
+            raise InputError(
+                f"unknown figure {k!r}{did_you_mean(k, KINDS)} (choices: {', '.join(KINDS)})",
+                field="--kind",
+            )
+    if "overview" not in kinds:
         raise InputError(
-            "plotting needs matplotlib: pip install 'speclight[plot]'", field="plot"
-        ) from exc
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _geometry_axes(ds: xr.Dataset, axes: Any) -> None:
-    t = ds["time"].values
-    observable = (ds["flags"].values & 3) == 0 if "flags" in ds else np.ones(t.size, bool)
-    panels = [
-        ("range", 1e-3, "range [km]"),
-        ("elevation", 1.0, "elevation [deg]"),
-        ("phase_angle", 1.0, "phase angle [deg]"),
-        ("sunlit", 1.0, "sunlit fraction"),
-    ]
-    for ax, (name, scale, label) in zip(axes, panels, strict=True):
-        y = ds[name].values * scale
-        ax.plot(t, y, color="0.7", lw=1)
-        ax.plot(t, np.where(observable, y, np.nan), color="C0", lw=1.5)
-        ax.set_ylabel(label)
-        ax.grid(alpha=0.3)
-        if name == "sunlit":
-            ax.set_ylim(-0.05, 1.05)
-    axes[-1].set_xlabel("time [UTC]")
+            "the overview figure is always written (it is the main output file); "
+            f"add 'overview' to the figures asked for (choices: {', '.join(KINDS)})",
+            field="--kind",
+        )
+    return [f for f in FIGURES if f.name in kinds]
 
 
-def plot_dataset(ds: xr.Dataset) -> Any:
-    """Build the figure for a dataset; returns the matplotlib figure."""
-    plt = _pyplot()
-    fig, axes = plt.subplots(4, 1, figsize=(9, 9), sharex=True, constrained_layout=True)
-    _geometry_axes(ds, axes)
-    name = ds.attrs.get("scenario_name", "")
-    fig.suptitle(f"{name}: geometry along the pass (grey: below min. elevation)")
-    fig.autofmt_xdate()
-    return fig
+def plot_dataset(ds: xr.Dataset, *, epoch: int | str | None = None) -> Any:
+    """Build the overview figure of a dataset (a :class:`matplotlib.figure.Figure`).
+
+    Parameters
+    ----------
+    ds
+        A dataset written by ``speclight simulate``.
+    epoch
+        Epoch marked as the one followed through the chain: an index, a UTC time, or
+        None for the brightest observable epoch.
+    """
+    check_dataset(ds)
+    return overview_figure(ds, resolve_epoch(ds, epoch))
 
 
-def plot_file(dataset: str | Path, output: str | Path, force: bool = False) -> Path:
-    """Read a dataset file and write its figure (atomically; ``force`` to overwrite)."""
-    dataset, output = Path(dataset), Path(output)
-    if output.exists() and not force:
-        raise InputError(f"{output} exists; pass --force to overwrite it", field="--output")
+def figure_paths(output: Path, names: Sequence[str]) -> dict[str, Path]:
+    """File of each figure: the main ``output`` and ``<stem><suffix><ext>`` beside it."""
+    by_name = {f.name: f for f in FIGURES}
+    return {n: output.with_name(f"{output.stem}{by_name[n].suffix}{output.suffix}") for n in names}
+
+
+def _check_output(output: Path) -> None:
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    formats = FigureCanvasBase.get_supported_filetypes()
+    ext = output.suffix.lstrip(".").lower()
+    if ext not in formats:
+        raise InputError(
+            f"cannot write a figure as {output.name!r}{did_you_mean(ext, formats)}; "
+            f"use one of the extensions {', '.join(sorted(formats))}, e.g. pass.png",
+            field="--output",
+        )
+    if not output.parent.is_dir():
+        raise InputError(f"folder {output.parent} does not exist", field="--output")
+
+
+def _load(dataset: Path) -> xr.Dataset:
     try:
         ds = xr.load_dataset(dataset, engine="h5netcdf")
-    except (OSError, ValueError) as exc:
-        raise InputError(f"cannot read {dataset} as a speclight dataset: {exc}") from exc
-    missing = [n for n in ("range", "elevation", "phase_angle", "sunlit") if n not in ds]
-    if missing:
-        raise InputError(f"{dataset} lacks {', '.join(missing)}; is it a speclight output?")
-    fig = plot_dataset(ds)
-    fd, tmp = tempfile.mkstemp(prefix=f".{output.name}.", suffix=output.suffix, dir=output.parent)
-    os.close(fd)
+    except (OSError, ValueError, TypeError, KeyError) as exc:
+        raise InputError(
+            f"cannot read it as a NetCDF dataset ({exc}); give a file written by "
+            "`speclight simulate`",
+            source=str(dataset),
+        ) from exc
+    check_dataset(ds, source=str(dataset))
+    return ds
+
+
+def plot_files(
+    dataset: str | Path,
+    output: str | Path,
+    force: bool = False,
+    *,
+    epoch: int | str | None = None,
+    band: str | None = None,
+    kinds: Sequence[str] | None = None,
+    dpi: int = DPI,
+) -> list[Path]:
+    """Read a dataset file and write all its figures; returns the files, main one first.
+
+    Parameters
+    ----------
+    dataset
+        NetCDF file written by ``speclight simulate``.
+    output
+        Main figure file (``.png``, ``.pdf``, ``.svg``...); the other figures go beside it
+        as ``<stem>-chain``, ``<stem>-images``, ``<stem>-ranging`` with the same extension.
+    force
+        Overwrite existing files; otherwise an existing target is an error and nothing is
+        written.
+    epoch
+        Epoch followed through the chain: index, UTC time (ISO 8601), or None for the
+        brightest observable epoch.
+    band
+        Band of the radiance images (default: the first band; the whole wavelength grid
+        when the dataset has no bands).
+    kinds
+        Figures to write (names in :data:`KINDS`); None for all that apply.
+    dpi
+        Resolution of raster formats [dots per inch].
+    """
+    dataset, output = Path(dataset), Path(output)
+    _check_output(output)
+    wanted = _kinds(kinds)
+    ds = _load(dataset)
+    choices = _choices(ds, epoch, band)
+    todo = [f for f in wanted if f.applies(ds, choices)]
+    paths = figure_paths(output, [f.name for f in todo])
+    existing = [str(p) for p in paths.values() if p.exists()]
+    if existing and not force:
+        raise InputError(
+            f"{', '.join(existing)} exist{'s' if len(existing) == 1 else ''}; "
+            "choose another name or pass --force to overwrite",
+            field="--output",
+        )
+    temporaries: list[tuple[str, Path]] = []
     try:
-        fig.savefig(tmp, dpi=120)
-        os.replace(tmp, output)
+        for kind in todo:
+            target = paths[kind.name]
+            fig = kind.build(ds, choices)
+            fd, tmp = tempfile.mkstemp(
+                prefix=f".{target.name}.", suffix=target.suffix, dir=target.parent
+            )
+            os.close(fd)
+            temporaries.append((tmp, target))
+            fig.savefig(tmp, dpi=dpi)
+        for tmp, target in temporaries:
+            os.replace(tmp, target)
     finally:
-        Path(tmp).unlink(missing_ok=True)
-    return output
+        for tmp, _ in temporaries:
+            Path(tmp).unlink(missing_ok=True)
+    return [paths[f.name] for f in todo]
+
+
+def plot_file(
+    dataset: str | Path,
+    output: str | Path,
+    force: bool = False,
+    *,
+    epoch: int | str | None = None,
+    band: str | None = None,
+    kinds: Sequence[str] | None = None,
+    dpi: int = DPI,
+) -> Path:
+    """Read a dataset file and write its figures (see :func:`plot_files`).
+
+    Returns
+    -------
+    Path
+        The main (overview) figure file.
+    """
+    return plot_files(dataset, output, force, epoch=epoch, band=band, kinds=kinds, dpi=dpi)[0]
