@@ -101,15 +101,39 @@ def plot(
     output: Annotated[Path, typer.Option("--output", "-o", help="Figure file (.png, .pdf).")] = (
         Path("speclight.png")
     ),
-    force: Annotated[bool, typer.Option("--force", help="Overwrite an existing figure.")] = False,
+    epoch: Annotated[
+        str | None,
+        typer.Option(
+            "--epoch",
+            help="Epoch of the chain figure: index or UTC time (default: brightest observable).",
+        ),
+    ] = None,
+    band: Annotated[
+        str | None, typer.Option("--band", help="Band of the radiance images (default: first).")
+    ] = None,
+    kind: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--kind",
+            help="Figures to write: overview, chain, images, ranging (repeatable; default: all "
+            "that the data can fill; the overview is always written).",
+        ),
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite existing figures.")] = False,
 ) -> None:
-    """Plot a dataset: geometry along the pass (and light curves, spectra where present)."""
+    """Plot a dataset: OUTPUT is the overview (light curves, spectrogram, geometry); the
+    chain, images and ranging figures go beside it (OUTPUT-chain.png, ...)."""
 
     def run() -> None:
-        from speclight.plot import plot_file
+        from speclight.plot import plot_files
 
-        written = plot_file(dataset, output, force=force)
-        typer.echo(f"wrote {written}")
+        chosen: int | str | None = epoch
+        if epoch is not None and epoch.strip().lstrip("-").isdigit():
+            chosen = int(epoch)
+        kinds = None if not kind else ["overview", *[k for k in kind if k != "overview"]]
+        written = plot_files(dataset, output, force=force, epoch=chosen, band=band, kinds=kinds)
+        for path in written:
+            typer.echo(f"wrote {path}")
 
     _guarded(run)
 

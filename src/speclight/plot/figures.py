@@ -44,6 +44,7 @@ class Choices:
     epoch: int | None
     epoch_reason: str
     band: str | None
+    epoch_given: bool = False
 
 
 @dataclass(frozen=True)
@@ -64,10 +65,15 @@ FIGURES: tuple[FigureKind, ...] = (
         lambda ds, c: has_spectra(ds) and c.epoch is not None,
         lambda ds, c: chain_figure(ds, c.epoch or 0, c.epoch_reason),
     ),
-    FigureKind("images", "-images", lambda ds, c: has_images(ds),
-               lambda ds, c: images_figure(ds, c.band)),
-    FigureKind("ranging", "-ranging", lambda ds, c: has_ranging(ds),
-               lambda ds, c: ranging_figure(ds, c.epoch)),
+    FigureKind(
+        "images", "-images", lambda ds, c: has_images(ds), lambda ds, c: images_figure(ds, c.band)
+    ),
+    FigureKind(
+        "ranging",
+        "-ranging",
+        lambda ds, c: has_ranging(ds),
+        lambda ds, c: ranging_figure(ds, c.epoch if c.epoch_given else None),
+    ),
 )
 KINDS = tuple(f.name for f in FIGURES)
 
@@ -75,7 +81,8 @@ KINDS = tuple(f.name for f in FIGURES)
 def _choices(ds: xr.Dataset, epoch: int | str | None, band: str | None) -> Choices:
     index = resolve_epoch(ds, epoch)
     reason = "brightest observable epoch" if epoch is None else "chosen with --epoch"
-    return Choices(index, reason, resolve_band(ds, band) if has_images(ds) else band)
+    band = resolve_band(ds, band) if has_images(ds) else band
+    return Choices(index, reason, band, epoch_given=epoch is not None)
 
 
 def _kinds(kinds: Sequence[str] | None) -> list[FigureKind]:
@@ -94,6 +101,15 @@ def _kinds(kinds: Sequence[str] | None) -> list[FigureKind]:
             field="--kind",
         )
     return [f for f in FIGURES if f.name in kinds]
+
+
+def figure_names(
+    ds: xr.Dataset, *, epoch: int | str | None = None, band: str | None = None
+) -> list[str]:
+    """Names of the figures :func:`plot_files` writes for ``ds`` (main one first)."""
+    check_dataset(ds)
+    choices = _choices(ds, epoch, band)
+    return [f.name for f in FIGURES if f.applies(ds, choices)]
 
 
 def plot_dataset(ds: xr.Dataset, *, epoch: int | str | None = None) -> Any:

@@ -1,0 +1,98 @@
+"""Saved images: band-integrated radiance and depth map of each saved epoch."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from numpy.typing import NDArray
+
+from speclight.plot.selection import band_radiance
+from speclight.plot.style import epoch_summary, new_figure
+
+# Most image epochs drawn in one figure; more would make rows too small to read.
+MAX_IMAGE_ROWS = 6
+# Dynamic range of the radiance colour scale (glints are orders brighter than diffuse parts).
+RADIANCE_DYNAMIC_RANGE = 1e3
+
+
+def _extent_m(ds: xr.Dataset, k: int, ny: int, nx: int) -> tuple[float, float, float, float]:
+    pitch = float(ds["image_pixel_size"].values[k]) if "image_pixel_size" in ds else 1.0
+    return (-nx * pitch / 2, nx * pitch / 2, -ny * pitch / 2, ny * pitch / 2)
+
+
+def _on_target(ds: xr.Dataset, k: int, img: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Pixels that see the target: finite depth, else a part index >= 0, else radiance > 0."""
+    if "image_depth" in ds:
+        return np.isfinite(np.asarray(ds["image_depth"].isel(image_time=k).values, dtype=float))
+    if "image_part" in ds:
+        return np.asarray(ds["image_part"].isel(image_time=k).values) >= 0
+    return np.asarray(img > 0)
+
+
+def images_figure(ds: xr.Dataset, band: str | None) -> Any:
+    """One row per saved epoch: radiance in ``band`` (or the whole grid) and depth map.
+
+    Pixel row 0 is the top of the image (the renderer's convention); axes are metres at
+    the target, right and up as seen by the observer.
+    """
+    from matplotlib import colormaps
+    from matplotlib.colors import LogNorm
+
+    n = ds.sizes["image_time"]
+    shown = min(n, MAX_IMAGE_ROWS)
+    columns = [c for c in ("image_radiance", "image_depth") if c in ds]
+    fig = new_figure(height_in=0.8 + 3.6 * shown, width_in=4.6 * len(columns) + 0.6)
+    axes = np.atleast_2d(fig.subplots(shown, len(columns), squeeze=False))
+    image_epochs = np.atleast_1d(ds["image_time"].values)
+    time = ds["time"].values
+    for k in range(shown):
+        i = int(np.argmin(np.abs(time - image_epochs[k])))
+        for ax, col in zip(axes[k], columns, strict=True):
+            if col == "image_radiance":
+                img = band_radiance(ds, k, band)
+                positive = img[np.isfinite(img) & (img > 0)]
+                vmax = float(positive.max()) if positive.size else 1.0
+                norm = LogNorm(vmin=vmax / RADIANCE_DYNAMIC_RANGE, vmax=vmax, clip=True)
+                cmap = colormaps["inferno"].with_extremes(under="black", bad="0.85")
+                data = np.ma.masked_invalid(np.where(_on_target(ds, k, img), img, np.nan))
+                what = f"radiance in {band}" if band else "radiance, whole grid"
+                what += " (grey: off target)"
+                label = (
+                    "∫ L R dλ [W m$^{-2}$ sr$^{-1}$]" if band else "∫ L dλ [W m$^{-2}$ sr$^{-1}$]"
+                )
+                im = ax.imshow(
+                    data,
+                    norm=norm,
+                    cmap=cmap,
+                    interpolation="nearest",
+                    extent=_extent_m(ds, k, *img.shape),
+                    origin="upper",
+                )
+            else:
+                depth = np.asarray(ds["image_depth"].isel(image_time=k).values, dtype=float)
+                cmap = colormaps["viridis"].with_extremes(bad="0.85")
+                im = ax.imshow(
+                    np.ma.masked_invalid(depth),
+                    cmap=cmap,
+                    interpolation="nearest",
+                    extent=_extent_m(ds, k, *depth.shape),
+                    origin="upper",
+                )
+                what = "depth (grey: off target)"
+                label = "depth behind target centre [m]"
+            fig.colorbar(
+                im,
+                ax=ax,
+                label=label,
+                shrink=0.85,
+                extend="min" if col == "image_radiance" else "neither",
+            )
+            ax.set_title(f"{what}\n{epoch_summary(ds, i)}", fontsize="small")
+            ax.set_xlabel("right [m]")
+            ax.set_ylabel("up [m]")
+    name = ds.attrs.get("scenario_name", "speclight dataset")
+    more = f" (first {shown} of {n})" if n > shown else ""
+    fig.suptitle(f"{name}: saved images{more}")
+    return fig

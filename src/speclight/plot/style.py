@@ -1,0 +1,157 @@
+"""Shared look of the figures: UTC time axes, band colours, unobservable-epoch shading.
+
+Figures are built on :class:`matplotlib.figure.Figure` directly, never through
+``pyplot``, so that plotting changes no process-wide matplotlib state (backend,
+current figure) of the caller.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from numpy.typing import NDArray
+
+from speclight.errors import InputError
+
+# Flag bits of the dataset (speclight.simulate.variables, CF flag_masks).
+FLAG_ORBIT_FAILED = 1
+FLAG_BELOW_MIN_ELEVATION = 2
+FLAG_IN_SHADOW = 4
+FLAG_PENUMBRA = 8
+FLAG_RENDER_FAILED = 16
+NOT_OBSERVABLE = FLAG_ORBIT_FAILED | FLAG_BELOW_MIN_ELEVATION | FLAG_IN_SHADOW | FLAG_RENDER_FAILED
+
+DPI = 120
+WIDTH_IN = 10.0
+
+# Shading of epochs along time axes: (flag bits, face colour, legend label).
+_SHADES = (
+    (FLAG_ORBIT_FAILED | FLAG_BELOW_MIN_ELEVATION | FLAG_RENDER_FAILED, "0.85", "not observable"),
+    (FLAG_IN_SHADOW, "#9aa7c7", "Earth shadow"),
+    (FLAG_PENUMBRA, "#f3d9a4", "penumbra"),
+)
+
+
+def new_figure(height_in: float, width_in: float = WIDTH_IN) -> Any:
+    """A constrained-layout figure that is not registered with pyplot."""
+    try:
+        from matplotlib.figure import Figure
+    except ImportError as exc:  # pragma: no cover - matplotlib is a dependency
+        raise InputError(
+            "plotting needs matplotlib; install it with: pip install matplotlib", field="plot"
+        ) from exc
+    return Figure(figsize=(width_in, height_in), dpi=DPI, layout="constrained")
+
+
+def flags(ds: xr.Dataset) -> NDArray[np.int64]:
+    """The flag bits per epoch (zeros when the dataset has no ``flags``)."""
+    if "flags" not in ds:
+        return np.zeros(ds.sizes["time"], dtype=np.int64)
+    return np.nan_to_num(ds["flags"].values).astype(np.int64)
+
+
+def observable(ds: xr.Dataset) -> NDArray[np.bool_]:
+    """Epochs above the minimum elevation, sunlit (penumbra allowed) and rendered."""
+    return (flags(ds) & NOT_OBSERVABLE) == 0
+
+
+def utc_label(ds: xr.Dataset) -> str:
+    """Time-axis label naming the UTC date of the first epoch."""
+    t = ds["time"].values
+    day = np.datetime_as_string(t[0], unit="D") if t.size else ""
+    return f"time [UTC] on {day}"
+
+
+def format_time_axis(ax: Any, ds: xr.Dataset, label: bool = True) -> None:
+    """HH:MM:SS UTC ticks; the date goes in the label."""
+    import matplotlib.dates as mdates
+
+    locator = mdates.AutoDateLocator(minticks=5, maxticks=13)
+    ax.xaxis.set_major_locator(locator)
+    ax.xaxis.set_major_formatter(mdates.DateFormatter("%H:%M:%S"))
+    if label:
+        ax.set_xlabel(utc_label(ds))
+
+
+def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
+    """(first, last) index of each run of True values."""
+    if not mask.any():
+        return []
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    starts = np.flatnonzero(edges == 1)
+    stops = np.flatnonzero(edges == -1) - 1
+    return list(zip(starts.tolist(), stops.tolist(), strict=True))
+
+
+def shade_unobservable(ax: Any, ds: xr.Dataset) -> list[Any]:
+    """Shade epochs that are not observable, in Earth shadow or in penumbra.
+
+    Returns legend handles for the kinds of shading actually drawn.
+    """
+    from matplotlib.patches import Patch
+
+    t = ds["time"].values
+    if t.size == 0:
+        return []
+    half = (t[1] - t[0]) / 2 if t.size > 1 else np.timedelta64(500, "ms")
+    f = flags(ds)
+    handles = []
+    for bits, colour, label in _SHADES:
+        runs = _runs((f & bits) != 0)
+        for i, j in runs:
+            ax.axvspan(t[i] - half, t[j] + half, color=colour, alpha=0.6, lw=0, zorder=0)
+        if runs:
+            handles.append(Patch(color=colour, alpha=0.6, label=label))
+    return handles
+
+
+def band_centres_nm(ds: xr.Dataset) -> NDArray[np.float64]:
+    """Response-weighted mean wavelength of each band [nm] (NaN when unknown)."""
+    n = ds.sizes.get("band", 0)
+    if "band_response" not in ds or "wavelength" not in ds.coords:
+        return np.full(n, np.nan)
+    r = np.nan_to_num(ds["band_response"].transpose("band", "wavelength").values)
+    w = ds["wavelength"].values
+    total = r.sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(total > 0, (r * w).sum(axis=1) / total, np.nan)
+
+
+def band_styles(ds: xr.Dataset) -> list[dict[str, Any]]:
+    """Colour (by the band's mean wavelength, 380-1100 nm) and line style of each band.
+
+    Bands whose mean wavelengths lie within 15 nm of an earlier band's get a dashed or
+    dotted line so that they stay distinguishable.
+    """
+    from matplotlib import colormaps
+
+    cmap = colormaps["turbo"]
+    centres = band_centres_nm(ds)
+    n = centres.size
+    styles: list[dict[str, Any]] = []
+    dashes = ["-", "--", ":", "-."]
+    for i, c in enumerate(centres):
+        if np.isfinite(c):
+            colour = cmap(float(np.clip((c - 380.0) / (1100.0 - 380.0), 0.0, 1.0)) * 0.9 + 0.05)
+            twins = int(np.sum(np.abs(centres[:i] - c) < 15.0))
+        else:
+            colour = colormaps["tab10"](i % 10)
+            twins = 0
+        styles.append({"color": colour, "ls": dashes[twins % len(dashes)]})
+    return styles[:n]
+
+
+def epoch_summary(ds: xr.Dataset, i: int) -> str:
+    """One line describing epoch ``i``: UTC time, range, elevation, phase angle."""
+    t = np.datetime_as_string(ds["time"].values[i], unit="s").replace("T", " ")
+    parts = [f"{t} UTC"]
+    for name, scale, fmt in (
+        ("range", 1e-3, "range {:.0f} km"),
+        ("elevation", 1.0, "elevation {:.1f}°"),
+        ("phase_angle", 1.0, "phase angle {:.1f}°"),
+    ):
+        if name in ds:
+            parts.append(fmt.format(float(ds[name].values[i]) * scale))
+    return ", ".join(parts)
