@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 from speclight.atmosphere.airmass import airmass
 from speclight.atmosphere.mapping import interpolate_in_airmass, log_transmission
 from speclight.atmosphere.params import AtmosphereParams
+from speclight.cache import cache_root
 from speclight.errors import InputError, SpeclightError
 from speclight.instrument.grid import bin_edges_nm
 
@@ -43,14 +44,6 @@ WORKERS = 2
 
 class SixSUnavailable(SpeclightError):
     """The 6S executable is missing or cannot run (e.g. libgfortran5 is not installed)."""
-
-
-def cache_root(override: Path | None = None) -> Path:
-    """Cache folder: ``override``, else ``$SPECLIGHT_CACHE_DIR``, else ``~/.cache/speclight``."""
-    if override is not None:
-        return Path(override)
-    env = os.environ.get("SPECLIGHT_CACHE_DIR")
-    return Path(env).expanduser() if env else Path.home() / ".cache" / "speclight"
 
 
 def sixs_executable() -> Path:

@@ -57,6 +57,7 @@ def render_intensity(
     progress: bool = False,
     keep_images_for: Iterable[int] | None = None,
     on_hits: Callable[..., None] | None = None,
+    solar_disk: bool = False,
 ) -> RenderResult:
     """Radiant intensity of a sunlit target toward an observer, per epoch and wavelength.
 
@@ -95,6 +96,12 @@ def render_intensity(
         each batch's primary ray cast with the batch's epoch indices (into the inputs), so
         that laser ranging (:mod:`speclight.render.ranging`) reuses the rays. It forces the
         in-process caster (``workers`` is ignored). Path mode ignores it.
+    solar_disk
+        Path mode: light with the finite solar disk (angular radius
+        :data:`~speclight.illumination.SOLAR_ANGULAR_RADIUS_RAD`, same total irradiance)
+        instead of a point Sun, so that smooth mirrors and smooth plastic coats show their
+        glint (a point Sun never reaches the observer through a mirror). Single mode always
+        models the glint with the disk and ignores it.
 
     Returns
     -------
@@ -190,6 +197,7 @@ def render_intensity(
                 int(seed),
                 keep_local,
                 on_epoch=advance,
+                solar_disk=bool(solar_disk),
             )
         intensity[valid] = inten
         std[valid] = err

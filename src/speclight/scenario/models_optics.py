@@ -230,6 +230,10 @@ class Laser(Strict):
 
 class Illumination(Strict):
     sun: bool = True
+    solar_disk: bool = Field(
+        default=False,
+        description="Path mode: the Sun as its 0.53 deg disk (for smooth mirror glints)",
+    )
     lasers: list[Laser] = Field(default_factory=list)
 
 

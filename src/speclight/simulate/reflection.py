@@ -86,6 +86,7 @@ def render_reflection(
             progress=progress,
             keep_images_for=keep or None,
             on_hits=None if on_hits is None else on_hits(idx),
+            solar_disk=sc.illumination.solar_disk,
         )
         scale = sunlit[idx, None]
         intensity[idx] = result.intensity_W_sr_nm * scale
