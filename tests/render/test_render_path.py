@@ -160,8 +160,9 @@ def test_white_concave_target_returns_all_intercepted_light_in_path_mode():
 def test_path_smooth_plastic_plate_diffuse_base():
     # Off the glint a smooth-coated plastic plate shows its base:
     # I = rho_d (1 - F_i)(1 - F_o) / (eta^2 pi (1 - F_dr,int)) E A cos(theta_i) cos(theta_o)
-    # (Weidlich & Wilkie 2007). Path mode gives Mitsuba one real coat index, each wavelength group's own n of
-    # fused silica over 500-700 nm (n varies by 0.3 % there, changing I by < 0.1 %).
+    # (Weidlich & Wilkie 2007). Path mode gives Mitsuba a real coat index per group of
+    # wavelength bins (render/path_plastic.py); n of fused silica varies by 0.3 % over
+    # 500-700 nm, changing I by < 0.1 %.
     from speclight.target import plate, refractive_index
 
     rho_d = 0.6
