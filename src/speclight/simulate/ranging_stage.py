@@ -39,9 +39,9 @@ from speclight import atmosphere, instrument, orbit
 from speclight.errors import InputError
 from speclight.illumination import laser as lz
 from speclight.illumination.solar import bin_edges_nm
+from speclight.instrument.photometry import photon_kernel
 from speclight.orbit.timescale import time_from_utc
 from speclight.ranging import band_histograms, transmitter_geometry
-from speclight.ranging.link import C_M_S, H_J_S
 from speclight.render.path import MAX_DEPTH as PATH_MAX_DEPTH
 from speclight.render.ranging import LaserLight, RangingAccumulator
 from speclight.scenario import LoadedScenario
@@ -319,13 +319,13 @@ def laser_ranging(
         area = instrument.aperture_area_m2(
             sc.telescope.aperture_diameter_m, sc.telescope.obstruction_diameter_m
         )
-        # electrons per joule per bin x width (B, L), as instrument.photometry.photon_kernel
-        # but with the per-band detector QE the pipeline uses
-        kernel = (
-            radiometry.band_response
-            * radiometry.optics[None, :]
-            * np.broadcast_to(radiometry.qe, radiometry.band_response.shape)
-            * (wavelength_nm * 1e-9 / (H_J_S * C_M_S) * instrument.bin_widths_nm(wavelength_nm))
+        # electrons per joule per bin x width (B, L); each band's own detector QE is folded
+        # into its response, as for the Sun's count rates (simulate/radiometry.py)
+        kernel = photon_kernel(
+            wavelength_nm,
+            radiometry.optics,
+            np.ones(n_wl),
+            radiometry.band_response * radiometry.qe,
         )
     for k, laser in enumerate(setup.lasers):
         sup = laser.light.support
