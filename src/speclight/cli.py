@@ -57,7 +57,7 @@ def simulate(
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing output.")] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")] = False,
 ) -> None:
-    """Run one scenario and write the dataset (SPEC section 4) to OUTPUT."""
+    """Run one scenario and write its NetCDF dataset (geometry, spectra, bands) to OUTPUT."""
 
     def run() -> None:
         from speclight.io.netcdf import check_writable, write_dataset
@@ -121,8 +121,8 @@ def plot(
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Overwrite existing figures.")] = False,
 ) -> None:
-    """Plot a dataset: OUTPUT is the overview (light curves, spectrogram, geometry); the
-    chain, images and ranging figures go beside it (OUTPUT-chain.png, ...)."""
+    """Plot a dataset: light curves, spectrogram and geometry in OUTPUT; the one-epoch chain,
+    images and ranging figures beside it (OUTPUT-chain.png, ...)."""
 
     def run() -> None:
         from speclight.plot import plot_files
