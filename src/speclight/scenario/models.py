@@ -61,6 +61,10 @@ class Observer(Strict):
         default=10.0, ge=-90, le=90, description="Epochs below this elevation are flagged [deg]"
     )
     refraction: bool = Field(default=False, description="Apply atmospheric refraction to elevation")
+    light_time: bool = Field(
+        default=True,
+        description="Place the target where it was when the received light left it",
+    )
     temperature_C: float = Field(default=10.0, ge=-80, le=60)
     pressure_mbar: float | None = Field(
         default=None, ge=0, le=1100, description="Site pressure; default from the altitude [mbar]"
