@@ -152,3 +152,56 @@ def test_stage_errors_name_the_scenario_file(tmp_path: Path) -> None:
     result = runner.invoke(app, ["simulate", str(path), "-o", str(tmp_path / "o.nc")])
     assert result.exit_code == 2
     assert f"{path}: render.variant: render variant 'llvm_ad_foo' is not available" in result.stderr
+
+
+CUBE_OBJ = """# a unit cube in two groups: the top face and the rest
+v -0.5 -0.5 -0.5
+v 0.5 -0.5 -0.5
+v 0.5 0.5 -0.5
+v -0.5 0.5 -0.5
+v -0.5 -0.5 0.5
+v 0.5 -0.5 0.5
+v 0.5 0.5 0.5
+v -0.5 0.5 0.5
+g top
+f 5 6 7 8
+g sides
+f 1 4 3 2
+f 1 2 6 5
+f 2 3 7 6
+f 3 4 8 7
+f 4 1 5 8
+"""
+
+
+def _mesh_scenario(tmp_path: Path, materials: dict[str, object]) -> Path:
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "cube.obj").write_text(CUBE_OBJ)
+    data = yaml.safe_load(example_text("calsphere"))
+    data["time"].update(start="2020-02-29T21:16:00Z", stop="2020-02-29T21:17:00Z", step_s=30.0)
+    data["target"] = {"shape": {"mesh_file": "meshes/cube.obj"}, "materials": materials}
+    data["render"]["resolution_px"] = 64
+    path = tmp_path / "cube.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def test_mesh_target_relative_to_the_scenario_file(tmp_path: Path) -> None:
+    lambert = {"bsdf": "lambertian", "reflectance": 0.5}
+    scenario = _mesh_scenario(tmp_path, {"top": lambert, "sides": lambert})
+    out = tmp_path / "cube.nc"
+    # run from another folder: the mesh path is relative to the scenario file
+    result = runner.invoke(app, ["simulate", str(scenario), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    intensity = xr.open_dataset(out)["intensity"].values
+    assert np.all(intensity[np.isfinite(intensity)] >= 0) and np.nanmax(intensity) > 0
+
+
+def test_material_for_a_missing_part_lists_the_parts(tmp_path: Path) -> None:
+    lambert = {"bsdf": "lambertian", "reflectance": 0.5}
+    scenario = _mesh_scenario(tmp_path, {"top": lambert, "side": lambert})
+    out = tmp_path / "cube.nc"
+    result = runner.invoke(app, ["simulate", str(scenario), "-o", str(out)])
+    assert result.exit_code == 2
+    assert "side" in result.stderr and "sides" in result.stderr and "top" in result.stderr
+    assert not out.exists()
