@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -83,6 +84,7 @@ def render_reflection(
             samples_per_pixel=sc.render.samples_per_pixel,
             seed=sc.render.seed,
             variant=sc.render.variant,
+            workers=os.cpu_count(),  # used by the numpy fallback; Dr.Jit uses all cores itself
             progress=progress,
             keep_images_for=keep or None,
             on_hits=None if on_hits is None else on_hits(idx),
