@@ -205,3 +205,25 @@ def test_material_for_a_missing_part_lists_the_parts(tmp_path: Path) -> None:
     assert result.exit_code == 2
     assert "side" in result.stderr and "sides" in result.stderr and "top" in result.stderr
     assert not out.exists()
+
+
+def test_without_libllvm_it_falls_back_with_a_one_line_notice(tmp_path: Path) -> None:
+    # A fresh process in which no libLLVM 16-19 is found (as on a machine without libllvm19):
+    # the run must succeed on the scalar/numpy path and say so in one line.
+    scenario = _short_scenario(
+        tmp_path, start="2020-02-29T21:16:00Z", stop="2020-02-29T21:17:00Z", step_s=30.0
+    )
+    code = (
+        "import sys\n"
+        "import speclight.render.variant as v\n"
+        "v.find_libllvm = lambda: None\n"
+        "from speclight.cli import main\n"
+        f"sys.argv = ['speclight', 'simulate', {str(scenario)!r}, '-o', "
+        f"{str(tmp_path / 'o.nc')!r}, '-q']\n"
+        "main()\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    lines = [line for line in run.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("notice: no CUDA GPU and no libLLVM 16-19")
+    assert xr.open_dataset(tmp_path / "o.nc").attrs["render_variant"] in ("numpy", "scalar_rgb")

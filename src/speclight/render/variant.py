@@ -15,6 +15,8 @@ import os
 import re
 import sys
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from functools import lru_cache
 from types import ModuleType
 
@@ -67,6 +69,20 @@ def mitsuba_installed() -> bool:
     )
 
 
+@contextmanager
+def _stderr_silenced() -> Iterator[None]:
+    """Silence file descriptor 2 (messages printed by native libraries) for a moment."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    try:
+        with open(os.devnull, "w") as devnull:
+            os.dup2(devnull.fileno(), 2)
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
 @lru_cache(maxsize=1)
 def _backends() -> tuple[bool, bool]:
     """(cuda works, llvm works), probed once; sets DRJIT_LIBLLVM_PATH before importing drjit."""
@@ -77,8 +93,11 @@ def _backends() -> tuple[bool, bool]:
         if llvm_path:
             os.environ["DRJIT_LIBLLVM_PATH"] = llvm_path
         else:
-            # Hide any unusable libLLVM (e.g. 15) so Dr.Jit does not pick it up.
+            # Hide any unusable libLLVM (e.g. 15) so Dr.Jit does not pick it up; Dr.Jit then
+            # reports the missing library on stderr, which the caller's notice replaces.
             os.environ["DRJIT_LIBLLVM_PATH"] = "/nonexistent/libLLVM.so"
+            with _stderr_silenced():
+                import drjit  # noqa: F401
     import drjit as dr
 
     cuda = bool(dr.has_backend(dr.JitBackend.CUDA))
