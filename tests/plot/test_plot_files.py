@@ -124,3 +124,36 @@ def test_plot_dataset_returns_a_figure_marking_image_epochs():
     lines = fig.axes[0].get_lines()
     marked = {np.datetime64(x.get_xdata()[0], "ns") for x in lines if x.get_linestyle() == ":"}
     assert marked == set(ds["time"].values[list(IMAGE_EPOCHS)])
+
+
+def test_images_figure_shows_the_named_parts() -> None:
+    # A 2 x 2 image whose pixels see parts 0 and 1 ("bus", "wing") or nothing.
+    import xarray as xr
+
+    from speclight.plot.images import images_figure, part_names
+
+    ds = xr.Dataset(
+        {
+            "image_radiance": (("image_time", "y", "x", "wavelength"), np.ones((1, 2, 2, 2))),
+            "image_depth": (("image_time", "y", "x"), np.array([[[0.1, np.nan], [0.2, 0.3]]])),
+            "image_part": (
+                ("image_time", "y", "x"),
+                np.array([[[0, -1], [1, 1]]], dtype=np.int16),
+                {"flag_values": np.array([0, 1]), "flag_meanings": "bus wing"},
+            ),
+            "image_pixel_size": (("image_time",), [0.5]),
+            "range": (("time",), [1e6]),
+            "elevation": (("time",), [45.0]),
+            "phase_angle": (("time",), [30.0]),
+            "sunlit": (("time",), [1.0]),
+        },
+        coords={
+            "time": np.array(["2020-01-01T00:00:00"], dtype="datetime64[ns]"),
+            "image_time": np.array(["2020-01-01T00:00:00"], dtype="datetime64[ns]"),
+            "wavelength": [500.0, 505.0],
+        },
+    )
+    assert part_names(ds) == ["bus", "wing"]
+    fig = images_figure(ds, None)
+    labels = [t.get_text() for ax in fig.axes for t in ax.get_yticklabels()]
+    assert "bus" in labels and "wing" in labels

@@ -103,6 +103,8 @@ def test_saved_images_integrate_to_the_intensity(tmp_path) -> None:
     pixel_area = ds["image_pixel_size"].values[:, None] ** 2
     summed = ds["image_radiance"].sum(dim=("y", "x")).values * pixel_area
     np.testing.assert_allclose(summed, ds["intensity"].values[[3, 5]], rtol=1e-5)
+    assert ds["image_part"].attrs["flag_meanings"] == "body"  # the sphere's one part
+    np.testing.assert_array_equal(np.isfinite(ds["image_depth"].values), ds["image_part"] == 0)
     depth = ds["image_depth"].values
     on_target = np.isfinite(depth)
     # the sphere's visible surface lies within one radius in front of its centre

@@ -31,8 +31,39 @@ def _on_target(ds: xr.Dataset, k: int, img: NDArray[np.float64]) -> NDArray[np.b
     return np.asarray(img > 0)
 
 
+def part_names(ds: xr.Dataset) -> list[str]:
+    """Names of the target's parts, index order (from ``image_part``'s ``flag_meanings``)."""
+    if "image_part" not in ds:
+        return []
+    return str(ds["image_part"].attrs.get("flag_meanings", "")).split()
+
+
+def _draw_parts(fig: Any, ax: Any, ds: xr.Dataset, k: int) -> str:
+    """Categorical map of the part seen in each pixel, with the part names on the colour bar."""
+    from matplotlib import colormaps
+    from matplotlib.colors import BoundaryNorm
+
+    names = part_names(ds)
+    parts = np.asarray(ds["image_part"].isel(image_time=k).values, dtype=float)
+    parts[parts < 0] = np.nan
+    cmap = colormaps["tab10"].resampled(max(len(names), 1)).with_extremes(bad="0.85")
+    norm = BoundaryNorm(np.arange(len(names) + 1) - 0.5, cmap.N)
+    im = ax.imshow(
+        np.ma.masked_invalid(parts),
+        cmap=cmap,
+        norm=norm,
+        interpolation="nearest",
+        extent=_extent_m(ds, k, *parts.shape),
+        origin="upper",
+    )
+    bar = fig.colorbar(im, ax=ax, ticks=np.arange(len(names)), shrink=0.85)
+    bar.ax.set_yticklabels(names, fontsize="small")
+    return "part seen (grey: off target)"
+
+
 def images_figure(ds: xr.Dataset, band: str | None) -> Any:
-    """One row per saved epoch: radiance in ``band`` (or the whole grid) and depth map.
+    """One row per saved epoch: radiance in ``band`` (or the whole grid), depth map, and the
+    part seen in each pixel (when the dataset names the parts).
 
     Pixel row 0 is the top of the image (the renderer's convention); axes are metres at
     the target, right and up as seen by the observer.
@@ -43,6 +74,8 @@ def images_figure(ds: xr.Dataset, band: str | None) -> Any:
     n = ds.sizes["image_time"]
     shown = min(n, MAX_IMAGE_ROWS)
     columns = [c for c in ("image_radiance", "image_depth") if c in ds]
+    if part_names(ds):
+        columns.append("image_part")
     fig = new_figure(height_in=0.8 + 3.6 * shown, width_in=4.6 * len(columns) + 0.6)
     axes = np.atleast_2d(fig.subplots(shown, len(columns), squeeze=False))
     image_epochs = np.atleast_1d(ds["image_time"].values)
@@ -50,6 +83,12 @@ def images_figure(ds: xr.Dataset, band: str | None) -> Any:
     for k in range(shown):
         i = int(np.argmin(np.abs(time - image_epochs[k])))
         for ax, col in zip(axes[k], columns, strict=True):
+            if col == "image_part":
+                what = _draw_parts(fig, ax, ds, k)
+                ax.set_title(f"{what}\n{epoch_summary(ds, i)}", fontsize="small")
+                ax.set_xlabel("right [m]")
+                ax.set_ylabel("up [m]")
+                continue
             if col == "image_radiance":
                 img = band_radiance(ds, k, band)
                 positive = img[np.isfinite(img) & (img > 0)]

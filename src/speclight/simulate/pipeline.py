@@ -97,7 +97,7 @@ def _simulate(loaded: LoadedScenario, progress: bool) -> SimulationResult:
         ranging = laser_ranging(loaded, geo, wavelength_nm, setup, transmission, radiometry)
     ds = geometry_dataset(geo)  # after rendering and ranging: they set flag bits
     ds = add_spectral(ds, wavelength_nm, reflection, transmission, radiometry)
-    ds = add_images(ds, reflection.images)
+    ds = add_images(ds, reflection.images, reflection.part_names)
     extra: dict[str, str] = {"render_mode": sc.render.mode, "atmosphere_model": sc.atmosphere.model}
     if reflection.variant:
         extra["render_variant"] = reflection.variant

@@ -39,6 +39,7 @@ class Reflection:
     intensity_std_W_sr_nm: F64 | None = None
     variant: str = ""
     images: dict[int, RenderImage] = field(default_factory=dict)
+    part_names: list[str] = field(default_factory=list)
 
 
 def render_reflection(
@@ -69,12 +70,15 @@ def render_reflection(
     idx = np.flatnonzero(lit)
     variant = ""
     images: dict[int, RenderImage] = {}
+    part_names: list[str] = []
     if idx.size:
         from speclight.render import render_intensity
 
         keep = [int(np.searchsorted(idx, i)) for i in sc.render.save_images_at if i in set(idx)]
+        target = build_target(loaded)
+        part_names = [part.name for part in target.parts]
         result = render_intensity(
-            build_target(loaded),
+            target,
             geo.sun_direction_body[idx],
             geo.observer_direction_body[idx],
             solar[idx],
@@ -102,4 +106,4 @@ def render_reflection(
         images = {int(idx[k]): image for k, image in result.images.items()}
         for epoch, image in images.items():  # penumbra: as the intensity
             image.radiance_W_m2_sr_nm = image.radiance_W_m2_sr_nm * sunlit[epoch]
-    return Reflection(solar, intensity, std, variant, images)
+    return Reflection(solar, intensity, std, variant, images, part_names)

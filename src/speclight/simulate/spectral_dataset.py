@@ -55,8 +55,11 @@ def add_spectral(
     return ds
 
 
-def add_images(ds: xr.Dataset, images: dict[int, RenderImage]) -> xr.Dataset:
-    """Add saved hyperspectral images and depth maps on an ``image_time`` dimension."""
+def add_images(ds: xr.Dataset, images: dict[int, RenderImage], part_names: list[str]) -> xr.Dataset:
+    """Add saved hyperspectral images and depth maps on an ``image_time`` dimension.
+
+    ``image_part`` carries the part names as CF ``flag_values`` / ``flag_meanings``.
+    """
     if not images:
         return ds
     epochs = sorted(images)
@@ -73,7 +76,11 @@ def add_images(ds: xr.Dataset, images: dict[int, RenderImage]) -> xr.Dataset:
     ds["image_part"] = (
         dims,
         np.stack([images[e].part_index for e in epochs]).astype(np.int16),
-        v.attrs("image_part"),
+        {
+            **v.attrs("image_part"),
+            "flag_values": np.arange(len(part_names), dtype=np.int16),
+            "flag_meanings": " ".join(name.replace(" ", "_") for name in part_names),
+        },
     )
     ds["image_pixel_size"] = (
         ("image_time",),
