@@ -31,14 +31,15 @@ def cached_arrays(
     kind: str,
     key: Mapping[str, Any],
     compute: Callable[[], dict[str, NDArray[Any]]],
+    root: Path | None = None,
 ) -> dict[str, NDArray[Any]]:
     """Return ``compute()``, from ``<cache>/<kind>/<hash of key>.npz`` when it is there.
 
     ``key`` must hold everything the result depends on (inputs, algorithm constants,
-    versions), as JSON-serialisable values.
+    versions), as JSON-serialisable values; ``root`` overrides the cache folder.
     """
     digest = hashlib.sha256(json.dumps(key, sort_keys=True, default=str).encode()).hexdigest()
-    path = cache_root() / kind / f"{digest[:32]}.npz"
+    path = cache_root(root) / kind / f"{digest[:32]}.npz"
     try:
         with np.load(path) as data:
             return {name: data[name] for name in data.files}

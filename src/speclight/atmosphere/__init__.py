@@ -12,8 +12,9 @@ from speclight.atmosphere.params import (
     AtmosphereModel,
     AtmosphereParams,
 )
-from speclight.atmosphere.sixs import SixSUnavailable, cache_root, sixs_executable
+from speclight.atmosphere.sixs import SixSUnavailable, sixs_executable
 from speclight.atmosphere.transmission import transmission
+from speclight.cache import cache_root
 
 __all__ = [
     "SIXS_AEROSOL_PROFILES",

