@@ -46,11 +46,18 @@ def info_report() -> dict[str, dict[str, str]]:
         "data coverage": data_coverage(),
     }
     try:
-        from speclight.render.variant import available_variants, choose_variant
+        from speclight.render.variant import (
+            available_variants,
+            choose_variant,
+            engine_versions,
+        )
 
+        variants = available_variants()
         report["render"] = {
-            "available variants": ", ".join(available_variants()) or "none",
+            "available variants": ", ".join(variants) or "none (numpy ray casting only)",
             "default variant": choose_variant(None),
+            "gpu (CUDA)": "yes" if any(v.startswith("cuda_") for v in variants) else "none",
+            "libLLVM": engine_versions()["libllvm"],
         }
     except ImportError as exc:  # rendering stage not installed
         report["render"] = {"status": f"unavailable ({exc})"}
