@@ -46,18 +46,14 @@ def info_report() -> dict[str, dict[str, str]]:
         "data coverage": data_coverage(),
     }
     try:
-        from speclight.render.variant import (
-            available_variants,
-            choose_variant,
-            engine_versions,
-        )
+        from speclight.render.variant import available_variants, choose_variant, find_libllvm
 
         variants = available_variants()
         report["render"] = {
             "available variants": ", ".join(variants) or "none (numpy ray casting only)",
             "default variant": choose_variant(None),
             "gpu (CUDA)": "yes" if any(v.startswith("cuda_") for v in variants) else "none",
-            "libLLVM": engine_versions()["libllvm"],
+            "libLLVM": find_libllvm() or "not found (LLVM variants unavailable)",
         }
     except ImportError as exc:  # rendering stage not installed
         report["render"] = {"status": f"unavailable ({exc})"}
