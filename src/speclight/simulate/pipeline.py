@@ -18,7 +18,7 @@ from speclight.simulate.radiometry import (
     wavelength_grid_nm,
 )
 from speclight.simulate.ranging_stage import laser_ranging, prepare_ranging
-from speclight.simulate.reflection import render_reflection
+from speclight.simulate.reflection import build_target, render_reflection
 from speclight.simulate.spectral_dataset import add_images, add_spectral
 
 
@@ -75,15 +75,18 @@ def simulate(loaded: LoadedScenario, progress: bool = False) -> SimulationResult
 
 def _simulate(loaded: LoadedScenario, progress: bool) -> SimulationResult:
     sc = loaded.scenario
+    target = build_target(loaded) if sc.target is not None else None  # once, and early
     geo = compute_geometry(loaded)
     wavelength_nm = wavelength_grid_nm(sc.spectrum)
-    setup = prepare_ranging(loaded, geo, wavelength_nm)  # None without lasers; sets flags
+    # None without lasers; sets flag bits
+    setup = prepare_ranging(loaded, geo, wavelength_nm, target=target)
     reflection = render_reflection(
         loaded,
         geo,
         wavelength_nm,
         progress=progress,
         on_hits=setup.on_hits_for if setup is not None else None,
+        target=target,
     )
     elevation = np.where(geo.observable, geo.elevation_deg, np.nan)
     transmission = atmosphere_transmission(loaded, wavelength_nm, elevation)

@@ -38,14 +38,23 @@ def wavelength_grid_nm(spectrum: Spectrum) -> F64:
     return np.asarray(spectrum.min_nm + spectrum.step_nm * np.arange(n), dtype=np.float64)
 
 
-def atmosphere_transmission(loaded: LoadedScenario, wavelength_nm: F64, elevation_deg: F64) -> F64:
-    """Direct-beam transmission (N, L) for the scenario's atmosphere model."""
+def atmosphere_params(loaded: LoadedScenario) -> dict[str, Any]:
+    """The scenario's parameters of its atmosphere model (paths resolved)."""
     cfg = loaded.scenario.atmosphere
     params: dict[str, Any] = {k: getattr(cfg, k) for k in _ATMOSPHERE_KEYS[cfg.model]}
     if "table_file" in params:
         params["table_file"] = loaded.resolve(params["table_file"])
+    return params
+
+
+def atmosphere_transmission(loaded: LoadedScenario, wavelength_nm: F64, elevation_deg: F64) -> F64:
+    """Direct-beam transmission (N, L) for the scenario's atmosphere model."""
     return atmosphere.transmission(
-        cfg.model, wavelength_nm, elevation_deg, loaded.scenario.observer.altitude_m, **params
+        loaded.scenario.atmosphere.model,
+        wavelength_nm,
+        elevation_deg,
+        loaded.scenario.observer.altitude_m,
+        **atmosphere_params(loaded),
     )
 
 

@@ -46,9 +46,10 @@ from speclight.render.path import MAX_DEPTH as PATH_MAX_DEPTH
 from speclight.render.ranging import LaserLight, RangingAccumulator
 from speclight.scenario import LoadedScenario
 from speclight.simulate.geometry import Geometry
-from speclight.simulate.radiometry import _ATMOSPHERE_KEYS, Radiometry
+from speclight.simulate.radiometry import Radiometry, atmosphere_params
 from speclight.simulate.reflection import build_target
 from speclight.simulate.variables import FLAG_LASER_BELOW_HORIZON
+from speclight.target import Target
 
 F64 = NDArray[np.float64]
 #: Line-shape values below this fraction of the peak are outside the laser's support.
@@ -89,14 +90,6 @@ class RangingSetup:
         return call
 
 
-def _atmosphere_params(loaded: LoadedScenario) -> dict[str, Any]:
-    cfg = loaded.scenario.atmosphere
-    params: dict[str, Any] = {k: getattr(cfg, k) for k in _ATMOSPHERE_KEYS[cfg.model]}
-    if "table_file" in params:
-        params["table_file"] = loaded.resolve(params["table_file"])
-    return params
-
-
 def _line_shape(loaded: LoadedScenario, cfg: Any, wl: F64, where: str) -> F64:
     if cfg.spectrum_file:
         x, y = lz.read_laser_spectrum(loaded.resolve(cfg.spectrum_file))
@@ -117,22 +110,19 @@ def _line_shape(loaded: LoadedScenario, cfg: Any, wl: F64, where: str) -> F64:
 def _laser(loaded: LoadedScenario, geo: Geometry, wl: F64, k: int, t: Any) -> LaserSetup:
     cfg = loaded.scenario.illumination.lasers[k]
     where = f"illumination.lasers[{k}]"
-    try:
-        power = lz.check_power_w(cfg.power_w, field=f"{where}.power_w")
-        rate = lz.check_repetition_rate_hz(cfg.repetition_rate_hz, f"{where}.repetition_rate_hz")
-        theta = lz.check_divergence_arcsec(
-            cfg.divergence_arcsec, cfg.wavelength_nm, f"{where}.divergence_arcsec"
-        )
-    except InputError as err:
-        raise InputError(err.message, source=loaded.source, field=err.field) from None
+    # (simulate() prefixes the scenario file to these messages)
+    power = lz.check_power_w(cfg.power_w, field=f"{where}.power_w")
+    rate = lz.check_repetition_rate_hz(cfg.repetition_rate_hz, f"{where}.repetition_rate_hz")
+    theta = lz.check_divergence_arcsec(
+        cfg.divergence_arcsec, cfg.wavelength_nm, f"{where}.divergence_arcsec"
+    )
     site = orbit.Site(cfg.latitude_deg, cfg.longitude_deg, cfg.altitude_m)
     tx = transmitter_geometry(site, t, geo.r_target_gcrs_m, geo.quaternion_body_to_gcrs)
-    min_el = float(getattr(cfg, "min_elevation_deg", 0.0) or 0.0)
+    min_el = cfg.min_elevation_deg
     with np.errstate(invalid="ignore"):
         up = geo.orbit_ok & (tx.elevation_deg > min_el)
-    offset = float(getattr(cfg, "pointing_offset_arcsec", 0.0) or 0.0) * lz.ARCSEC_RAD
-    profile: lz.BeamProfile = getattr(cfg, "beam_profile", "gaussian") or "gaussian"
-    beam = lz.beam_irradiance_W_m2(power, theta, tx.range_m, offset, profile)
+    offset = cfg.pointing_offset_arcsec * lz.ARCSEC_RAD
+    beam = lz.beam_irradiance_W_m2(power, theta, tx.range_m, offset, cfg.beam_profile)
     shape = _line_shape(loaded, cfg, wl, where)
     support = np.flatnonzero(shape > SUPPORT_THRESHOLD * shape.max())
     elev = np.where(up, tx.elevation_deg, np.nan)
@@ -143,7 +133,7 @@ def _laser(loaded: LoadedScenario, geo: Geometry, wl: F64, k: int, t: Any) -> La
             wl,
             elev[up],
             cfg.altitude_m,
-            **_atmosphere_params(loaded),
+            **atmosphere_params(loaded),
         )
         t_up[up] = full[:, support]
     spectral = np.where(up[:, None], beam[:, None] * shape[support][None, :] * t_up, 0.0)
@@ -162,9 +152,15 @@ def _laser(loaded: LoadedScenario, geo: Geometry, wl: F64, k: int, t: Any) -> La
 
 
 def prepare_ranging(
-    loaded: LoadedScenario, geo: Geometry, wavelength_nm: F64, range_bins: int = RANGE_BINS
+    loaded: LoadedScenario,
+    geo: Geometry,
+    wavelength_nm: F64,
+    range_bins: int = RANGE_BINS,
+    target: Target | None = None,
 ) -> RangingSetup | None:
     """Lasers' geometry and irradiance, and the accumulator; ``None`` without lasers/target.
+
+    ``target``: the scenario's target if already built (else it is built here).
 
     Sets :data:`FLAG_LASER_BELOW_HORIZON` in ``geo.flags`` where a laser is below its horizon.
     """
@@ -175,7 +171,8 @@ def prepare_ranging(
     lasers = [_laser(loaded, geo, wavelength_nm, k, t) for k in range(len(sc.illumination.lasers))]
     for laser in lasers:
         geo.flags[geo.orbit_ok & ~laser.above_horizon] |= FLAG_LASER_BELOW_HORIZON
-    target = build_target(loaded)
+    if target is None:
+        target = build_target(loaded)
     obs = np.where(geo.observable[:, None], geo.observer_direction_body, np.nan)
     com = np.zeros(3)
     centre, radius = target.bounding_sphere()
@@ -192,7 +189,7 @@ def prepare_ranging(
         wavelength_nm,
         edges,
         com,
-        max_depth=int(getattr(sc.render, "max_depth", PATH_MAX_DEPTH)) if path else 2,
+        max_depth=PATH_MAX_DEPTH if path else 2,
         samples_per_pixel=sc.render.samples_per_pixel,
         seed=sc.render.seed,
     )

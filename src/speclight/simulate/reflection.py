@@ -48,12 +48,14 @@ def render_reflection(
     wavelength_nm: F64,
     progress: bool = False,
     on_hits: Callable[[NDArray[np.int64]], Callable[..., None]] | None = None,
+    target: Target | None = None,
 ) -> Reflection:
     """Render the sunlit, observable epochs; unlit epochs get 0, unobservable ones NaN.
 
     Epochs in the Earth's penumbra are rendered with the full Sun and scaled by the visible
     fraction of the solar disk. ``on_hits(epochs)`` gives a callback that sees the render's
-    primary ray hits (laser ranging reuses them).
+    primary ray hits (laser ranging reuses them). ``target``: the scenario's target if
+    already built (else it is built here).
     """
     sc = loaded.scenario
     solar = solar_irradiance_W_m2_nm(wavelength_nm, geo.sun_distance_m / AU_M)
@@ -75,7 +77,8 @@ def render_reflection(
         from speclight.render import render_intensity
 
         keep = [int(np.searchsorted(idx, i)) for i in sc.render.save_images_at if i in set(idx)]
-        target = build_target(loaded)
+        if target is None:
+            target = build_target(loaded)
         part_names = [part.name for part in target.parts]
         result = render_intensity(
             target,
