@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -68,26 +70,29 @@ def time_grid(grid: TimeGrid) -> NDArray[np.datetime64]:
     return start + offsets_ns
 
 
-def _target_positions(
-    loaded: LoadedScenario, t: object, time_utc: NDArray[np.datetime64]
-) -> tuple[NDArray, NDArray]:
+Trajectory = Callable[[Any], tuple[NDArray[np.float64], NDArray[np.bool_]]]
+
+
+def _trajectory(loaded: LoadedScenario, time_utc: NDArray[np.datetime64]) -> Trajectory:
+    """Read the orbit source once; return ``t -> (r_gcrs_m (N, 3), ok (N,))``."""
     cfg = loaded.scenario.orbit
-    if cfg.tle is not None:
-        tle = orbit.parse_tle(cfg.tle, source=f"{loaded.source}: orbit.tle")
-        return orbit.tle_position_gcrs_m(tle, t)
-    if cfg.tle_file is not None:
-        # of several element sets of the object, the one nearest the middle of the window
-        middle = time_utc[0] + (time_utc[-1] - time_utc[0]) / 2
-        tle = orbit.read_tle_file(
-            loaded.resolve(cfg.tle_file), norad_id=cfg.norad_id, near_epoch=middle
-        )
-        return orbit.tle_position_gcrs_m(tle, t)
+    if cfg.tle is not None or cfg.tle_file is not None:
+        if cfg.tle is not None:
+            tle = orbit.parse_tle(cfg.tle, source=f"{loaded.source}: orbit.tle")
+        else:
+            assert cfg.tle_file is not None
+            # of several element sets of the object, the one nearest the middle of the window
+            middle = time_utc[0] + (time_utc[-1] - time_utc[0]) / 2
+            tle = orbit.read_tle_file(
+                loaded.resolve(cfg.tle_file), norad_id=cfg.norad_id, near_epoch=middle
+            )
+        return lambda t: orbit.tle_position_gcrs_m(tle, t)
     if cfg.cpf_file is not None:
         cpf = orbit.read_cpf(loaded.resolve(cfg.cpf_file))
-        return orbit.cpf_position_gcrs_m(cpf, t)
+        return lambda t: orbit.cpf_position_gcrs_m(cpf, t)
     assert cfg.ephemeris_file is not None
     eph = orbit.read_ephemeris_csv(loaded.resolve(cfg.ephemeris_file))
-    return orbit.ephemeris_position_gcrs_m(eph, t)
+    return lambda t: orbit.ephemeris_position_gcrs_m(eph, t)
 
 
 def _orientation(o: AxesOrientation) -> NDArray[np.float64]:
@@ -129,7 +134,7 @@ LIGHT_TIME_ITERATIONS = 2
 
 
 def _at_emission(
-    loaded: LoadedScenario,
+    trajectory: Trajectory,
     time_utc: NDArray[np.datetime64],
     r_target: NDArray[np.float64],
     ok: NDArray[np.bool_],
@@ -148,7 +153,7 @@ def _at_emission(
     for _ in range(LIGHT_TIME_ITERATIONS):
         tau_s = np.nan_to_num(np.linalg.norm(r_target - r_site, axis=1) / C_M_S)
         emitted = time_utc - np.rint(tau_s * 1e9).astype("timedelta64[ns]")
-        r_target, ok_emit = _target_positions(loaded, time_from_utc(emitted), emitted)
+        r_target, ok_emit = trajectory(time_from_utc(emitted))
         ok = ok & ok_emit
     tau_s = np.linalg.norm(r_target - r_site, axis=1) / C_M_S
     return r_target, ok, np.nan_to_num(tau_s)
@@ -161,10 +166,11 @@ def compute_geometry(loaded: LoadedScenario) -> Geometry:
     t = time_from_utc(time_utc)
     t_s = (time_utc - time_utc[0]) / np.timedelta64(1, "s")
     site = orbit.Site(sc.observer.latitude_deg, sc.observer.longitude_deg, sc.observer.altitude_m)
-    r_target, ok = _target_positions(loaded, t, time_utc)
+    trajectory = _trajectory(loaded, time_utc)
+    r_target, ok = trajectory(t)
     delay_s = np.zeros(t_s.size)
     if sc.observer.light_time:
-        r_target, ok, delay_s = _at_emission(loaded, time_utc, r_target, ok, site, t)
+        r_target, ok, delay_s = _at_emission(trajectory, time_utc, r_target, ok, site, t)
     geo = orbit.compute_geometry(
         t,
         r_target,
