@@ -135,6 +135,10 @@ def test_plot_writes_png_and_refuses_overwrite(tmp_path: Path) -> None:
     assert fig.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     again = runner.invoke(app, ["plot", str(out), "-o", str(fig)])
     assert again.exit_code == 2 and "--force" in again.stderr
+    other = tmp_path / "other.png"
+    bad_kind = runner.invoke(app, ["plot", str(out), "-o", str(other), "--kind", "chian"])
+    assert bad_kind.exit_code == 2 and "did you mean 'chain'" in bad_kind.stderr
+    assert not other.exists()
 
 
 def test_plot_rejects_a_file_that_is_not_a_dataset(tmp_path: Path) -> None:
