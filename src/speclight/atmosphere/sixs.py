@@ -29,7 +29,7 @@ from speclight.atmosphere.mapping import interpolate_in_airmass, log_transmissio
 from speclight.atmosphere.params import AtmosphereParams
 from speclight.cache import cached_arrays
 from speclight.errors import InputError, SpeclightError
-from speclight.instrument.grid import bin_edges_nm
+from speclight.wavelength_grid import bin_edges_nm
 
 #: Wavelength range of 6S [nm].
 SIXS_RANGE_NM = (250.0, 4000.0)

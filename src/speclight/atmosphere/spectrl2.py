@@ -10,7 +10,7 @@ from numpy.typing import NDArray
 from speclight.atmosphere.airmass import airmass, pressure_from_altitude
 from speclight.atmosphere.params import AtmosphereParams
 from speclight.errors import InputError
-from speclight.instrument.grid import bin_average
+from speclight.wavelength_grid import bin_average
 
 #: Wavelength range of SPECTRL2 [nm].
 SPECTRL2_RANGE_NM = (300.0, 4000.0)

@@ -29,8 +29,8 @@ from numpy.typing import NDArray
 from speclight.atmosphere.airmass import airmass
 from speclight.atmosphere.mapping import interpolate_in_airmass, log_transmission
 from speclight.errors import InputError
-from speclight.instrument.grid import bin_average
 from speclight.instrument.tables import read_table, sort_unique, value_to_fraction, wavelength_to_nm
+from speclight.wavelength_grid import bin_average
 
 FIELD = "atmosphere.table_file"
 _NUMBER = re.compile(r"[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?")

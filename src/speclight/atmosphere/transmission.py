@@ -13,7 +13,7 @@ from speclight.atmosphere.sixs import SixSUnavailable, sixs_transmission
 from speclight.atmosphere.spectrl2 import spectrl2_transmission
 from speclight.atmosphere.table import table_transmission
 from speclight.errors import InputError
-from speclight.instrument.grid import check_wavelength_grid
+from speclight.wavelength_grid import check_wavelength_grid
 
 
 def transmission(

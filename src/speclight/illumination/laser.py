@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.special import erf
 
 from speclight.errors import InputError
-from speclight.illumination.solar import bin_edges_nm
+from speclight.wavelength_grid import cumulative_integral, grid_bin_bounds_nm
 
 F64 = NDArray[np.float64]
 ARCSEC_RAD = float(np.pi / 180.0 / 3600.0)
@@ -160,7 +160,7 @@ def gaussian_line_per_nm(wavelength_nm: ArrayLike, center_nm: float, fwhm_nm: fl
     wl = np.asarray(wavelength_nm, dtype=float).ravel()
     if not (np.isfinite(fwhm_nm) and fwhm_nm > 0):
         raise InputError(f"linewidth_nm = {fwhm_nm!r} must be > 0", field="linewidth_nm")
-    lo, hi = bin_edges_nm(wl, 1.0 if wl.size == 1 else None)
+    lo, hi = grid_bin_bounds_nm(wl)
     sigma = fwhm_nm / (2.0 * np.sqrt(2.0 * np.log(2.0)))
     z = np.sqrt(2.0) * sigma
     cdf_hi = 0.5 * (1.0 + erf((hi - center_nm) / z))
@@ -183,17 +183,10 @@ def table_line_per_nm(wavelength_nm: ArrayLike, table_nm: ArrayLike, value: Arra
         raise InputError(
             "laser spectrum values must be finite, >= 0 and not all 0", field="spectrum_file"
         )
-    seg = np.concatenate([[0.0], np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(x))])
-
-    def cumulative(q: F64) -> F64:
-        qc = np.clip(q, x[0], x[-1])
-        j = np.clip(np.searchsorted(x, qc, side="right") - 1, 0, x.size - 2)
-        dx = qc - x[j]
-        slope = (y[j + 1] - y[j]) / (x[j + 1] - x[j])
-        return np.asarray(seg[j] + y[j] * dx + 0.5 * slope * dx * dx)
-
-    lo, hi = bin_edges_nm(wl, 1.0 if wl.size == 1 else None)
-    return np.asarray((cumulative(hi) - cumulative(lo)) / (hi - lo) / seg[-1])
+    lo, hi = grid_bin_bounds_nm(wl)
+    total = np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(x))[-1]  # the table's integral
+    cum_hi, cum_lo = cumulative_integral(x, y, hi), cumulative_integral(x, y, lo)
+    return np.asarray((cum_hi - cum_lo) / (hi - lo) / total)
 
 
 def read_laser_spectrum(path: str | Path) -> tuple[F64, F64]:
@@ -220,7 +213,7 @@ def read_laser_spectrum(path: str | Path) -> tuple[F64, F64]:
 def line_fraction_in_grid(shape_per_nm: F64, wavelength_nm: ArrayLike) -> float:
     """Fraction of the line's energy that falls inside the grid's bins."""
     wl = np.asarray(wavelength_nm, dtype=float).ravel()
-    lo, hi = bin_edges_nm(wl, 1.0 if wl.size == 1 else None)
+    lo, hi = grid_bin_bounds_nm(wl)
     return float(np.sum(shape_per_nm * (hi - lo)))
 
 

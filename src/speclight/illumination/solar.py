@@ -13,11 +13,13 @@ from importlib import resources
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from speclight.constants import AU_M, SUN_RADIUS_M
 from speclight.errors import InputError
+from speclight.wavelength_grid import bin_bounds_nm, cumulative_integral
 
-#: Mean angular radius of the solar disk seen from 1 AU [rad] (959.63 arcsec; IAU 2015
-#: nominal solar radius 695 700 km over 1 au = 149 597 870.7 km, doi:10.3847/0004-6256/152/2/41).
-SOLAR_ANGULAR_RADIUS_RAD = float(np.arcsin(695_700.0 / 149_597_870.7))
+#: Mean angular radius of the solar disk seen from 1 AU [rad] (959.63 arcsec): the nominal
+#: solar radius over 1 au (:mod:`speclight.constants`), the ratio taken in km.
+SOLAR_ANGULAR_RADIUS_RAD = float(np.arcsin((SUN_RADIUS_M / 1e3) / (AU_M / 1e3)))
 
 
 @lru_cache(maxsize=1)
@@ -31,41 +33,6 @@ def solar_table() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     )
     data = np.loadtxt(text.splitlines(), delimiter=",", comments="#", skiprows=3)
     return data[:, 0].copy(), data[:, 1].copy()
-
-
-def _cumulative(
-    x_nm: NDArray[np.float64], wl: NDArray[np.float64], e: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """Exact integral of the piecewise-linear table from its first node to ``x_nm``."""
-    seg = np.concatenate([[0.0], np.cumsum(0.5 * (e[1:] + e[:-1]) * np.diff(wl))])
-    j = np.clip(np.searchsorted(wl, x_nm, side="right") - 1, 0, len(wl) - 2)
-    dx = x_nm - wl[j]
-    slope = (e[j + 1] - e[j]) / (wl[j + 1] - wl[j])
-    return seg[j] + e[j] * dx + 0.5 * slope * dx * dx
-
-
-def bin_edges_nm(
-    wavelength_nm: NDArray[np.float64], bin_width_nm: ArrayLike | None = None
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Lower and upper edges [nm] of the bins centred on ``wavelength_nm``.
-
-    Without ``bin_width_nm`` the edges lie half-way between neighbouring centres (the outer
-    bins are symmetric about their centre); a single centre then needs an explicit width.
-    """
-    wl = np.asarray(wavelength_nm, dtype=float)
-    if bin_width_nm is not None:
-        width = np.broadcast_to(np.asarray(bin_width_nm, dtype=float), wl.shape)
-        if np.any(~(width > 0)):
-            raise InputError(f"bin_width_nm = {bin_width_nm!r} must be > 0", field="bin_width_nm")
-        return wl - 0.5 * width, wl + 0.5 * width
-    if wl.size < 2:
-        raise InputError(
-            "a single wavelength needs an explicit bin_width_nm > 0", field="bin_width_nm"
-        )
-    mid = 0.5 * (wl[1:] + wl[:-1])
-    lo = np.concatenate([[wl[0] - (mid[0] - wl[0])], mid])
-    hi = np.concatenate([mid, [wl[-1] + (wl[-1] - mid[-1])]])
-    return lo, hi
 
 
 def solar_irradiance_W_m2_nm(
@@ -104,14 +71,15 @@ def solar_irradiance_W_m2_nm(
             field="wavelength_nm",
         )
     table_wl, table_e = solar_table()
-    lo, hi = bin_edges_nm(wl, bin_width_nm)
+    lo, hi = bin_bounds_nm(wl, bin_width_nm)
     if lo[0] < table_wl[0] or hi[-1] > table_wl[-1]:
         raise InputError(
             f"wavelength bins {lo[0]:g}-{hi[-1]:g} nm leave the ASTM E490 table "
             f"({table_wl[0]:g}-{table_wl[-1]:g} nm); choose a grid inside it",
             field="wavelength_nm",
         )
-    mean = (_cumulative(hi, table_wl, table_e) - _cumulative(lo, table_wl, table_e)) / (hi - lo)
+    cum_hi = cumulative_integral(table_wl, table_e, hi)
+    mean = (cum_hi - cumulative_integral(table_wl, table_e, lo)) / (hi - lo)
     d = np.asarray(distance_au, dtype=float)
     if np.any(~(d > 0) & np.isfinite(d)):
         raise InputError(f"distance_au must be > 0, got {distance_au!r}", field="distance_au")

@@ -15,7 +15,6 @@ from speclight.instrument.bands import (
     table_band,
 )
 from speclight.instrument.curves import DETECTOR_PRESETS, load_preset, spectral_curve
-from speclight.instrument.grid import bin_average, bin_edges_nm, bin_widths_nm
 from speclight.instrument.noise import simulate_measurement, sky_count_rate_per_s
 from speclight.instrument.photometry import (
     AB_ZERO_W_M2_HZ,
@@ -24,6 +23,7 @@ from speclight.instrument.photometry import (
     count_rate_per_s,
 )
 from speclight.instrument.telescope import aperture_area_m2, spectral_flux_W_nm
+from speclight.wavelength_grid import bin_average, bin_edges_nm, bin_widths_nm
 
 __all__ = [
     "AB_ZERO_W_M2_HZ",

@@ -21,8 +21,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.special import ndtr
 
 from speclight.errors import InputError, did_you_mean
-from speclight.instrument.grid import bin_average, bin_edges_nm, check_wavelength_grid
 from speclight.instrument.tables import read_table, sort_unique, value_to_fraction, wavelength_to_nm
+from speclight.wavelength_grid import bin_average, bin_edges_nm, check_wavelength_grid
 
 #: A band must have at least this fraction of its integrated response on the grid.
 MIN_FRACTION_ON_GRID = 0.9

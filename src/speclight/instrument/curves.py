@@ -19,8 +19,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError, did_you_mean
-from speclight.instrument.grid import bin_average, check_wavelength_grid
 from speclight.instrument.tables import read_table, sort_unique, value_to_fraction, wavelength_to_nm
+from speclight.wavelength_grid import bin_average, check_wavelength_grid
 
 
 @dataclass(frozen=True)

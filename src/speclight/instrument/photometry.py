@@ -1,7 +1,7 @@
 """Detected photo-electron rates and AB magnitudes per band.
 
 Quadrature: every wavelength integral is a bin sum, sum_i f_i w_i, with w_i the widths of
-bins whose edges lie half-way between samples (:func:`~speclight.instrument.grid.bin_widths_nm`);
+bins whose edges lie half-way between samples (:func:`~speclight.wavelength_grid.bin_widths_nm`);
 each sample is the mean over its bin (6S and the tables are band-averaged over exactly
 these bins, Gaussian bands through the error function), so the bin sum is the integral of
 that piecewise-constant spectrum. On the default 5 nm grid it differs from the trapezoid
@@ -13,16 +13,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from speclight.constants import AB_ZERO_W_M2_HZ, C_M_S, H_J_S
 from speclight.errors import InputError
-from speclight.instrument.grid import bin_widths_nm, check_wavelength_grid
-
-#: Planck constant [J s] (SI 2019, exact).
-H_J_S = 6.62607015e-34
-#: Speed of light in vacuum [m s-1] (exact).
-C_M_S = 299792458.0
-#: AB magnitude zero point: flux density of a source of AB magnitude 0 [W m-2 Hz-1]
-#: (3631 Jy; Oke & Gunn 1983, ApJ 266, 713, doi:10.1086/160817).
-AB_ZERO_W_M2_HZ = 3631.0e-26
+from speclight.wavelength_grid import bin_widths_nm, check_wavelength_grid
 
 
 def ab_reference_W_m2_nm(wavelength_nm: ArrayLike) -> NDArray[np.float64]:

@@ -14,11 +14,11 @@ import numpy as np
 from numpy.typing import NDArray
 from skyfield.timelib import Time
 
+from speclight.constants import AU_M
 from speclight.orbit.frames import FAST_MIN_EPOCHS, TimeLike, as_time
 from speclight.orbit.interpolate import lagrange_interpolate
 from speclight.orbit.timescale import load_ephemeris, load_timescale
 
-AU_M = 149_597_870_700.0  # IAU 2012 Resolution B2
 SUN_GRID_STEP_DAYS = 1.0 / 24.0
 
 

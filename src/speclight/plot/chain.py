@@ -8,10 +8,10 @@ import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
+from speclight.constants import HC_J_M
 from speclight.plot.style import NOT_OBSERVABLE, band_styles, epoch_summary, flags, new_figure
 
 # Planck constant x speed of light [J m] (CODATA 2018, exact), for photons per joule.
-HC_J_M = 6.62607015e-34 * 299792458.0
 
 
 def _row(ds: xr.Dataset, name: str, i: int) -> NDArray[np.float64]:

@@ -24,9 +24,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from speclight.constants import C_M_S, H_J_S
+
 F64 = NDArray[np.float64]
-H_J_S = 6.62607015e-34
-C_M_S = 299_792_458.0
 
 
 def photons_from_intensity(

@@ -36,7 +36,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
-from speclight.illumination.solar import bin_edges_nm
 from speclight.render import models
 from speclight.render.camera import image_axes, primary_rays
 from speclight.render.path_plastic import base_for_mitsuba, group_bases, index_groups
@@ -46,6 +45,7 @@ from speclight.render.variant import activate
 from speclight.target.geometry import Target
 from speclight.target.materials import Material
 from speclight.target.reflectance import Reflectance
+from speclight.wavelength_grid import grid_bin_bounds_nm
 
 F64 = NDArray[np.float64]
 #: Longest path (number of bounces + 1) followed; Russian roulette starts after 5.
@@ -301,7 +301,7 @@ def render_path(
         )
     mi = activate(variant)
     # A single wavelength is rendered as a 1 nm wide bin around it.
-    lo, hi = bin_edges_nm(wavelength_nm, 1.0 if len(wavelength_nm) == 1 else None)
+    lo, hi = grid_bin_bounds_nm(wavelength_nm)
     width = hi - lo
     passes = max(1, min(MAX_PASSES, samples_per_pixel))
     spp = max(1, samples_per_pixel // passes)

@@ -8,10 +8,11 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from speclight.constants import AU_M
 from speclight.info import engine_versions
 from speclight.scenario import LoadedScenario
 from speclight.simulate import variables as v
-from speclight.simulate.geometry import AU_M, Geometry
+from speclight.simulate.geometry import Geometry
 
 
 def geometry_dataset(geo: Geometry) -> xr.Dataset:

@@ -11,6 +11,7 @@ from numpy.typing import NDArray
 
 from speclight import attitude as att
 from speclight import orbit
+from speclight.constants import C_M_S
 from speclight.errors import InputError
 from speclight.orbit.timescale import time_from_utc
 from speclight.scenario import LoadedScenario
@@ -22,8 +23,6 @@ from speclight.scenario.models import (
     TorqueFreeAttitude,
 )
 from speclight.simulate import variables as v
-
-AU_M = 149_597_870_700.0
 
 
 @dataclass
@@ -127,7 +126,6 @@ def attitude_quaternions(
     return q
 
 
-C_M_S = 299_792_458.0
 #: Fixed-point iterations of the light-time equation; each gains a factor v/c ~ 3e-5, so two
 #: leave < 1e-9 s (0.3 mm) for targets up to GEO.
 LIGHT_TIME_ITERATIONS = 2

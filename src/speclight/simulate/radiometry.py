@@ -12,6 +12,7 @@ from speclight import atmosphere, instrument
 from speclight.instrument.curves import DETECTOR_PRESETS
 from speclight.scenario import LoadedScenario
 from speclight.scenario.models_optics import ReflectanceFile, Spectrum
+from speclight.wavelength_grid import grid_from_range_nm
 
 F64 = NDArray[np.float64]
 
@@ -34,8 +35,7 @@ _ATMOSPHERE_KEYS: dict[str, tuple[str, ...]] = {
 
 def wavelength_grid_nm(spectrum: Spectrum) -> F64:
     """Bin centres from ``min_nm`` to ``max_nm`` (included when on the grid) [nm]."""
-    n = int(np.floor((spectrum.max_nm - spectrum.min_nm) / spectrum.step_nm + 1e-9)) + 1
-    return np.asarray(spectrum.min_nm + spectrum.step_nm * np.arange(n), dtype=np.float64)
+    return grid_from_range_nm(spectrum.min_nm, spectrum.max_nm, spectrum.step_nm)
 
 
 def atmosphere_params(loaded: LoadedScenario) -> dict[str, Any]:

@@ -38,7 +38,6 @@ from numpy.typing import NDArray
 from speclight import atmosphere, instrument, orbit
 from speclight.errors import InputError
 from speclight.illumination import laser as lz
-from speclight.illumination.solar import bin_edges_nm
 from speclight.instrument.photometry import photon_kernel
 from speclight.orbit.timescale import time_from_utc
 from speclight.ranging import band_histograms, transmitter_geometry
@@ -50,6 +49,7 @@ from speclight.simulate.radiometry import Radiometry, atmosphere_params
 from speclight.simulate.reflection import build_target
 from speclight.simulate.variables import FLAG_LASER_BELOW_HORIZON
 from speclight.target import Target
+from speclight.wavelength_grid import grid_bin_bounds_nm
 
 F64 = NDArray[np.float64]
 #: Line-shape values below this fraction of the peak are outside the laser's support.
@@ -137,7 +137,7 @@ def _laser(loaded: LoadedScenario, geo: Geometry, wl: F64, k: int, t: Any) -> La
         )
         t_up[up] = full[:, support]
     spectral = np.where(up[:, None], beam[:, None] * shape[support][None, :] * t_up, 0.0)
-    lo, hi = bin_edges_nm(wl, 1.0 if wl.size == 1 else None)
+    lo, hi = grid_bin_bounds_nm(wl)
     irradiance = np.where(geo.orbit_ok, spectral @ (hi - lo)[support], np.nan)
     direction = np.where(up[:, None], tx.direction_body, np.nan)
     return LaserSetup(

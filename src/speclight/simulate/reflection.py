@@ -9,11 +9,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from speclight.constants import AU_M
 from speclight.illumination import solar_irradiance_W_m2_nm
 from speclight.render.result import RenderImage
 from speclight.scenario import LoadedScenario
 from speclight.simulate import variables as v
-from speclight.simulate.geometry import AU_M, Geometry
+from speclight.simulate.geometry import Geometry
 from speclight.target import Target, target_from_spec
 
 F64 = NDArray[np.float64]

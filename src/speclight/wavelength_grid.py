@@ -4,7 +4,8 @@ speclight treats each wavelength sample as the mean over its bin, whose edges li
 between neighbouring samples (the outer bins extend half a step outward). Integrals over
 wavelength are bin sums, and tabulated curves are put on the grid by averaging their
 piecewise-linear interpolant exactly over each bin, so no narrow feature is missed or
-counted twice. The atmosphere models use the same helpers.
+counted twice. Every stage (illumination, render, atmosphere, instrument, ranging) uses
+these helpers; nothing else computes bin edges or integrates a table.
 """
 
 from __future__ import annotations
@@ -37,6 +38,12 @@ def check_wavelength_grid(wavelength_nm: ArrayLike) -> NDArray[np.float64]:
     return wl
 
 
+def grid_from_range_nm(min_nm: float, max_nm: float, step_nm: float) -> NDArray[np.float64]:
+    """Bin centres from ``min_nm`` to ``max_nm`` (included when on the grid) in ``step_nm`` [nm]."""
+    n = int(np.floor((max_nm - min_nm) / step_nm + 1e-9)) + 1
+    return np.asarray(min_nm + step_nm * np.arange(n), dtype=np.float64)
+
+
 def bin_edges_nm(wavelength_nm: ArrayLike) -> NDArray[np.float64]:
     """Bin edges [nm] (L+1,): mid-points between samples, outer bins symmetric."""
     wl = check_wavelength_grid(wavelength_nm)
@@ -49,8 +56,52 @@ def bin_widths_nm(wavelength_nm: ArrayLike) -> NDArray[np.float64]:
     return np.diff(bin_edges_nm(wavelength_nm))
 
 
-def _cumulative(x: NDArray[np.float64], y: NDArray[np.float64], at: NDArray[np.float64]) -> NDArray:
-    """Integral of the piecewise-linear (x, y) from x[0] to ``at`` (0 outside on the left)."""
+def bin_bounds_nm(
+    wavelength_nm: ArrayLike, bin_width_nm: ArrayLike | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Lower and upper edges [nm] (L,) and (L,) of the bins centred on ``wavelength_nm``.
+
+    Without ``bin_width_nm`` these are :func:`bin_edges_nm` (half-way between neighbouring
+    centres, the outer bins symmetric about their centre); a single centre then needs an
+    explicit width. With it, each bin is ``centre -+ width / 2``.
+    """
+    wl = np.asarray(wavelength_nm, dtype=float)
+    if bin_width_nm is not None:
+        width = np.broadcast_to(np.asarray(bin_width_nm, dtype=float), wl.shape)
+        if np.any(~(width > 0)):
+            raise InputError(f"bin_width_nm = {bin_width_nm!r} must be > 0", field="bin_width_nm")
+        return wl - 0.5 * width, wl + 0.5 * width
+    if wl.size < 2:
+        raise InputError(
+            "a single wavelength needs an explicit bin_width_nm > 0", field="bin_width_nm"
+        )
+    mid = 0.5 * (wl[1:] + wl[:-1])
+    lo = np.concatenate([[wl[0] - (mid[0] - wl[0])], mid])
+    hi = np.concatenate([mid, [wl[-1] + (wl[-1] - mid[-1])]])
+    return lo, hi
+
+
+#: Width given to a grid of a single wavelength [nm] (it is rendered as a 1 nm wide bin).
+SINGLE_BIN_WIDTH_NM = 1.0
+
+
+def grid_bin_bounds_nm(
+    wavelength_nm: ArrayLike,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`bin_bounds_nm` of a render grid: a single wavelength is a
+    :data:`SINGLE_BIN_WIDTH_NM` wide bin."""
+    wl = np.asarray(wavelength_nm, dtype=float).ravel()
+    return bin_bounds_nm(wl, SINGLE_BIN_WIDTH_NM if wl.size == 1 else None)
+
+
+def cumulative_integral(
+    x: NDArray[np.float64], y: NDArray[np.float64], at: ArrayLike
+) -> NDArray[np.float64]:
+    """Exact integral of the piecewise-linear (x, y) from x[0] to ``at``.
+
+    ``y`` may have leading axes (..., n). ``at`` is clipped to the table (the curve is 0 to
+    the left and the integral constant to the right of it).
+    """
     seg = 0.5 * (y[..., 1:] + y[..., :-1]) * np.diff(x)
     cum = np.concatenate((np.zeros((*y.shape[:-1], 1)), np.cumsum(seg, axis=-1)), axis=-1)
     a = np.clip(at, x[0], x[-1])
@@ -91,5 +142,5 @@ def bin_average(
         lo, hi = min(edges[0], x[0]) - 1.0, max(edges[-1], x[-1]) + 1.0
         x = np.concatenate(([lo], x, [hi]))
         yy = np.concatenate((yy[..., :1], yy, yy[..., -1:]), axis=-1)
-    cum = _cumulative(x, yy, edges)
+    cum = cumulative_integral(x, yy, edges)
     return np.diff(cum, axis=-1) / np.diff(edges)

@@ -1,0 +1,23 @@
+"""Physical and astronomical constants used by speclight, each with its source, in one place.
+
+All values are in SI units (the unit is part of every name).
+"""
+
+from __future__ import annotations
+
+#: Speed of light in vacuum [m s-1] (SI 2019, exact).
+C_M_S = 299_792_458.0
+#: Planck constant [J s] (SI 2019, exact).
+H_J_S = 6.62607015e-34
+#: Planck constant times the speed of light [J m] (a photon of wavelength lambda carries hc/lambda).
+HC_J_M = H_J_S * C_M_S
+#: Astronomical unit [m] (IAU 2012 Resolution B2, exact).
+AU_M = 149_597_870_700.0
+#: Nominal solar radius [m] (IAU 2015 Resolution B3; Prsa et al. 2016, AJ 152, 41,
+#: doi:10.3847/0004-6256/152/2/41).
+SUN_RADIUS_M = 695_700_000.0
+#: AB magnitude zero point: flux density of a source of AB magnitude 0 [W m-2 Hz-1]
+#: (3631 Jy; Oke & Gunn 1983, ApJ 266, 713, doi:10.1086/160817).
+AB_ZERO_W_M2_HZ = 3631.0e-26
+
+__all__ = ["AB_ZERO_W_M2_HZ", "AU_M", "C_M_S", "HC_J_M", "H_J_S", "SUN_RADIUS_M"]
