@@ -11,7 +11,7 @@ import time
 import yaml
 
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate.geometry import compute_geometry
+from speclight.simulate.geometry_stage import compute_geometry
 
 ATTITUDES = {
     "spin": {

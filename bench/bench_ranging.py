@@ -26,7 +26,7 @@ from speclight.illumination import solar_irradiance_W_m2_nm
 from speclight.render import render_intensity
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
-from speclight.simulate.geometry import AU_M, compute_geometry
+from speclight.simulate.geometry_stage import AU_M, compute_geometry
 from speclight.simulate.radiometry import (
     atmosphere_transmission,
     instrument_response,

@@ -16,7 +16,7 @@ from speclight.errors import InputError
 from speclight.render import render_intensity
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
-from speclight.simulate.geometry import compute_geometry
+from speclight.simulate.geometry_stage import compute_geometry
 from speclight.simulate.radiometry import (
     atmosphere_transmission,
     instrument_response,

@@ -2,7 +2,7 @@
 
 Reference: Mitsuba 3's ``path`` integrator (Jakob et al. 2022, https://mitsuba-renderer.org),
 an independent renderer, gives the radiant intensity of the target lit by the laser with and
-without interreflections; the range-resolved tracer of ``speclight.render.ranging_path`` must
+without interreflections; the range-resolved tracer of ``speclight.render.laser_multibounce`` must
 give the same multi-bounce intensity (the sum of its histogram) within the Monte Carlo errors.
 A convex body has no interreflection: there the multi-bounce result equals the exact
 single-scattering one.
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from speclight.render import available_variants, render_intensity
-from speclight.render.ranging import LaserLight, render_ranging
+from speclight.render.laser_returns import LaserLight, render_ranging
 from speclight.target import Material, Part, Reflectance, Target, sphere
 
 WL = np.array([530.0, 531.0, 532.0])

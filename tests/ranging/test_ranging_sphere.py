@@ -29,7 +29,7 @@ checks the laser's shadow rays (terminator) and direction handling.
 import numpy as np
 import pytest
 
-from speclight.render.ranging import LaserLight, render_ranging
+from speclight.render.laser_returns import LaserLight, render_ranging
 from speclight.target import Material, Reflectance, sphere
 
 WL = np.array([530.0, 531.0, 532.0])

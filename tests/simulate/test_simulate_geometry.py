@@ -9,7 +9,7 @@ import yaml
 from speclight.errors import InputError
 from speclight.scenario import example_text, parse_scenario
 from speclight.simulate import simulate
-from speclight.simulate.geometry import time_grid
+from speclight.simulate.geometry_stage import time_grid
 
 
 def _scenario(name: str = "lcs1", **changes: object) -> str:

@@ -10,7 +10,7 @@ from speclight.orbit.cpf import Cpf, cpf_position_gcrs_m, read_cpf
 from speclight.orbit.cpf_write import format_cpf, write_cpf
 from speclight.orbit.ephemeris import Ephemeris, ephemeris_position_gcrs_m, read_ephemeris_csv
 from speclight.orbit.frames import EarthOrientation, as_time, earth_orientation
-from speclight.orbit.geometry import ObservationGeometry, compute_geometry
+from speclight.orbit.observation import ObservationGeometry, compute_geometry
 from speclight.orbit.observer import (
     Site,
     Topocentric,

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from speclight.plot.geometry import PANELS, geometry_panels
+from speclight.plot.geometry_panels import PANELS, geometry_panels
 from speclight.plot.lightcurve import count_rate_panel, magnitude_panel
 from speclight.plot.selection import has_bands, has_spectra
 from speclight.plot.spectrogram import spectrogram_panel

@@ -1,7 +1,7 @@
 """Ranging stage: laser transmitters' geometry, the laser-radar link and range histograms.
 
 Plain numpy arrays in and out; the rendering of laser light resolved in range lives in
-:mod:`speclight.render.ranging`, the pipeline glue in :mod:`speclight.simulate.ranging_stage`.
+:mod:`speclight.render.laser_returns`, the pipeline glue in :mod:`speclight.simulate.ranging_stage`.
 """
 
 from speclight.ranging.link import (

@@ -13,7 +13,7 @@ from speclight.render.raycast import Caster, MitsubaCaster, NumpyCaster
 from speclight.render.result import RenderResult
 from speclight.render.rgl import is_rgl
 from speclight.render.variant import choose_variant
-from speclight.target.geometry import Target
+from speclight.target.parts import Target
 
 RenderMode = Literal["single", "path"]
 MIN_RESOLUTION_PX = 8
@@ -94,7 +94,7 @@ def render_intensity(
     on_hits
         Single mode: ``on_hits(epochs, origin, direction, hits, caster)`` is called after
         each batch's primary ray cast with the batch's epoch indices (into the inputs), so
-        that laser ranging (:mod:`speclight.render.ranging`) reuses the rays. It forces the
+        that laser ranging (:mod:`speclight.render.laser_returns`) reuses the rays. It forces the
         in-process caster (``workers`` is ignored). Path mode ignores it.
     solar_disk
         Path mode: light with the finite solar disk (angular radius

@@ -36,14 +36,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
-from speclight.render import models
+from speclight.render import material_channels as channels
 from speclight.render.camera import image_axes, primary_rays
 from speclight.render.path_plastic import base_for_mitsuba, group_bases, index_groups
 from speclight.render.result import RenderImage
 from speclight.render.rgl import is_rgl, path_bsdf
 from speclight.render.variant import activate
-from speclight.target.geometry import Target
 from speclight.target.materials import Material
+from speclight.target.parts import Target
 from speclight.target.reflectance import Reflectance
 from speclight.wavelength_grid import grid_bin_bounds_nm
 
@@ -150,7 +150,7 @@ def _sun(lo: float, hi: float, solar_disk: bool) -> dict[str, Any]:
             "direction": [0.0, 0.0, -1.0],
             "irradiance": {**unit, "values": "1, 1"},
         }
-    radiance = 1.0 / (np.pi * models.sun_disk_sin2())
+    radiance = 1.0 / (np.pi * channels.sun_disk_sin2())
     return {
         "type": "sphere",
         "to_world": _sun_sphere_transform(np.zeros(3), 1.0, np.array([0.0, 0.0, 1.0])),
@@ -167,7 +167,7 @@ def _sun_sphere_transform(centre: F64, radius: float, sun: F64) -> Any:
 
     dist = SUN_DISTANCE_FACTOR * radius
     pos = centre + dist * np.asarray(sun, float)
-    r = dist * np.sqrt(models.sun_disk_sin2())
+    r = dist * np.sqrt(channels.sun_disk_sin2())
     return mi.ScalarTransform4f().translate(pos.tolist()) @ mi.ScalarTransform4f().scale([r, r, r])
 
 

@@ -15,7 +15,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.target.geometry import Target
+from speclight.target.parts import Target
 
 F64 = NDArray[np.float64]
 

@@ -3,7 +3,7 @@
 For each epoch an orthographic grid of rays (one per pixel centre) is cast along the line of
 sight; each hit is tested for shadow by a ray towards the Sun, and the BRDF is evaluated for
 the Sun and observer directions. Every model factorises into geometric weights times spectral
-factors (see :mod:`speclight.render.models`), so one ray cast per epoch gives all
+factors (see :mod:`speclight.render.material_channels`), so one ray cast per epoch gives all
 wavelengths, without noise in wavelength:
 
     I(lambda) = E(lambda) * sum_c w_c * R_c(lambda)      [W sr-1 nm-1]
@@ -26,11 +26,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.render import models
+from speclight.render import material_channels as channels
 from speclight.render.camera import image_axes, primary_rays
 from speclight.render.raycast import Caster
 from speclight.render.result import RenderImage
-from speclight.target.geometry import Target
+from speclight.target.parts import Target
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
@@ -52,8 +52,8 @@ class _Kept:
 class _Layout:
     """Channel layout: main channel m for material m, then a block per plastic or RGL material.
 
-    Blocks (:func:`speclight.render.models.block_size`) carry what does not factorise: K*K
-    channels of a plastic's diffuse base, one channel per wavelength node of an RGL file.
+    Blocks (:func:`speclight.render.material_channels.block_size`) carry what does not
+    factorise: K*K channels of a plastic's diffuse base, one channel per wavelength node of an RGL file.
     """
 
     def __init__(self, target: Target) -> None:
@@ -62,7 +62,7 @@ class _Layout:
         self.block: dict[int, int] = {}
         c = len(self.mats)
         for k, m in enumerate(self.mats):
-            extra = models.block_size(m)  # plastic base, RGL wavelength nodes
+            extra = channels.block_size(m)  # plastic base, RGL wavelength nodes
             if extra:
                 self.block[k] = c
                 c += extra
@@ -78,12 +78,12 @@ def _pixel_contributions(
         sel = np.flatnonzero(mat == k)
         if sel.size == 0:
             continue
-        w = models.main_weight(m, cos_i[sel], cos_o[sel], cos_h[sel], cos_d[sel], mirror_ok[sel])
+        w = channels.main_weight(m, cos_i[sel], cos_o[sel], cos_h[sel], cos_d[sel], mirror_ok[sel])
         rows.append(sel)
         chans.append(np.full(sel.size, k))
         weights.append(w)
         if k in layout.block:
-            r, c, bw = models.block_weights(m, cos_i[sel], cos_o[sel], cos_d[sel])
+            r, c, bw = channels.block_weights(m, cos_i[sel], cos_o[sel], cos_d[sel])
             rows.append(sel[r])
             chans.append(layout.block[k] + c)
             weights.append(bw)
@@ -107,7 +107,7 @@ def geometric_weights(
 
     ``on_hits(epochs, origin, direction, hits, caster)``, if given, is called after each
     batch's primary ray cast with the batch's epoch indices (so that other lights, e.g.
-    lasers for ranging, reuse the rays: :mod:`speclight.render.ranging`).
+    lasers for ranging, reuse the rays: :mod:`speclight.render.laser_returns`).
     """
     layout = _Layout(target)
     centre, radius = target.bounding_sphere()
@@ -142,7 +142,7 @@ def geometric_weights(
         cos_h = np.einsum("mk,mk->m", n[idx], half[e_idx])
         cos_d = np.einsum("mk,mk->m", s, half)[e_idx]
         mirror = 2.0 * cos_o[idx, None] * n[idx] - o[e_idx]
-        mirror_ok = (np.einsum("mk,mk->m", mirror, s[e_idx]) >= models.SUN_COS).astype(float)
+        mirror_ok = (np.einsum("mk,mk->m", mirror, s[e_idx]) >= channels.SUN_COS).astype(float)
         mat = layout.part_mat[hits.part[idx]]
         rows, chans, px_w = _pixel_contributions(
             layout, mat, cos_i[idx], cos_o[idx], cos_h, cos_d, mirror_ok
@@ -182,7 +182,7 @@ def render_single(
 ) -> tuple[F64, dict[int, RenderImage]]:
     """Intensity (N, L) [W sr-1 nm-1] of valid epochs and the kept images (see module doc)."""
     for m in target.materials:
-        if m.bsdf not in models.SUPPORTED:
+        if m.bsdf not in channels.SUPPORTED:
             raise NotImplementedError(f"bsdf '{m.bsdf}' is not supported in single mode")
     keep = list(keep)
     w, kept, pitch, layout = geometric_weights(
@@ -192,14 +192,14 @@ def render_single(
         caster,
         resolution_px,
         keep,
-        rays_per_batch=models.rays_per_batch(target.materials),
+        rays_per_batch=channels.rays_per_batch(target.materials),
         on_batch=on_batch,
         on_hits=on_hits,
     )
     cos_half = np.sqrt(np.clip(0.5 * (1.0 + np.einsum("nk,nk->n", sun_dir, obs_dir)), 0.0, 1.0))
     n_mat = len(layout.mats)
-    main = [models.main_factor(m, cos_half, wavelength_nm) for m in layout.mats]
-    blocks = {k: models.block_factor(layout.mats[k], wavelength_nm) for k in layout.block}
+    main = [channels.main_factor(m, cos_half, wavelength_nm) for m in layout.mats]
+    blocks = {k: channels.block_factor(layout.mats[k], wavelength_nm) for k in layout.block}
     total = sum(w[:, k, None] * main[k] for k in range(n_mat))
     for k, start in layout.block.items():
         total = total + w[:, start : start + blocks[k].shape[0]] @ blocks[k]

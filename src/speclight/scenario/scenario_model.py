@@ -4,8 +4,15 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from speclight.scenario.models import Attitude, Observer, Orbit, Strict, Telescope, TimeGrid
-from speclight.scenario.models_optics import (
+from speclight.scenario.sections_geometry import (
+    Attitude,
+    Observer,
+    Orbit,
+    Strict,
+    Telescope,
+    TimeGrid,
+)
+from speclight.scenario.sections_light import (
     Atmosphere,
     Illumination,
     Instrument,

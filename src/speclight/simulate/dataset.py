@@ -12,7 +12,7 @@ from speclight.constants import AU_M
 from speclight.info import engine_versions
 from speclight.scenario import LoadedScenario
 from speclight.simulate import variables as v
-from speclight.simulate.geometry import Geometry
+from speclight.simulate.geometry_stage import Geometry
 
 
 def geometry_dataset(geo: Geometry) -> xr.Dataset:

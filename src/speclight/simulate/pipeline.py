@@ -11,7 +11,7 @@ from speclight.errors import InputError
 from speclight.scenario import LoadedScenario
 from speclight.simulate import variables as v
 from speclight.simulate.dataset import geometry_dataset, global_attributes
-from speclight.simulate.geometry import Geometry, compute_geometry
+from speclight.simulate.geometry_stage import Geometry, compute_geometry
 from speclight.simulate.radiometry import (
     atmosphere_transmission,
     instrument_response,

@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 from speclight import atmosphere, instrument
 from speclight.instrument.curves import DETECTOR_PRESETS
 from speclight.scenario import LoadedScenario
-from speclight.scenario.models_optics import ReflectanceFile, Spectrum
+from speclight.scenario.sections_light import ReflectanceFile, Spectrum
 from speclight.wavelength_grid import grid_from_range_nm
 
 F64 = NDArray[np.float64]

@@ -12,12 +12,12 @@ Per laser and epoch: the transmitter's own range, elevation and body-frame direc
 (:mod:`speclight.ranging.transmitter`); the beam irradiance at the target from the full
 divergence and range (:mod:`speclight.illumination.laser`); the uplink transmission at the
 transmitter's elevation from its own altitude; the line shape on the grid. The target is
-rendered with each laser as light source (:mod:`speclight.render.ranging`), and the return is
+rendered with each laser as light source (:mod:`speclight.render.laser_returns`), and the return is
 carried to the receiver with the downlink transmission, aperture and band response
 (:mod:`speclight.ranging.link`). A laser below its transmitter's horizon contributes nothing at
 that epoch and sets :data:`FLAG_LASER_BELOW_HORIZON`; the run goes on. In ``render.mode: path``
 the interreflections are added at their full optical path length
-(:mod:`speclight.render.ranging_path`, Monte Carlo with ``render.samples_per_pixel`` and
+(:mod:`speclight.render.laser_multibounce`, Monte Carlo with ``render.samples_per_pixel`` and
 ``render.seed``); single mode is single scattering, exact.
 
 Optional laser fields read when the scenario model has them (defaults in brackets):
@@ -41,10 +41,10 @@ from speclight.illumination import laser as lz
 from speclight.instrument.photometry import photon_kernel
 from speclight.orbit.timescale import time_from_utc
 from speclight.ranging import band_histograms, transmitter_geometry
+from speclight.render.laser_returns import LaserLight, RangingAccumulator
 from speclight.render.path import MAX_DEPTH as PATH_MAX_DEPTH
-from speclight.render.ranging import LaserLight, RangingAccumulator
 from speclight.scenario import LoadedScenario
-from speclight.simulate.geometry import Geometry
+from speclight.simulate.geometry_stage import Geometry
 from speclight.simulate.radiometry import Radiometry, atmosphere_params
 from speclight.simulate.reflection import build_target
 from speclight.simulate.variables import FLAG_LASER_BELOW_HORIZON

@@ -14,7 +14,7 @@ from speclight.illumination import solar_irradiance_W_m2_nm
 from speclight.render.result import RenderImage
 from speclight.scenario import LoadedScenario
 from speclight.simulate import variables as v
-from speclight.simulate.geometry import Geometry
+from speclight.simulate.geometry_stage import Geometry
 from speclight.target import Target, target_from_spec
 
 F64 = NDArray[np.float64]

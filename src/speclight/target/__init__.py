@@ -1,6 +1,6 @@
 """Target stage: shapes, meshes, materials and spectral reflectances of the observed object."""
 
-from speclight.target.geometry import Part, Target, assign_materials
+from speclight.target.from_values import material_from_spec, reflectance_from_spec, target_from_spec
 from speclight.target.materials import BSDF_NAMES, BsdfName, Material
 from speclight.target.mesh_io import load_mesh
 from speclight.target.optical_constants import (
@@ -9,9 +9,9 @@ from speclight.target.optical_constants import (
     fresnel_reflectance,
     refractive_index,
 )
+from speclight.target.parts import Part, Target, assign_materials
 from speclight.target.reflectance import Reflectance
 from speclight.target.shapes import CUBE_FACES, box_wing, cube, cylinder, plate, sphere
-from speclight.target.spec import material_from_spec, reflectance_from_spec, target_from_spec
 
 __all__ = [
     "BSDF_NAMES",

@@ -14,8 +14,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
-from speclight.target.geometry import Part, Target, assign_materials
 from speclight.target.materials import Material
+from speclight.target.parts import Part, Target, assign_materials
 
 Mesh = tuple[NDArray[np.float64], NDArray[np.int64]]
 _PLY_TYPES = {

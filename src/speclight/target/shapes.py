@@ -1,6 +1,6 @@
 """Built-in target shapes: sphere, plate, cube, cylinder (rocket body) and a box-wing satellite.
 
-Every builder returns a :class:`~speclight.target.geometry.Target` in the body frame [m] and
+Every builder returns a :class:`~speclight.target.parts.Target` in the body frame [m] and
 takes ``materials``: one :class:`Material` for all parts or a mapping part name -> material.
 """
 
@@ -12,8 +12,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
-from speclight.target.geometry import Part, Target, assign_materials
 from speclight.target.materials import Material
+from speclight.target.parts import Part, Target, assign_materials
 
 Materials = Material | Mapping[str, Material]
 Mesh = tuple[NDArray[np.float64], NDArray[np.int64]]

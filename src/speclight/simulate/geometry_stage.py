@@ -15,7 +15,7 @@ from speclight.constants import C_M_S
 from speclight.errors import InputError
 from speclight.orbit.timescale import time_from_utc
 from speclight.scenario import LoadedScenario
-from speclight.scenario.models import (
+from speclight.scenario.sections_geometry import (
     AxesOrientation,
     FixedAttitude,
     SpinAttitude,

@@ -24,7 +24,7 @@ radiant intensity (the same quantity as :func:`speclight.render.render_intensity
 light of that direction and irradiance), the first moment over the sum the exact mean offset.
 
 With ``max_depth`` > 2 the interreflections are added at their full optical path length by
-:mod:`speclight.render.ranging_path` (Monte Carlo); the default 2 is single scattering.
+:mod:`speclight.render.laser_multibounce` (Monte Carlo); the default 2 is single scattering.
 """
 
 from __future__ import annotations
@@ -34,11 +34,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.render import models
+from speclight.render import material_channels as channels
 from speclight.render.camera import primary_rays
 from speclight.render.raycast import Caster, Hits
 from speclight.render.single import _Layout, _pixel_contributions
-from speclight.target.geometry import Target
+from speclight.target.parts import Target
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
@@ -132,7 +132,7 @@ class RangingAccumulator:
         seed: int = 0,
     ) -> None:
         for m in target.materials:
-            if m.bsdf not in models.SUPPORTED:
+            if m.bsdf not in channels.SUPPORTED:
                 raise NotImplementedError(f"bsdf '{m.bsdf}' is not supported for ranging")
         self.target = target
         self.obs = np.asarray(observer_dir_body, dtype=float)
@@ -152,12 +152,12 @@ class RangingAccumulator:
             )
         self.active &= np.all(np.isfinite(self.obs), axis=1)
         #: Path length limit (Mitsuba's convention): 2 = single scattering; more adds the
-        #: interreflections of :mod:`speclight.render.ranging_path` (Monte Carlo).
+        #: interreflections of :mod:`speclight.render.laser_multibounce` (Monte Carlo).
         self.max_depth = int(max_depth)
         self.samples_per_pixel = int(samples_per_pixel)
         self.seed = int(seed)
         self._plastic = {
-            k: models.plastic_factor(self.layout.mats[k], self.wl) for k in self.layout.block
+            k: channels.plastic_factor(self.layout.mats[k], self.wl) for k in self.layout.block
         }
 
     def __call__(
@@ -229,7 +229,7 @@ class RangingAccumulator:
             # one-way-equivalent range offset of each lit pixel (module docstring)
             rel_s = np.einsum("mk,mk->m", pos - self.com, s[e_idx])
             delta_px = -0.5 * (v.rel_o[idx] + rel_s)
-        mirror_ok = (mirror_cos >= models.SUN_COS).astype(float)
+        mirror_ok = (mirror_cos >= channels.SUN_COS).astype(float)
         mat = self.layout.part_mat[v.part[idx]]
         rows, chans, w = _pixel_contributions(
             self.layout, mat, cos_i, cos_o, cos_h, cos_d, mirror_ok
@@ -241,7 +241,7 @@ class RangingAccumulator:
                 k, light, epochs, s, o, e_idx[rows], chans, w * pixel_area, delta_px[rows]
             )
         if self.max_depth > 2:
-            from speclight.render.ranging_path import add_multibounce
+            from speclight.render.laser_multibounce import add_multibounce
 
             add_multibounce(self, k, light, v, s, lit_ep, self._caster, pixel_area)
 
@@ -264,7 +264,7 @@ class RangingAccumulator:
         cos_half = np.sqrt(np.clip(0.5 * (1.0 + np.einsum("bk,bk->b", s, o)), 0.0, 1.0))
         factor = np.zeros((b, self.layout.n_channels, n_s))
         for c, m in enumerate(self.layout.mats):
-            factor[:, c, :] = models.main_factor(m, cos_half, self.wl[sup])
+            factor[:, c, :] = channels.main_factor(m, cos_half, self.wl[sup])
         for c, start in self.layout.block.items():
             blk = self._plastic[c][:, sup]
             factor[:, start : start + blk.shape[0], :] = blk[None]
@@ -337,7 +337,7 @@ def render_ranging(
     max_depth, samples_per_pixel, seed
         ``max_depth`` > 2 adds multi-bounce returns at their full path length, traced with
         ``samples_per_pixel`` Monte Carlo paths per pixel from ``seed``
-        (:mod:`speclight.render.ranging_path`); 2 is single scattering (exact, no noise).
+        (:mod:`speclight.render.laser_multibounce`); 2 is single scattering (exact, no noise).
 
     Returns
     -------

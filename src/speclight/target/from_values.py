@@ -15,9 +15,9 @@ from typing import Any
 
 from speclight.errors import InputError, did_you_mean
 from speclight.target import shapes
-from speclight.target.geometry import Target
 from speclight.target.materials import Material
 from speclight.target.mesh_io import load_mesh
+from speclight.target.parts import Target
 from speclight.target.reflectance import Reflectance
 
 _BUILTINS = {

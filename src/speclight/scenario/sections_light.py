@@ -10,7 +10,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, Discriminator, Field, Tag, field_validator, model_validator
 
-from speclight.scenario.models import Strict, Vector3
+from speclight.scenario.sections_geometry import Strict, Vector3
 
 BsdfName = Literal["lambertian", "beckmann", "ggx", "plastic", "specular", "measured"]
 ConductorName = Literal["Al", "Ag", "Au"]

@@ -3,7 +3,7 @@
 Mitsuba's integrators return radiance, not the distribution of path lengths (its core has no
 transient/time-gated rendering), so the interreflections are traced here: a Monte Carlo path
 tracer in numpy over the same ray caster (Mitsuba's ``ray_intersect``/``ray_test`` or the
-numpy one), started from the receiver's primary hits of :mod:`speclight.render.ranging`.
+numpy one), started from the receiver's primary hits of :mod:`speclight.render.laser_returns`.
 
 Estimator (Kajiya 1986, "The rendering equation", doi:10.1145/15886.15902; Veach 1997, PhD
 thesis, Stanford, ch. 3 and 16). From the first hit ``p1`` (seen along ``o``), a direction
@@ -17,7 +17,7 @@ times the pixel area, at the one-way range offset
     delta = (-(p1 - c) . o + sum_i |p_{i+1} - p_i| - (p_j - c) . l) / 2
 
 (receiver plane and transmitter plane through the centre of mass ``c``). The one-bounce term
-(``j = 1``) is the exact single-scattering one of :mod:`speclight.render.ranging`, so the sum
+(``j = 1``) is the exact single-scattering one of :mod:`speclight.render.laser_returns`, so the sum
 over bounces is unbiased for the full multi-bounce return. Paths stop after ``max_depth - 1``
 surface vertices (Mitsuba's ``max_depth`` convention, camera segment included). Limitation:
 cosine sampling cannot follow the delta reflection of smooth mirrors (``specular``, a smooth
@@ -33,12 +33,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.render import models
+from speclight.render import material_channels as channels
 from speclight.render.raycast import Caster
 from speclight.render.single import _Layout, _pixel_contributions
 
 if TYPE_CHECKING:
-    from speclight.render.ranging import LaserLight, RangingAccumulator, _View
+    from speclight.render.laser_returns import LaserLight, RangingAccumulator, _View
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
@@ -72,7 +72,7 @@ def fcos_spectral(
     half /= np.maximum(np.linalg.norm(half, axis=1, keepdims=True), 1e-300)
     cos_h, cos_d = _dot(nn, half), _dot(s, half)
     mirror = 2.0 * cos_o[ok, None] * nn - v
-    mirror_ok = (_dot(mirror, s) >= models.SUN_COS).astype(float)
+    mirror_ok = (_dot(mirror, s) >= channels.SUN_COS).astype(float)
     rows, chans, w = _pixel_contributions(
         layout, part_material[ok], cos_i[ok], cos_o[ok], cos_h, cos_d, mirror_ok
     )
@@ -80,7 +80,7 @@ def fcos_spectral(
         sel = np.flatnonzero(chans == c)
         if sel.size:
             r = rows[sel]
-            out[ok[r]] += w[sel, None] * models.main_factor(m, cos_d[r], wavelength_nm)
+            out[ok[r]] += w[sel, None] * channels.main_factor(m, cos_d[r], wavelength_nm)
     for c, start in layout.block.items():
         sel = np.flatnonzero((chans >= start) & (chans < start + plastic[c].shape[0]))
         if sel.size:
