@@ -53,7 +53,8 @@ class _Layout:
     """Channel layout: main channel m for material m, then a block per plastic or RGL material.
 
     Blocks (:func:`speclight.render.material_channels.block_size`) carry what does not
-    factorise: K*K channels of a plastic's diffuse base, one channel per wavelength node of an RGL file.
+    factorise: K*K channels of a plastic's diffuse base, one channel per wavelength node of an
+    RGL file.
     """
 
     def __init__(self, target: Target) -> None:
