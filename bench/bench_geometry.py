@@ -11,7 +11,7 @@ import time
 import yaml
 
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate.geometry_stage import compute_geometry
+from speclight.simulate.geometry_stage import scenario_geometry
 
 ATTITUDES = {
     "spin": {
@@ -32,14 +32,14 @@ ATTITUDES = {
 def main() -> None:
     base = yaml.safe_load(example_text("lcs1"))
     base["time"] = {"start": "2020-07-18T00:00:00Z", "stop": "2020-07-18T23:59:59Z", "step_s": 1.0}
-    compute_geometry(parse_scenario(yaml.safe_dump(base)))  # warm caches (ephemeris, EOP)
+    scenario_geometry(parse_scenario(yaml.safe_dump(base)))  # warm caches (ephemeris, EOP)
     for name, attitude in ATTITUDES.items():
         base["attitude"] = attitude
         loaded = parse_scenario(yaml.safe_dump(base))
         best = float("inf")
         for _ in range(3):
             t0 = time.perf_counter()
-            geo = compute_geometry(loaded)
+            geo = scenario_geometry(loaded)
             best = min(best, time.perf_counter() - t0)
         print(f"geometry+attitude ({name}): {geo.t_s.size} epochs in {best:.3f} s (best of 3)")
 

@@ -1,7 +1,7 @@
 """Benchmark of the orbit stage: one day at 1 s steps (86,400 epochs).
 
 Times TLE propagation (SGP4 + TEME->GCRS), the Sun, the Earth shadow and topocentric
-range/azimuth/elevation for LCS 1 seen from Stuttgart, as ``compute_geometry`` runs them.
+range/azimuth/elevation for LCS 1 seen from Stuttgart, as ``observation_geometry`` runs them.
 
 Run: ``.venv/bin/python bench/bench_orbit.py``
 """
@@ -15,8 +15,8 @@ import numpy as np
 from speclight.orbit import (
     Site,
     as_time,
-    compute_geometry,
     earth_orientation,
+    observation_geometry,
     parse_tle,
     sun_position_gcrs_m,
     sunlit_fraction,
@@ -61,8 +61,8 @@ def run_once() -> dict[str, float]:
     t = as_time(times)
     eo = earth_orientation(t)
     r, _ = tle_position_gcrs_m(tle, t, orientation=eo)
-    compute_geometry(t, r, SITE, orientation=eo)
-    out["end to end: TLE + compute_geometry"] = time.perf_counter() - t1
+    observation_geometry(t, r, SITE, orientation=eo)
+    out["end to end: TLE + observation_geometry"] = time.perf_counter() - t1
     return out
 
 

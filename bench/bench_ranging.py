@@ -22,11 +22,12 @@ from typing import Any
 import numpy as np
 import yaml
 
+from speclight.constants import AU_M
 from speclight.illumination import solar_irradiance_W_m2_nm
 from speclight.render import render_intensity
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
-from speclight.simulate.geometry_stage import AU_M, compute_geometry
+from speclight.simulate.geometry_stage import scenario_geometry
 from speclight.simulate.radiometry import (
     atmosphere_transmission,
     instrument_response,
@@ -101,7 +102,7 @@ class Hook:
 
 def run(n_epochs: int, bistatic: bool, repeats: int) -> None:
     loaded = scenario(n_epochs, bistatic)
-    geo = compute_geometry(loaded)
+    geo = scenario_geometry(loaded)
     wl = wavelength_grid_nm(loaded.scenario.spectrum)
     elev = np.where(geo.observable, geo.elevation_deg, np.nan)
     trans = atmosphere_transmission(loaded, wl, elev)

@@ -14,8 +14,8 @@ from speclight.errors import InputError
 from speclight.orbit import (
     AU_M,
     Site,
-    compute_geometry,
     earth_orientation,
+    observation_geometry,
     parse_tle,
     phase_angle_deg,
     sun_distance_au,
@@ -98,7 +98,7 @@ def test_compute_geometry_bundle() -> None:
     t = _times(500)
     r, _ = tle_position_gcrs_m(parse_tle(f"{L1}\n{L2}"), t)
     r[7] = np.nan  # a failed epoch stays a NaN row, the others are unaffected
-    g = compute_geometry(t, r, SITE)
+    g = observation_geometry(t, r, SITE)
     for key in (
         "r_sun_gcrs_m",
         "r_site_gcrs_m",

@@ -14,19 +14,17 @@ from scipy import stats
 
 from speclight.errors import InputError
 from speclight.render import render_intensity
+from speclight.render.session import RenderSession
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
-from speclight.simulate.geometry_stage import compute_geometry
+from speclight.schema import FLAG_LASER_BELOW_HORIZON
+from speclight.simulate.geometry_stage import scenario_geometry
 from speclight.simulate.radiometry import (
     atmosphere_transmission,
     instrument_response,
     wavelength_grid_nm,
 )
-from speclight.simulate.ranging_stage import (
-    FLAG_LASER_BELOW_HORIZON,
-    laser_ranging,
-    prepare_ranging,
-)
+from speclight.simulate.ranging_stage import laser_ranging, prepare_ranging
 from speclight.simulate.reflection import build_target
 
 H, C = 6.62607015e-34, 299_792_458.0  # CODATA 2018, exact
@@ -60,13 +58,16 @@ def _scenario(lasers, sun=False):
 
 
 def _run(loaded, variant=None):
-    geo = compute_geometry(loaded)
+    geo = scenario_geometry(loaded)
     wl = wavelength_grid_nm(loaded.scenario.spectrum)
     trans = atmosphere_transmission(loaded, wl, np.where(geo.observable, geo.elevation_deg, np.nan))
     rad = instrument_response(loaded, wl, np.zeros((geo.t_s.size, wl.size)), trans, geo.range_m)
-    setup = prepare_ranging(loaded, geo, wl)
+    target = build_target(loaded)
+    session = RenderSession.create("single", variant, target.materials)
+    setup = prepare_ranging(loaded, geo, wl, target, session)
     assert setup is not None
-    return geo, laser_ranging(loaded, geo, wl, setup, trans, rad)
+    geo.flags = geo.flags | setup.flags  # as the pipeline merges the stages' flag bits
+    return geo, laser_ranging(loaded, geo, setup, trans, rad)
 
 
 def test_return_photons_per_pulse_match_the_laser_radar_equation():
@@ -148,9 +149,11 @@ def test_bad_laser_inputs_are_refused(field, value, match):
 
 def test_sun_only_render_is_unchanged_by_the_ranging_hook():
     loaded = _scenario([], sun=True)
-    geo = compute_geometry(loaded)
+    geo = scenario_geometry(loaded)
     wl = wavelength_grid_nm(loaded.scenario.spectrum)
-    assert prepare_ranging(loaded, geo, wl) is None  # no lasers: nothing to do
+    target = build_target(loaded)
+    session = RenderSession.create("single", None, target.materials)
+    assert prepare_ranging(loaded, geo, wl, target, session) is None  # no lasers: nothing to do
     args = (
         build_target(loaded),
         geo.sun_direction_body,

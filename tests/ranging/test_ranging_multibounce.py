@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from speclight.render import available_variants, render_intensity
-from speclight.render.laser_returns import LaserLight, render_ranging
+from speclight.render.laser_returns import LaserLight, render_laser_returns
 from speclight.target import Material, Part, Reflectance, Target, sphere
 
 WL = np.array([530.0, 531.0, 532.0])
@@ -35,7 +35,7 @@ def _view() -> np.ndarray:
 def _ranging(target, depth, spp, seed, variant="numpy", res=48):
     obs = _view()
     light = LaserLight(obs, np.array([1]), np.ones((1, 1)))
-    return render_ranging(
+    return render_laser_returns(
         target,
         obs,
         [light],

@@ -29,7 +29,7 @@ checks the laser's shadow rays (terminator) and direction handling.
 import numpy as np
 import pytest
 
-from speclight.render.laser_returns import LaserLight, render_ranging
+from speclight.render.laser_returns import LaserLight, render_laser_returns
 from speclight.target import Material, Reflectance, sphere
 
 WL = np.array([530.0, 531.0, 532.0])
@@ -45,7 +45,7 @@ def _render(material: Material, obs: np.ndarray, laser: np.ndarray, variant: str
     target = sphere(R, {"body": material})
     e = np.ones((len(obs), 1)) * 2.0  # W m-2 nm-1 in the bin at 531 nm
     light = LaserLight(laser, np.array([1]), e)
-    rr = render_ranging(target, obs, [light], WL, resolution_px=RES, variant=variant)
+    rr = render_laser_returns(target, obs, [light], WL, resolution_px=RES, variant=variant)
     intensity = rr.intensity_W_sr_nm(0)[:, 0]
     return rr, intensity, rr.moment_m[0][:, 0] / intensity
 
@@ -111,7 +111,7 @@ def test_offset_is_relative_to_the_centre_of_mass(shift):
     obs = _views()[:1]
     target = sphere(R, {"body": Material("p", "lambertian", Reflectance.constant(0.5))})
     light = LaserLight(obs, np.array([1]), np.ones((1, 1)))
-    rr = render_ranging(target, obs, [light], WL, resolution_px=RES, com_body_m=shift)
+    rr = render_laser_returns(target, obs, [light], WL, resolution_px=RES, com_body_m=shift)
     offset = rr.moment_m[0][0, 0] / rr.intensity_W_sr_nm(0)[0, 0]
     # moving the centre of mass by s moves the offset by +s.o (geometry, exact)
     np.testing.assert_allclose(offset, -0.75 * R + shift @ obs[0], rtol=QUADRATURE_REL)

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from speclight.errors import InputError
 from speclight.render import available_variants, render_intensity, rgl
 from speclight.target import Material, Reflectance, cube, plate, sphere
 from speclight.target.rgl_file import write_tensor_file
@@ -118,20 +119,26 @@ def test_mitsuba_measured_plugin_reads_the_written_file_as_lambertian(grey, monk
     np.testing.assert_allclose(sun[:, 2], cos_i, atol=1e-12)
     np.testing.assert_allclose(obs[:, 2], cos_o, atol=1e-12)
     np.testing.assert_allclose(np.einsum("nk,nk->n", sun, obs), cos_phase, atol=1e-9)
-    f_cos = rgl.eval_plugin(str(grey), sun, obs)  # (n, 2): both wavelength nodes
+    spectral = _spectral_variants()[-1]
+    f_cos = rgl.eval_plugin(str(grey), sun, obs, spectral)  # (n, 2): both wavelength nodes
     ref = 0.6 / np.pi * cos_i
     assert np.max(np.abs(f_cos - ref[:, None])) < FILE_INTERP_TOL * 0.6 / np.pi
     # evaluating in several Dr.Jit batches changes nothing
     monkeypatch.setattr(rgl, "EVAL_BATCH", 7)
-    np.testing.assert_array_equal(rgl.eval_plugin(str(grey), sun, obs), f_cos)
+    np.testing.assert_array_equal(rgl.eval_plugin(str(grey), sun, obs, spectral), f_cos)
     # below the horizon the plugin returns 0
     sun_below = sun * np.array([1.0, 1.0, -1.0])
-    assert np.all(rgl.eval_plugin(str(grey), sun_below, obs) == 0.0)
+    assert np.all(rgl.eval_plugin(str(grey), sun_below, obs, spectral) == 0.0)
 
 
-def test_single_rgl_sphere_follows_the_lambert_phase_law(grey, caster_variant):
-    # caster_variant: numpy, and llvm_ad_rgb (forces the switch to a spectral variant for the
-    # plugin and back for the ray caster).
+def _spectral_variants():
+    fast = [v for v in available_variants() if v.startswith(("cuda_", "llvm_"))]
+    return ["auto", *[v for v in fast if v.endswith("_spectral")][:1]]
+
+
+@pytest.mark.parametrize("variant", _spectral_variants())
+def test_single_rgl_sphere_follows_the_lambert_phase_law(grey, variant):
+    # The run's one variant is a spectral one: rays are cast in it and the plugin runs in it.
     phase = np.array([0.0, 30.0, 60.0, 90.0, 120.0])
     sun, obs = _phase_dirs(phase)
     wl = np.array([350.0, 550.0, 1200.0])
@@ -143,9 +150,10 @@ def test_single_rgl_sphere_follows_the_lambert_phase_law(grey, caster_variant):
         np.ones((len(phase), len(wl))),
         wl,
         resolution_px=SPHERE_PX,
-        variant=caster_variant,
+        variant=variant,
         keep_images_for=[2],
     )
+    assert res.variant.endswith("_spectral")
     ref = _lambert_sphere(0.6, phase)
     np.testing.assert_allclose(res.intensity_W_sr_nm, ref[:, None] * np.ones(3), rtol=SPHERE_TOL)
     img = res.images[2]
@@ -238,3 +246,54 @@ def test_path_rgl_sphere_follows_the_lambert_law_within_monte_carlo_error(grey):
     assert np.all(sd > 0)
     sigma_mean = np.sqrt((sd**2).sum(axis=1)) / len(wl)
     assert np.all(np.abs(i.mean(axis=1) - ref) < Z_MAX * sigma_mean + FILE_INTERP_TOL * ref)
+
+
+@pytest.mark.parametrize("variant", ["numpy", "llvm_ad_rgb"])
+def test_single_rgl_refuses_a_variant_that_cannot_evaluate_it(grey, variant):
+    # One variant per run: a ray-casting-only variant cannot run the plugin, and speclight
+    # no longer switches the process-wide variant behind the user's back.
+    if variant != "numpy" and variant not in available_variants():
+        pytest.skip(f"{variant} not available here")
+    m = Material("rgl", "measured", Reflectance.constant(1.0), brdf_table=str(grey))
+    sun, obs = _phase_dirs([30.0])
+    with pytest.raises(InputError, match="spectral variant") as err:
+        render_intensity(
+            sphere(1.0, m),
+            sun,
+            obs,
+            np.ones((1, 2)),
+            np.array([500.0, 600.0]),
+            resolution_px=32,
+            variant=variant,
+        )
+    assert err.value.field == "render.variant"
+
+
+def test_rgl_material_and_a_laser_share_one_variant(grey):
+    # Issue 8: a run with an RGL material and a laser used to mix *_spectral (Sun render) and
+    # *_rgb (laser render). The session hands both the same variant and the same caster.
+    import mitsuba as mi
+
+    from speclight.render.laser_returns import LaserLight, render_laser_returns
+    from speclight.render.session import RenderSession
+
+    m = Material("rgl", "measured", Reflectance.constant(1.0), brdf_table=str(grey))
+    target = sphere(1.0, m)
+    session = RenderSession.create("single", None, target.materials)
+    assert session.variant.endswith("_spectral")
+    wl = np.array([500.0, 532.0, 600.0])
+    sun, obs = _phase_dirs([0.0])
+    sun_render = render_intensity(
+        target, sun, obs, np.ones((1, 3)), wl, resolution_px=SPHERE_PX, session=session
+    )
+    assert sun_render.variant == session.variant == mi.variant()
+    light = LaserLight(obs, np.array([1]), np.ones((1, 1)))  # coaxial laser at 532 nm
+    laser = render_laser_returns(target, obs, [light], wl, resolution_px=SPHERE_PX, session=session)
+    assert mi.variant() == session.variant  # nothing switched it
+    # the same Lambertian sphere at zero phase, lit by the laser or by the Sun
+    np.testing.assert_allclose(
+        laser.intensity_W_sr_nm(0)[0, 0], sun_render.intensity_W_sr_nm[0, 1], rtol=1e-9
+    )
+    np.testing.assert_allclose(
+        laser.intensity_W_sr_nm(0)[0, 0], _lambert_sphere(0.6, 0.0), rtol=SPHERE_TOL
+    )

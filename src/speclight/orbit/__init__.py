@@ -2,7 +2,7 @@
 
 Positions are numpy arrays in metres with the frame in the name (``r_gcrs_m``); times are
 skyfield ``Time`` objects or arrays of UTC ``datetime64``. Target sources: TLE (SGP4),
-ILRS CPF predictions, tabulated ephemerides. :func:`compute_geometry` bundles what the
+ILRS CPF predictions, tabulated ephemerides. :func:`observation_geometry` bundles what the
 later stages need (Sun, site, shadow, range/azimuth/elevation, phase angle, unit vectors).
 """
 
@@ -10,7 +10,7 @@ from speclight.orbit.cpf import Cpf, cpf_position_gcrs_m, read_cpf
 from speclight.orbit.cpf_write import format_cpf, write_cpf
 from speclight.orbit.ephemeris import Ephemeris, ephemeris_position_gcrs_m, read_ephemeris_csv
 from speclight.orbit.frames import EarthOrientation, as_time, earth_orientation
-from speclight.orbit.observation import ObservationGeometry, compute_geometry
+from speclight.orbit.observation import ObservationGeometry, observation_geometry
 from speclight.orbit.observer import (
     Site,
     Topocentric,
@@ -33,13 +33,13 @@ __all__ = [
     "Tle",
     "Topocentric",
     "as_time",
-    "compute_geometry",
     "cpf_position_gcrs_m",
     "earth_orientation",
     "ephemeris_position_gcrs_m",
     "format_cpf",
     "load_ephemeris",
     "load_timescale",
+    "observation_geometry",
     "parse_tle",
     "phase_angle_deg",
     "read_cpf",

@@ -69,7 +69,7 @@ def _unit(v: NDArray[np.float64]) -> NDArray[np.float64]:
     return v / np.linalg.norm(v, axis=1, keepdims=True)
 
 
-def compute_geometry(
+def observation_geometry(
     t: TimeLike,
     r_target_gcrs_m: NDArray[np.float64],
     site: Site,

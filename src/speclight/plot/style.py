@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 
 from speclight.errors import InputError
 
-# Flag bits of the dataset (speclight.simulate.variables, CF flag_masks).
+# Flag bits of the dataset (speclight.schema, CF flag_masks).
 FLAG_ORBIT_FAILED = 1
 FLAG_BELOW_MIN_ELEVATION = 2
 FLAG_IN_SHADOW = 4

@@ -15,96 +15,147 @@ For a target of optical cross-section ``sigma = 4 pi I / E`` this is the standar
 
 with the far-field gain ``G_t = 8/theta_t²`` of a Gaussian beam of 1/e² half-angle
 divergence ``theta_t`` (Degnan 1993, "Millimeter accuracy satellite laser ranging: a review",
-AGU Geodynamics Series 25, eq. 2.1 and 2.4, doi:10.1029/GD025p0133), written out in
-:func:`cross_section_link_photons` for targets given by a cross-section.
+AGU Geodynamics Series 25, eq. 2.1 and 2.4, doi:10.1029/GD025p0133); the test suite checks
+the two against each other for a sphere.
+
+The uplink (:func:`uplink_spectral_irradiance`) and the downlink (:func:`receiver_returns`)
+are both here: the pipeline calls these functions and does no link arithmetic of its own.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
-
-from speclight.constants import C_M_S, H_J_S
 
 F64 = NDArray[np.float64]
 
 
-def photons_from_intensity(
-    intensity_W_sr_nm: F64,
+def uplink_spectral_irradiance(
+    beam_W_m2: F64, line_per_nm: F64, transmission_up: F64, lit: NDArray[np.bool_]
+) -> F64:
+    """Spectral irradiance of a laser at the target on its support (N, S) [W m-2 nm-1].
+
+    ``beam_W_m2`` (N,) is the beam irradiance above the atmosphere, ``line_per_nm`` (S,) the
+    line shape on the support bins, ``transmission_up`` (N, S) the uplink transmission and
+    ``lit`` (N,) where the laser reaches the target (0 elsewhere).
+    """
+    spectral = beam_W_m2[:, None] * line_per_nm[None, :] * transmission_up
+    return np.asarray(np.where(lit[:, None], spectral, 0.0))
+
+
+def uplink_irradiance_W_m2(spectral_W_m2_nm: F64, bin_width_nm: F64, ok: NDArray[np.bool_]) -> F64:
+    """Laser irradiance at the target (N,) [W m-2]: the bin sum of the spectral irradiance
+    (N, S) with the support's bin widths (S,) [nm]; NaN where ``ok`` is false."""
+    return np.asarray(np.where(ok, spectral_W_m2_nm @ bin_width_nm, np.nan))
+
+
+def downlink_conversion(
     transmission_down: F64,
-    aperture_area_m2: float,
+    observable: NDArray[np.bool_],
     range_rx_m: F64,
+    aperture_area_m2: float,
     photon_kernel: F64,
 ) -> F64:
-    """Detected photo-electrons per second (N, B) from the intensity toward the receiver.
+    """Detected counts per second per unit intensity (N, S, B) [s-1 per W sr-1 nm-1].
 
     Parameters
     ----------
-    intensity_W_sr_nm
-        (N, L) radiant intensity toward the receiver [W sr-1 nm-1] (mean power).
     transmission_down
-        (N, L) atmospheric transmission target -> receiver [1].
-    aperture_area_m2
-        Receiver collecting area [m²].
+        (N, S) atmospheric transmission target -> receiver on a laser's support [1].
+    observable
+        (N,) epochs whose returns reach the receiver (0 elsewhere).
     range_rx_m
         (N,) target-to-receiver distance [m].
+    aperture_area_m2
+        Receiver collecting area [m²].
     photon_kernel
-        (B, L) electrons per joule per bin x bin width [nm J-1]
+        (B, S) electrons per joule per bin x bin width [nm J-1] on the support
         (:func:`speclight.instrument.photometry.photon_kernel`).
-
-    Returns
-    -------
-    numpy.ndarray
-        (N, B) [s-1]. Divide by the repetition rate for photo-electrons per pulse.
     """
-    flux = intensity_W_sr_nm * transmission_down * aperture_area_m2 / range_rx_m[:, None] ** 2
-    return np.asarray(flux @ photon_kernel.T)
+    with np.errstate(invalid="ignore"):
+        down = np.where(observable[:, None], transmission_down, 0.0)
+        down = (
+            np.nan_to_num(down)
+            * aperture_area_m2
+            / np.where(observable, range_rx_m, 1.0)[:, None] ** 2
+        )
+    return np.asarray(down[:, :, None] * photon_kernel.T[None, :, :])
+
+
+def band_rates(values: F64, conversion: F64) -> F64:
+    """Band values (N, B) from values on a laser's support (N, S): ``sum_s x c``.
+
+    With intensities [W sr-1 nm-1] this gives count rates [s-1]; with first moments
+    (intensity x offset) the count-weighted offsets [s-1 m].
+    """
+    return np.asarray(np.einsum("ns,nsb->nb", values, conversion))
 
 
 def band_histograms(histogram: F64, conversion: F64) -> F64:
     """Band-resolved histograms (N, B, nbins) from per-wavelength ones (N, S, nbins).
 
     ``conversion`` (N, S, B) maps an intensity on the support wavelength s to a detected
-    count in band b (transmission x area / range² x photon kernel).
+    count in band b (:func:`downlink_conversion`).
     """
     return np.asarray(np.einsum("nsk,nsb->nbk", histogram, conversion))
 
 
-def mean_offset_m(moment: F64, total: F64, conversion: F64) -> F64:
-    """Return-weighted mean range offset per band (N, B) [m]: sum(I delta c) / sum(I c).
+@dataclass
+class ReceiverReturns:
+    """What the receiver detects from all lasers, per band.
 
-    NaN where a band receives nothing.
+    Attributes
+    ----------
+    per_pulse
+        (N, K, B) return photo-electrons per pulse of each laser [1].
+    rate_per_s
+        (N, B) return photo-electrons per second, all lasers [s-1].
+    histogram_per_s
+        (N, B, nbins) the same per range-offset bin [s-1].
+    offset_m
+        (N, B) count-weighted mean range offset [m] (NaN where a band receives nothing).
     """
-    num = np.einsum("ns,nsb->nb", moment, conversion)
-    den = np.einsum("ns,nsb->nb", total, conversion)
+
+    per_pulse: F64
+    rate_per_s: F64
+    histogram_per_s: F64
+    offset_m: F64
+
+
+def receiver_returns(
+    histograms: list[F64],
+    moments_m: list[F64],
+    conversions: list[F64],
+    repetition_rate_hz: list[float],
+) -> ReceiverReturns:
+    """Carry each laser's rendered returns to the receiver's bands and sum the lasers.
+
+    Parameters
+    ----------
+    histograms, moments_m
+        Per laser k: intensity histograms (N, S_k, nbins) [W sr-1 nm-1 per bin] and first
+        moments (N, S_k) [W sr-1 nm-1 m] on its support (the render's output).
+    conversions
+        Per laser: :func:`downlink_conversion` (N, S_k, B).
+    repetition_rate_hz
+        Per laser: pulses per second.
+    """
+    n, n_bins = histograms[0].shape[0], histograms[0].shape[2]
+    n_b = conversions[0].shape[2]
+    per_pulse = np.zeros((n, len(histograms), n_b))
+    hist = np.zeros((n, n_b, n_bins))
+    moment = np.zeros((n, n_b))
+    total = np.zeros((n, n_b))
+    for k, (h_k, m_k, conv, rate_hz) in enumerate(
+        zip(histograms, moments_m, conversions, repetition_rate_hz, strict=True)
+    ):
+        rate = band_rates(h_k.sum(axis=2), conv)
+        per_pulse[:, k] = rate / rate_hz
+        hist += band_histograms(h_k, conv)
+        moment += band_rates(m_k, conv)
+        total += rate
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.asarray(np.where(den > 0, num / den, np.nan))
-
-
-def cross_section_link_photons(
-    pulse_energy_J: float,
-    wavelength_nm: float,
-    divergence_full_rad: float,
-    cross_section_m2: float,
-    range_m: float,
-    aperture_area_m2: float,
-    transmission_one_way: float = 1.0,
-    efficiency: float = 1.0,
-) -> float:
-    """Photo-electrons per pulse from Degnan's link equation for a target cross-section [1].
-
-    ``n = eta (E lambda/hc) G_t sigma / (4 pi R²)² A T²`` with ``G_t = 8 / (theta/2)²``
-    (monostatic, target on the beam axis; Degnan 1993, doi:10.1029/GD025p0133, eq. 2.1, 2.4).
-    """
-    photons = pulse_energy_J * wavelength_nm * 1e-9 / (H_J_S * C_M_S)
-    gain = 8.0 / (divergence_full_rad / 2.0) ** 2
-    geometric = (1.0 / (4.0 * np.pi * range_m**2)) ** 2
-    return float(
-        efficiency
-        * photons
-        * gain
-        * cross_section_m2
-        * geometric
-        * aperture_area_m2
-        * transmission_one_way**2
-    )
+        offset = np.where(total > 0, moment / total, np.nan)
+    return ReceiverReturns(per_pulse, total, hist, offset)

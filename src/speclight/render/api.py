@@ -3,19 +3,15 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError
-from speclight.render.raycast import Caster, MitsubaCaster, NumpyCaster
 from speclight.render.result import RenderResult
-from speclight.render.rgl import is_rgl
-from speclight.render.variant import choose_variant
+from speclight.render.session import RenderMode, RenderSession
 from speclight.target.parts import Target
 
-RenderMode = Literal["single", "path"]
 MIN_RESOLUTION_PX = 8
 
 
@@ -32,13 +28,6 @@ def _unit_rows(
     ok = np.isfinite(norm) & (norm > 0)
     out = np.where(ok[:, None], x / np.where(ok, norm, 1.0)[:, None], np.nan)
     return out, ok
-
-
-def make_caster(target: Target, variant: str) -> Caster:
-    """The ray caster for a variant: Mitsuba for llvm/cuda variants, numpy otherwise."""
-    if variant.startswith(("llvm_", "cuda_")):
-        return MitsubaCaster(target, variant)
-    return NumpyCaster(target)
 
 
 def render_intensity(
@@ -58,6 +47,7 @@ def render_intensity(
     keep_images_for: Iterable[int] | None = None,
     on_hits: Callable[..., None] | None = None,
     solar_disk: bool = False,
+    session: RenderSession | None = None,
 ) -> RenderResult:
     """Radiant intensity of a sunlit target toward an observer, per epoch and wavelength.
 
@@ -83,7 +73,8 @@ def render_intensity(
         Path mode: random seed (the result is reproducible for a given seed and variant).
     variant
         Mitsuba variant or ``None``/``"auto"`` (see :func:`speclight.render.choose_variant`);
-        ``"numpy"`` or a ``scalar_*`` variant casts single-mode rays with numpy.
+        ``"numpy"`` or a ``scalar_*`` variant casts single-mode rays with numpy. Ignored when
+        ``session`` is given.
     workers
         Single mode with the numpy caster: number of processes over blocks of epochs.
         Dr.Jit variants are already parallel over all cores and ignore it.
@@ -102,6 +93,10 @@ def render_intensity(
         instead of a point Sun, so that smooth mirrors and smooth plastic coats show their
         glint (a point Sun never reaches the observer through a mirror). Single mode always
         models the glint with the disk and ignores it.
+    session
+        The run's render session (:class:`~speclight.render.session.RenderSession`: the one
+        variant and the ray casters of a run); built from ``mode``, ``variant`` and the
+        target's materials when not given.
 
     Returns
     -------
@@ -109,8 +104,9 @@ def render_intensity(
         ``intensity_W_sr_nm`` (N, L) = sum over pixels of radiance x pixel area, NaN rows for
         epochs whose inputs are not finite.
     """
-    if mode not in ("single", "path"):
-        raise InputError(f"render.mode = '{mode}' must be 'single' or 'path'", field="render.mode")
+    if session is None:
+        session = RenderSession.create(mode, variant, target.materials)
+    mode = session.mode
     if int(resolution_px) < MIN_RESOLUTION_PX:
         raise InputError(
             f"render.resolution_px = {resolution_px} must be >= {MIN_RESOLUTION_PX}",
@@ -142,8 +138,7 @@ def render_intensity(
     std = np.full((len(sun), len(wl)), np.nan)
     images = {}
     if mode == "single":
-        # RGL materials are evaluated in a spectral variant: cast rays in it too (no switching).
-        chosen = choose_variant(variant, spectral=any(is_rgl(m) for m in target.materials))
+        chosen = session.variant
         n_workers = int(workers or 1)
         multi = n_workers > 1 and on_hits is None
         if multi and not chosen.startswith(("llvm_", "cuda_")) and len(valid) > 1:
@@ -161,7 +156,7 @@ def render_intensity(
             )
             used = "numpy"
         else:
-            caster = make_caster(target, chosen)
+            caster = session.caster(target)
             from speclight.render.single import render_single
 
             with _progress(progress, len(valid)) as advance:
@@ -181,7 +176,7 @@ def render_intensity(
         intensity[valid] = inten
         std[valid] = 0.0
     else:
-        chosen = choose_variant(variant, spectral=True)
+        chosen = session.variant
         from speclight.render.path import render_path
 
         with _progress(progress, len(valid)) as advance:
@@ -191,7 +186,7 @@ def render_intensity(
                 obs[valid],
                 e[valid],
                 wl,
-                chosen,
+                session,
                 int(resolution_px),
                 int(samples_per_pixel),
                 int(seed),
@@ -276,3 +271,61 @@ class _progress:
     def __exit__(self, *exc: object) -> None:
         if self.show:
             self.bar.stop()
+
+
+def material_contributions(
+    target: Target,
+    sun_dir_body: ArrayLike,
+    observer_dir_body: ArrayLike,
+    solar_irradiance_W_m2_nm: ArrayLike,
+    wavelength_nm: ArrayLike,
+    *,
+    resolution_px: int = 256,
+    variant: str | None = None,
+    session: RenderSession | None = None,
+) -> NDArray[np.float64]:
+    """Each material's contribution to the single-scattering intensity (N, M, L) [W sr-1 nm-1].
+
+    Same inputs as :func:`render_intensity` (single mode). ``[:, k, :]`` is the light reflected
+    by the pixels of ``target.materials[k]``; the sum over materials is the intensity
+    ``render_intensity`` gives (to rounding). NaN rows for epochs whose inputs are not finite.
+
+    Intensity is linear in each material's reflectance where the BRDF is proportional to it
+    (``lambertian``, and ``beckmann``/``ggx``/``specular`` with a reflectance given as numbers
+    rather than n,k): scaling material k's reflectance by ``a_k`` scales its contribution by
+    ``a_k``, so ``contributions[:, :, band]`` is the design matrix of a fit of per-material
+    albedos, and the contributions are the endmember spectra of an unmixing. For ``plastic``
+    only the diffuse base scales with ``diffuse_reflectance``; the coat does not.
+
+    Examples
+    --------
+    >>> from speclight.target import Material, Reflectance, cube
+    >>> grey = Material("grey", "lambertian", Reflectance.constant(0.5))
+    >>> c = material_contributions(cube(1.0, grey), [0, 0, 1], [0, 0, 1], [1.0, 1.0],
+    ...                            [500.0, 600.0], resolution_px=16, variant="numpy")
+    >>> c.shape
+    (1, 1, 2)
+    """
+    wl = np.asarray(wavelength_nm, dtype=float).ravel()
+    sun, ok_s = _unit_rows(sun_dir_body, "sun_dir_body")
+    obs, ok_o = _unit_rows(observer_dir_body, "observer_dir_body", len(sun))
+    e = np.asarray(solar_irradiance_W_m2_nm, dtype=float)
+    e = np.broadcast_to(e, (len(sun), len(wl))) if e.ndim == 1 else e
+    if e.shape != (len(sun), len(wl)):
+        raise InputError(
+            f"solar_irradiance_W_m2_nm must have shape (N, L) = ({len(sun)}, {len(wl)}), "
+            f"got {e.shape}",
+            field="solar_irradiance_W_m2_nm",
+        )
+    if session is None:
+        session = RenderSession.create("single", variant, target.materials)
+    ok = ok_s & ok_o & np.all(np.isfinite(e), axis=1)
+    out = np.full((len(sun), len(target.materials), len(wl)), np.nan)
+    valid = np.flatnonzero(ok)
+    if valid.size:
+        from speclight.render.single import material_contributions as contributions
+
+        out[valid] = contributions(
+            target, sun[valid], obs[valid], e[valid], wl, session.caster(target), int(resolution_px)
+        )
+    return out

@@ -28,28 +28,22 @@ followed, with more noise the smoother they are.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Iterator
 
 import numpy as np
 from numpy.typing import NDArray
 
 from speclight.render import material_channels as channels
+from speclight.render.material_channels import ChannelLayout, pixel_contributions
 from speclight.render.raycast import Caster
-from speclight.render.single import _Layout, _pixel_contributions
-
-if TYPE_CHECKING:
-    from speclight.render.laser_returns import LaserLight, RangingAccumulator, _View
+from speclight.render.shading import VisibleHits, dot_rows, half_vectors, mirror_in_sun
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
 
 
-def _dot(a: F64, b: F64) -> F64:
-    return np.asarray(np.einsum("mk,mk->m", a, b))
-
-
 def fcos_spectral(
-    layout: _Layout,
+    layout: ChannelLayout,
     plastic: dict[int, F64],
     wavelength_nm: F64,
     part_material: I64,
@@ -63,17 +57,15 @@ def fcos_spectral(
     """
     m_count, s_count = len(n), len(wavelength_nm)
     out = np.zeros((m_count, s_count))
-    cos_i, cos_o = _dot(n, to_light), _dot(n, to_viewer)
+    cos_i, cos_o = dot_rows(n, to_light), dot_rows(n, to_viewer)
     ok = np.flatnonzero((cos_i > 0) & (cos_o > 0))
     if ok.size == 0:
         return out
     s, v, nn = to_light[ok], to_viewer[ok], n[ok]
-    half = s + v
-    half /= np.maximum(np.linalg.norm(half, axis=1, keepdims=True), 1e-300)
-    cos_h, cos_d = _dot(nn, half), _dot(s, half)
-    mirror = 2.0 * cos_o[ok, None] * nn - v
-    mirror_ok = (_dot(mirror, s) >= channels.SUN_COS).astype(float)
-    rows, chans, w = _pixel_contributions(
+    half = half_vectors(s, v)
+    cos_h, cos_d = dot_rows(nn, half), dot_rows(s, half)
+    mirror_ok = mirror_in_sun(nn, cos_o[ok], v, s)
+    rows, chans, w = pixel_contributions(
         layout, part_material[ok], cos_i[ok], cos_o[ok], cos_h, cos_d, mirror_ok
     )
     for c, m in enumerate(layout.mats):
@@ -108,42 +100,72 @@ def _offset_origin(pos: F64, n: F64) -> F64:
     return np.asarray(pos + scale * n)
 
 
-def add_multibounce(
-    acc: RangingAccumulator,
-    k: int,
-    light: LaserLight,
-    v: _View,
+def multibounce_returns(
+    layout: ChannelLayout,
+    plastic: dict[int, F64],
+    wavelength_nm: F64,
+    v: VisibleHits,
     s_dir: F64,
     lit_ep: NDArray[np.bool_],
+    irradiance_W_m2_nm: F64,
     caster: Caster,
     pixel_area_m2: float,
-) -> None:
-    """Add the returns of bounces 2..max_depth-1 of light ``k`` to the accumulator."""
-    sup = light.support
-    wl = acc.wl[sup]
-    plastic = {c: f[:, sup] for c, f in acc._plastic.items()}
-    e_slot = light.irradiance_W_m2_nm[v.epochs]  # (b, S)
+    com_body_m: F64,
+    bin_edges_m: F64,
+    *,
+    max_depth: int,
+    samples_per_pixel: int,
+    seed: tuple[int, ...],
+) -> Iterator[tuple[F64, F64]]:
+    """The returns of bounces 2..max_depth-1 of one laser, as increments to its histograms.
+
+    Parameters
+    ----------
+    layout, plastic
+        Channel layout of the target and each plastic material's block factors on the
+        laser's support wavelengths ``wavelength_nm`` (S,) [nm].
+    v
+        The batch's primary hits (:class:`~speclight.render.shading.VisibleHits`).
+    s_dir, lit_ep
+        (b, 3) unit vectors to the laser and (b,) whether it lights each epoch of the batch.
+    irradiance_W_m2_nm
+        (b, S) the laser's spectral irradiance at the target.
+    caster, pixel_area_m2
+        The ray caster and the area of one primary pixel [m²].
+    com_body_m, bin_edges_m
+        Centre of mass (3,) [m] and the uniform range-offset bin edges (nbins+1,) [m].
+    max_depth, samples_per_pixel, seed
+        Path length limit (Mitsuba's convention), Monte Carlo paths per pixel, and the
+        entropy of the random stream (:class:`numpy.random.SeedSequence`).
+
+    Yields
+    ------
+    tuple
+        ``(histogram (b, S, nbins) [W sr-1 nm-1], moment (b, S) [W sr-1 nm-1 m])`` for every
+        sample and bounce that returns light; the caller adds them in order.
+    """
+    wl = wavelength_nm
     start = np.flatnonzero(lit_ep[v.ep])
     if start.size == 0:
         return
-    part_mat = acc.layout.part_mat
-    spp = max(1, int(acc.samples_per_pixel))
-    nb = len(acc.edges) - 1
-    width = (acc.edges[-1] - acc.edges[0]) / nb
-    b, n_s = len(v.epochs), sup.size
-    seed = np.random.SeedSequence([acc.seed, int(v.epochs[0]), k])
-    for child in seed.spawn(spp):
+    part_mat = layout.part_mat
+    spp = max(1, int(samples_per_pixel))
+    edges = bin_edges_m
+    nb = len(edges) - 1
+    width = (edges[-1] - edges[0]) / nb
+    b, n_s = len(v.epochs), len(wl)
+    for child in np.random.SeedSequence(list(seed)).spawn(spp):
         rng = np.random.default_rng(child)
         slot = v.ep[start]
-        pos = v.origin[v.hit[start]] - v.t[start, None] * v.o[slot]
+        pos = v.position(start)
         n, view = v.n[start], v.o[slot]
         mat = part_mat[v.part[start]]
         path = -v.rel_o[start]  # receiver plane -> p1
         through = np.ones((start.size, n_s))
-        for _ in range(2, acc.max_depth):
+        for _ in range(2, max_depth):
             w = _cosine_hemisphere(n, rng)
-            fc = fcos_spectral(acc.layout, plastic, wl, mat, n, w, view)
-            through = through * fc * np.pi / np.maximum(_dot(n, w), 1e-12)[:, None]
+            fc = fcos_spectral(layout, plastic, wl, mat, n, w, view)
+            through = through * fc * np.pi / np.maximum(dot_rows(n, w), 1e-12)[:, None]
             hits = caster.intersect(_offset_origin(pos, n), w)
             keep = np.flatnonzero(hits.hit & np.any(through > 0, axis=1))
             if keep.size == 0:
@@ -154,25 +176,27 @@ def add_multibounce(
             path = path[keep] + t
             view = -w
             n = hits.normal[keep]
-            n = n * np.where(_dot(n, view) < 0, -1.0, 1.0)[:, None]
+            n = n * np.where(dot_rows(n, view) < 0, -1.0, 1.0)[:, None]
             mat = part_mat[hits.part[keep]]
             # next-event estimation towards the laser
             s = s_dir[slot]
-            lit = np.flatnonzero(_dot(n, s) > 0)
+            lit = np.flatnonzero(dot_rows(n, s) > 0)
             if lit.size:
                 blocked = caster.occluded(pos[lit], s[lit], n[lit])
                 lit = lit[~blocked]
             if lit.size:
-                fl = fcos_spectral(acc.layout, plastic, wl, mat[lit], n[lit], s[lit], view[lit])
-                value = through[lit] * fl * e_slot[slot[lit]] * (pixel_area_m2 / spp)
-                delta = 0.5 * (path[lit] - _dot(pos[lit] - acc.com, s[lit]))
-                bins = np.clip(((delta - acc.edges[0]) / width).astype(np.int64), 0, nb - 1)
+                fl = fcos_spectral(layout, plastic, wl, mat[lit], n[lit], s[lit], view[lit])
+                value = through[lit] * fl * irradiance_W_m2_nm[slot[lit]] * (pixel_area_m2 / spp)
+                delta = 0.5 * (path[lit] - dot_rows(pos[lit] - com_body_m, s[lit]))
+                bins = np.clip(((delta - edges[0]) / width).astype(np.int64), 0, nb - 1)
                 flat_m = slot[lit, None] * n_s + np.arange(n_s)[None, :]
                 h = np.bincount(
                     (flat_m * nb + bins[:, None]).ravel(), value.ravel(), minlength=b * n_s * nb
                 )
-                acc.hist[k][v.epochs] += h.reshape(b, n_s, nb)
                 mom = np.bincount(
                     flat_m.ravel(), (value * delta[:, None]).ravel(), minlength=b * n_s
                 )
-                acc.moment[k][v.epochs] += mom.reshape(b, n_s)
+                yield (
+                    np.asarray(h, float).reshape(b, n_s, nb),
+                    np.asarray(mom, float).reshape(b, n_s),
+                )

@@ -30,15 +30,21 @@ With ``max_depth`` > 2 the interreflections are added at their full optical path
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
 from speclight.render import material_channels as channels
 from speclight.render.camera import primary_rays
+from speclight.render.laser_multibounce import multibounce_returns
+from speclight.render.material_channels import ChannelLayout, pixel_contributions
 from speclight.render.raycast import Caster, Hits
-from speclight.render.single import _Layout, _pixel_contributions
+from speclight.render.shading import VisibleHits, dot_rows, half_vectors, mirror_in_sun
 from speclight.target.parts import Target
+
+if TYPE_CHECKING:
+    from speclight.render.session import RenderSession
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
@@ -68,7 +74,7 @@ class LaserLight:
 
 
 @dataclass
-class RangingRender:
+class LaserReturns:
     """Intensity histograms of each light: ``histogram[k]`` (N, S_k, B) [W sr-1 nm-1 per bin],
     ``moment_m[k]`` (N, S_k) [W sr-1 nm-1 m] (sum of intensity x offset), bin edges (B+1,) [m],
     and ``rendered`` (N,) True where the epoch was cast."""
@@ -83,35 +89,7 @@ class RangingRender:
         return np.asarray(self.histogram[k].sum(axis=2))
 
 
-def default_bin_edges_m(target: Target, com_body_m: F64, n_bins: int = 200) -> F64:
-    """Uniform range-offset bins covering every point of the target seen from any side [m]."""
-    centre, radius = target.bounding_sphere()
-    r_max = float(np.linalg.norm(centre - com_body_m) + radius) * 1.001
-    return np.linspace(-r_max, r_max, n_bins + 1)
-
-
-@dataclass
-class _View:
-    """Rays of one batch that see a surface: epoch slot, normal (flipped to the receiver),
-    cosine, ray index and distance, ``(p - c) . o``, part; and the batch's ray origins."""
-
-    epochs: I64
-    ep: I64
-    o: F64
-    n: F64
-    cos_o: F64
-    hit: I64
-    t: F64
-    rel_o: F64
-    part: I64
-    origin: F64
-
-    @property
-    def pixels(self) -> int:
-        return len(self.origin) // len(self.epochs)
-
-
-class RangingAccumulator:
+class LaserReturnAccumulator:
     """Accumulates laser intensity histograms from batches of primary ray hits.
 
     It is the ``on_hits`` callback of :func:`speclight.render.single.geometric_weights`
@@ -131,16 +109,18 @@ class RangingAccumulator:
         samples_per_pixel: int = 1,
         seed: int = 0,
     ) -> None:
-        for m in target.materials:
-            if m.bsdf not in channels.SUPPORTED:
-                raise NotImplementedError(f"bsdf '{m.bsdf}' is not supported for ranging")
+        channels.check_supported(target.materials)
         self.target = target
         self.obs = np.asarray(observer_dir_body, dtype=float)
         self.lights = lights
         self.wl = np.asarray(wavelength_nm, dtype=float)
         self.com = np.zeros(3) if com_body_m is None else np.asarray(com_body_m, dtype=float)
-        self.edges = default_bin_edges_m(target, self.com) if bin_edges_m is None else bin_edges_m
-        self.layout = _Layout(target)
+        if bin_edges_m is None:
+            from speclight.ranging.bins import range_bin_edges_m
+
+            bin_edges_m = range_bin_edges_m(target, self.com)
+        self.edges = np.asarray(bin_edges_m, dtype=float)
+        self.layout = ChannelLayout(target)
         n, nb = len(self.obs), len(self.edges) - 1
         self.hist = [np.zeros((n, len(lt.support), nb)) for lt in lights]
         self.moment = [np.zeros((n, len(lt.support))) for lt in lights]
@@ -184,12 +164,12 @@ class RangingAccumulator:
         t = hits.t_m[hit]
         # (p - c) . o = (origin - c) . o - t: the primary rays travel along -o
         ray0 = np.einsum("bk,bk->b", origin[np.arange(b) * pixels] - self.com, o)
-        view = _View(epochs, ep, o, n, cos_o, hit, t, ray0[ep] - t, hits.part[hit], origin)
+        view = VisibleHits(epochs, ep, o, n, cos_o, hit, t, ray0[ep] - t, hits.part[hit], origin)
         for k, light in enumerate(self.lights):
             self._light(k, light, view)
         self.rendered[epochs] = True
 
-    def _light(self, k: int, light: LaserLight, v: _View) -> None:
+    def _light(self, k: int, light: LaserLight, v: VisibleHits) -> None:
         epochs, o = v.epochs, v.o
         lit_ep = np.all(np.isfinite(light.direction_body[epochs]), axis=1) & np.any(
             light.irradiance_W_m2_nm[epochs] > 0, axis=1
@@ -204,12 +184,12 @@ class RangingAccumulator:
             e_idx = v.ep[idx]
             cos_o = v.cos_o[idx]
             cos_i, cos_h, cos_d = cos_o, cos_o, np.ones_like(cos_o)
-            mirror_cos = 2.0 * cos_o**2 - 1.0
+            mirror_ok = (2.0 * cos_o**2 - 1.0 >= channels.SUN_COS).astype(float)
             delta_px = -v.rel_o[idx]
         else:
-            cos_all = np.einsum("mk,mk->m", v.n, s[v.ep])
+            cos_all = dot_rows(v.n, s[v.ep])
             idx = np.flatnonzero(lit_ep[v.ep] & (cos_all > 0))
-            pos = v.origin[v.hit[idx]] - v.t[idx, None] * o[v.ep[idx]]
+            pos = v.position(idx)
             check = np.flatnonzero(~coaxial[v.ep[idx]])
             if check.size:
                 blocked = self._caster.occluded(pos[check], s[v.ep[idx[check]]], v.n[idx[check]])
@@ -219,19 +199,15 @@ class RangingAccumulator:
             e_idx = v.ep[idx]
             n_i, cos_o = v.n[idx], v.cos_o[idx]
             cos_i = cos_all[idx]
-            half = s + o
-            norm = np.linalg.norm(half, axis=1, keepdims=True)
-            half = np.where(norm > 1e-12, half / np.maximum(norm, 1e-300), s)
-            cos_h = np.einsum("mk,mk->m", n_i, half[e_idx])
-            cos_d = np.einsum("mk,mk->m", s, half)[e_idx]
-            mirror = 2.0 * cos_o[:, None] * n_i - o[e_idx]
-            mirror_cos = np.einsum("mk,mk->m", mirror, s[e_idx])
+            half = half_vectors(s, o)
+            cos_h = dot_rows(n_i, half[e_idx])
+            cos_d = dot_rows(s, half)[e_idx]
+            mirror_ok = mirror_in_sun(n_i, cos_o, o[e_idx], s[e_idx])
             # one-way-equivalent range offset of each lit pixel (module docstring)
-            rel_s = np.einsum("mk,mk->m", pos - self.com, s[e_idx])
+            rel_s = dot_rows(pos - self.com, s[e_idx])
             delta_px = -0.5 * (v.rel_o[idx] + rel_s)
-        mirror_ok = (mirror_cos >= channels.SUN_COS).astype(float)
         mat = self.layout.part_mat[v.part[idx]]
-        rows, chans, w = _pixel_contributions(
+        rows, chans, w = pixel_contributions(
             self.layout, mat, cos_i, cos_o, cos_h, cos_d, mirror_ok
         )
         radius = self.target.bounding_sphere()[1]
@@ -241,9 +217,26 @@ class RangingAccumulator:
                 k, light, epochs, s, o, e_idx[rows], chans, w * pixel_area, delta_px[rows]
             )
         if self.max_depth > 2:
-            from speclight.render.laser_multibounce import add_multibounce
-
-            add_multibounce(self, k, light, v, s, lit_ep, self._caster, pixel_area)
+            sup = light.support
+            increments = multibounce_returns(
+                self.layout,
+                {c: f[:, sup] for c, f in self._plastic.items()},
+                self.wl[sup],
+                v,
+                s,
+                lit_ep,
+                light.irradiance_W_m2_nm[epochs],
+                self._caster,
+                pixel_area,
+                self.com,
+                self.edges,
+                max_depth=self.max_depth,
+                samples_per_pixel=self.samples_per_pixel,
+                seed=(self.seed, int(epochs[0]), k),
+            )
+            for hist, moment in increments:  # in order: the sums are those of one pass
+                self.hist[k][epochs] += hist
+                self.moment[k][epochs] += moment
 
     def _add_single(
         self,
@@ -295,12 +288,12 @@ class RangingAccumulator:
             hits = caster.intersect(origin, direction)
             self(epochs, origin, direction, hits)
 
-    def result(self) -> RangingRender:
+    def result(self) -> LaserReturns:
         """The accumulated histograms."""
-        return RangingRender(self.hist, self.moment, self.edges, self.rendered.copy())
+        return LaserReturns(self.hist, self.moment, self.edges, self.rendered.copy())
 
 
-def render_ranging(
+def render_laser_returns(
     target: Target,
     observer_dir_body: F64,
     lights: list[LaserLight],
@@ -313,7 +306,8 @@ def render_ranging(
     max_depth: int = 2,
     samples_per_pixel: int = 1,
     seed: int = 0,
-) -> RangingRender:
+    session: RenderSession | None = None,
+) -> LaserReturns:
     """Laser intensity histograms over range offset, rendering every epoch itself.
 
     Parameters
@@ -329,25 +323,31 @@ def render_ranging(
     resolution_px
         Image size (square) over the target's bounding sphere.
     variant
-        Mitsuba variant, ``"numpy"`` or ``None`` (automatic), as for ``render_intensity``.
+        Mitsuba variant, ``"numpy"`` or ``None`` (automatic), as for ``render_intensity``;
+        ignored when ``session`` is given.
     bin_edges_m
-        Uniform range-offset bin edges [m] (default :func:`default_bin_edges_m`).
+        Uniform range-offset bin edges [m] (default
+        :func:`speclight.ranging.bins.range_bin_edges_m`, single-bounce span).
     com_body_m
         Centre of mass in the body frame [m] (default: the body-frame origin).
     max_depth, samples_per_pixel, seed
         ``max_depth`` > 2 adds multi-bounce returns at their full path length, traced with
         ``samples_per_pixel`` Monte Carlo paths per pixel from ``seed``
         (:mod:`speclight.render.laser_multibounce`); 2 is single scattering (exact, no noise).
+    session
+        The run's render session (:class:`speclight.render.session.RenderSession`): its
+        variant and ray caster.
 
     Returns
     -------
-    RangingRender
+    LaserReturns
     """
-    from speclight.render.api import make_caster
-    from speclight.render.variant import choose_variant
+    from speclight.render.session import RenderSession
 
-    caster = make_caster(target, choose_variant(variant, spectral=False))
-    acc = RangingAccumulator(
+    if session is None:
+        session = RenderSession.create("single", variant, target.materials)
+    caster = session.caster(target)
+    acc = LaserReturnAccumulator(
         target,
         observer_dir_body,
         lights,
@@ -365,8 +365,7 @@ def render_ranging(
 __all__ = [
     "COAXIAL_RAD",
     "LaserLight",
-    "RangingAccumulator",
-    "RangingRender",
-    "default_bin_edges_m",
-    "render_ranging",
+    "LaserReturnAccumulator",
+    "LaserReturns",
+    "render_laser_returns",
 ]

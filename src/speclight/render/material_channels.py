@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.cache import cached_arrays
+from speclight.errors import InputError
 from speclight.illumination.solar import SOLAR_ANGULAR_RADIUS_RAD
 from speclight.render import rgl
 from speclight.render.brdf import microfacet_weight
@@ -34,8 +35,10 @@ from speclight.render.rgl import is_rgl
 from speclight.target.brdf_table import load_brdf_table
 from speclight.target.materials import Material
 from speclight.target.optical_constants import fresnel_reflectance
+from speclight.target.parts import Target
 
 F64 = NDArray[np.float64]
+I64 = NDArray[np.int64]
 
 
 def sun_disk_sin2() -> float:
@@ -64,6 +67,17 @@ PLASTIC_NODES = 33
 #: Largest coat-index step of the rough-coat tables' index grid (interpolated between).
 COAT_ETA_STEP = 0.01
 SUPPORTED = ("lambertian", "beckmann", "ggx", "specular", "plastic", "measured")
+
+
+def check_supported(materials: tuple[Material, ...] | list[Material]) -> None:
+    """Raise an InputError naming the first material whose ``bsdf`` no render model has."""
+    for m in materials:
+        if m.bsdf not in SUPPORTED:
+            raise InputError(
+                f"material '{m.name}': bsdf '{m.bsdf}' is not known "
+                f"(accepted: {', '.join(SUPPORTED)})",
+                field=f"target.materials.{m.name}.bsdf",
+            )
 
 
 def main_weight(m: Material, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mirror_ok: F64) -> F64:
@@ -343,3 +357,51 @@ def rough_coat_tables(eta: F64, alpha: float) -> tuple[F64, F64]:
 def coat_table_nodes() -> F64:
     """Cosine nodes of the rough-coat transmittance table."""
     return np.maximum(1e-6, np.linspace(0.0, 1.0, COAT_TABLE_NODES))
+
+
+class ChannelLayout:
+    """Channel layout: main channel m for material m, then a block per plastic or RGL material.
+
+    Blocks (:func:`speclight.render.material_block_size`) carry what does not
+    factorise: K*K channels of a plastic's diffuse base, one channel per wavelength node of an
+    RGL file.
+    """
+
+    def __init__(self, target: Target) -> None:
+        self.mats = list(target.materials)
+        self.part_mat = target.part_material_index
+        self.block: dict[int, int] = {}
+        c = len(self.mats)
+        for k, m in enumerate(self.mats):
+            extra = block_size(m)  # plastic base, RGL wavelength nodes
+            if extra:
+                self.block[k] = c
+                c += extra
+        self.n_channels = c
+
+
+def pixel_contributions(
+    layout: ChannelLayout, mat: I64, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mirror_ok: F64
+) -> tuple[I64, I64, F64]:
+    """(pixel position in the input, channel, weight [sr-1]) of every contribution.
+
+    ``mat`` (M,) is each pixel's material index; the cosines are those of
+    :mod:`speclight.render.shading`; ``mirror_ok`` (M,) is 1 where a smooth mirror glints.
+    """
+    rows, chans, weights = [], [], []
+    for k, m in enumerate(layout.mats):
+        sel = np.flatnonzero(mat == k)
+        if sel.size == 0:
+            continue
+        w = main_weight(m, cos_i[sel], cos_o[sel], cos_h[sel], cos_d[sel], mirror_ok[sel])
+        rows.append(sel)
+        chans.append(np.full(sel.size, k))
+        weights.append(w)
+        if k in layout.block:
+            r, c, bw = block_weights(m, cos_i[sel], cos_o[sel], cos_d[sel])
+            rows.append(sel[r])
+            chans.append(layout.block[k] + c)
+            weights.append(bw)
+    if not rows:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
+    return np.concatenate(rows), np.concatenate(chans), np.concatenate(weights)

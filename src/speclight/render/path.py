@@ -30,7 +30,7 @@ from __future__ import annotations
 import tempfile
 from collections.abc import Callable, Iterable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -39,13 +39,16 @@ from speclight.errors import InputError
 from speclight.render import material_channels as channels
 from speclight.render.camera import image_axes, primary_rays
 from speclight.render.path_plastic import base_for_mitsuba, group_bases, index_groups
+from speclight.render.raycast import Caster
 from speclight.render.result import RenderImage
 from speclight.render.rgl import is_rgl, path_bsdf
-from speclight.render.variant import activate
 from speclight.target.materials import Material
 from speclight.target.parts import Target
 from speclight.target.reflectance import Reflectance
 from speclight.wavelength_grid import grid_bin_bounds_nm
+
+if TYPE_CHECKING:
+    from speclight.render.session import RenderSession
 
 F64 = NDArray[np.float64]
 #: Longest path (number of bounces + 1) followed; Russian roulette starts after 5.
@@ -280,7 +283,7 @@ def render_path(
     obs_dir: F64,
     irradiance: F64,
     wavelength_nm: F64,
-    variant: str,
+    session: RenderSession,
     resolution_px: int,
     samples_per_pixel: int,
     seed: int,
@@ -290,16 +293,13 @@ def render_path(
 ) -> tuple[F64, F64, dict[int, RenderImage]]:
     """Intensity (N, L), its standard error (N, L) [W sr-1 nm-1] and kept images.
 
+    ``session``: the run's render session (its spectral variant; its ray caster gives the
+    kept images' depth maps and part indices).
+
     ``solar_disk``: light the target with the finite solar disk (:func:`_sun`) instead of a
     point (directional) Sun, so that smooth mirrors and smooth plastic coats show their glint.
     """
-    if not variant.endswith(("_spectral", "_spectral_polarized")) or variant.endswith("polarized"):
-        raise InputError(
-            f"render.mode 'path' needs a *_spectral variant, got '{variant}' "
-            "(use 'auto', llvm_ad_spectral, cuda_ad_spectral or scalar_spectral)",
-            field="render.variant",
-        )
-    mi = activate(variant)
+    mi = session.activate()  # a *_spectral variant (RenderSession.create checks it)
     # A single wavelength is rendered as a 1 nm wide bin around it.
     lo, hi = grid_bin_bounds_nm(wavelength_nm)
     width = hi - lo
@@ -345,20 +345,25 @@ def render_path(
         err = np.full((n_ep, n_wl), np.nan)
     images = {
         e: _image(
-            e, variant, target, obs_dir[e], resolution_px, a_e / passes / width * irradiance[e]
+            e,
+            session.caster(target),
+            target,
+            obs_dir[e],
+            resolution_px,
+            a_e / passes / width * irradiance[e],
         )
         for e, a_e in acc.items()
     }
     return mean, err, images
 
 
-def _image(e: int, variant: str, target: Target, obs: F64, res: int, radiance: F64) -> RenderImage:
+def _image(
+    e: int, caster: Caster, target: Target, obs: F64, res: int, radiance: F64
+) -> RenderImage:
     """Kept image with a depth map and part indices from orthographic ray casting."""
-    from speclight.render.api import make_caster
-
     centre, radius = target.bounding_sphere()
     origin, direction, pixel_area = primary_rays(centre, radius, obs[None, :], res)
-    hits = make_caster(target, variant).intersect(origin, direction)
+    hits = caster.intersect(origin, direction)
     depth = (hits.t_m - 2.0 * radius).reshape(res, res)
     right, up = image_axes(obs[None, :])
     return RenderImage(

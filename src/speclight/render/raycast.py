@@ -251,3 +251,10 @@ class MitsubaCaster:
         o = origin + scale * normal
         ray = self._rays(o, direction)
         return np.array(self.scene.ray_test(ray), dtype=bool)
+
+
+def make_caster(target: Target, variant: str) -> Caster:
+    """The ray caster for a variant: Mitsuba for llvm/cuda variants, numpy otherwise."""
+    if variant.startswith(("llvm_", "cuda_")):
+        return MitsubaCaster(target, variant)
+    return NumpyCaster(target)

@@ -5,8 +5,10 @@ Both render modes use Mitsuba's own implementation of the Dupuy & Jakob 2018 par
 37(6) 274, doi:10.1145/3272127.3275059), so they share one BRDF:
 
 * path mode puts the plugin in the scene (:func:`path_bsdf`);
-* single mode calls the plugin's ``eval`` for every lit pixel (:func:`pixel_weights`), in a
-  spectral Dr.Jit variant, at the file's wavelength nodes. The plugin interpolates the
+* single mode calls the plugin's ``eval`` for every lit pixel (:func:`pixel_weights`), in the
+  run's spectral Dr.Jit variant (the render session chooses ``*_spectral`` for a target with
+  RGL materials, :mod:`speclight.render.session`, and nothing switches it), at the file's
+  wavelength nodes. The plugin interpolates the
   tabulated spectra linearly in wavelength (and holds them constant outside the file's range),
   so the BRDF at any wavelength is ``sum_j f(lambda_j) h_j(lambda)`` with ``h_j`` the hat
   functions on the nodes (:func:`hat_factor`): the single mode's channel sum reproduces the
@@ -25,8 +27,6 @@ this is Mitsuba's ``blendbsdf`` of the measured BSDF (weight c) with a black one
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
 from functools import cache
 from typing import Any
 
@@ -34,7 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
-from speclight.render.variant import activate, available_variants
+from speclight.render.variant import activate
 from speclight.target.materials import Material
 from speclight.target.rgl_file import is_rgl_path, load_rgl_info
 
@@ -70,39 +70,20 @@ def hat_factor(m: Material, wavelength_nm: F64) -> F64:
     return np.stack([np.interp(wavelength_nm, nodes, row) for row in eye]) * scale(m)
 
 
-def eval_variant() -> str:
-    """Spectral Dr.Jit variant for ``eval``: the current backend if it is one, else the best."""
-    avail = available_variants()  # probes the backends before Mitsuba is imported
-    current = ""
-    if avail:
+def _eval_variant(variant: str | None) -> str:
+    """The variant ``eval`` runs in: ``variant``, or the active one; a vectorised spectral one."""
+    if variant is None:
         import mitsuba as mi
 
-        current = mi.variant() or ""
-    for prefix in ("cuda_ad_", "llvm_ad_"):
-        if current.startswith(prefix) and prefix + "spectral" in avail:
-            return prefix + "spectral"
-    for prefix in ("cuda_ad_", "llvm_ad_"):
-        if prefix + "spectral" in avail:
-            return prefix + "spectral"
-    raise InputError(
-        "RGL .bsdf materials in render.mode 'single' need Mitsuba with a cuda_ad or llvm_ad "
-        f"spectral variant (available: {', '.join(avail) or 'none'}); install Mitsuba and "
-        "libLLVM >= 16, or use render.mode 'path'",
-        field="render.variant",
-    )
-
-
-@contextmanager
-def _using(variant: str) -> Iterator[Any]:
-    """Activate ``variant`` for a block and restore the caller's variant afterwards."""
-    import mitsuba as mi
-
-    previous = mi.variant()
-    try:
-        yield activate(variant)
-    finally:
-        if previous and previous != variant:
-            activate(previous)
+        variant = mi.variant() or ""
+    if not (variant.startswith(("cuda_ad_", "llvm_ad_")) and variant.endswith("_spectral")):
+        raise InputError(
+            "RGL .bsdf materials in render.mode 'single' need Mitsuba with a cuda_ad or llvm_ad "
+            f"spectral variant (the run uses '{variant or 'none'}'); install Mitsuba and "
+            "libLLVM >= 16, or use render.mode 'path'",
+            field="render.variant",
+        )
+    return variant
 
 
 @cache
@@ -128,11 +109,12 @@ def local_directions(cos_i: F64, cos_o: F64, cos_phase: F64) -> tuple[F64, F64]:
     return sun, obs
 
 
-def eval_plugin(path: str, sun_local: F64, obs_local: F64) -> F64:
+def eval_plugin(path: str, sun_local: F64, obs_local: F64, variant: str | None = None) -> F64:
     """``f cos(theta_sun)`` [sr-1] (P, W) of an RGL file at its W wavelength nodes.
 
     Calls Mitsuba's ``measured`` plugin with ``si.wi`` = observer and ``wo`` = Sun (local
-    frames), as its path tracer does.
+    frames), as its path tracer does, in ``variant`` (default: the active variant, which must
+    be a ``cuda_ad_*`` or ``llvm_ad_*`` spectral one; it is never switched).
     """
     nodes = load_rgl_info(path).wavelength_nm
     n_pix, n_wl = len(sun_local), len(nodes)
@@ -142,24 +124,24 @@ def eval_plugin(path: str, sun_local: F64, obs_local: F64) -> F64:
     if n_pix == 0:
         return out
     step = max(1, EVAL_BATCH // n_grp)
-    with _using(eval_variant()) as mi:
-        import drjit as dr
+    mi = activate(_eval_variant(variant))
+    import drjit as dr
 
-        bsdf = _plugin(mi.variant(), path)
-        ctx = mi.BSDFContext()
-        for a in range(0, n_pix, step):
-            n = min(step, n_pix - a)
-            # lanes ordered (pixel, group): each pixel's directions repeated for every group
-            wi = np.repeat(obs_local[a : a + n], n_grp, axis=0).T.astype(np.float32)
-            wo = np.repeat(sun_local[a : a + n], n_grp, axis=0).T.astype(np.float32)
-            wl = np.tile(lam, (n, 1)).T  # (4, n * G)
-            si = dr.zeros(mi.SurfaceInteraction3f, n * n_grp)
-            si.wi = mi.Vector3f(np.ascontiguousarray(wi))
-            si.sh_frame = mi.Frame3f(mi.Vector3f(0.0, 0.0, 1.0))
-            si.wavelengths = mi.Spectrum(np.ascontiguousarray(wl))
-            val = bsdf.eval(ctx, si, mi.Vector3f(np.ascontiguousarray(wo)))
-            v = np.asarray(val, dtype=float).T.reshape(n, 4 * n_grp)  # (pixel, group * 4)
-            out[a : a + n] = v[:, :n_wl]
+    bsdf = _plugin(mi.variant(), path)
+    ctx = mi.BSDFContext()
+    for a in range(0, n_pix, step):
+        n = min(step, n_pix - a)
+        # lanes ordered (pixel, group): each pixel's directions repeated for every group
+        wi = np.repeat(obs_local[a : a + n], n_grp, axis=0).T.astype(np.float32)
+        wo = np.repeat(sun_local[a : a + n], n_grp, axis=0).T.astype(np.float32)
+        wl = np.tile(lam, (n, 1)).T  # (4, n * G)
+        si = dr.zeros(mi.SurfaceInteraction3f, n * n_grp)
+        si.wi = mi.Vector3f(np.ascontiguousarray(wi))
+        si.sh_frame = mi.Frame3f(mi.Vector3f(0.0, 0.0, 1.0))
+        si.wavelengths = mi.Spectrum(np.ascontiguousarray(wl))
+        val = bsdf.eval(ctx, si, mi.Vector3f(np.ascontiguousarray(wo)))
+        v = np.asarray(val, dtype=float).T.reshape(n, 4 * n_grp)  # (pixel, group * 4)
+        out[a : a + n] = v[:, :n_wl]
     return out
 
 

@@ -28,8 +28,10 @@ from numpy.typing import NDArray
 
 from speclight.render import material_channels as channels
 from speclight.render.camera import image_axes, primary_rays
+from speclight.render.material_channels import ChannelLayout, pixel_contributions
 from speclight.render.raycast import Caster
 from speclight.render.result import RenderImage
+from speclight.render.shading import dot_rows, half_vectors, mirror_in_sun
 from speclight.target.parts import Target
 
 F64 = NDArray[np.float64]
@@ -49,50 +51,6 @@ class _Kept:
     up: F64
 
 
-class _Layout:
-    """Channel layout: main channel m for material m, then a block per plastic or RGL material.
-
-    Blocks (:func:`speclight.render.material_channels.block_size`) carry what does not
-    factorise: K*K channels of a plastic's diffuse base, one channel per wavelength node of an
-    RGL file.
-    """
-
-    def __init__(self, target: Target) -> None:
-        self.mats = list(target.materials)
-        self.part_mat = target.part_material_index
-        self.block: dict[int, int] = {}
-        c = len(self.mats)
-        for k, m in enumerate(self.mats):
-            extra = channels.block_size(m)  # plastic base, RGL wavelength nodes
-            if extra:
-                self.block[k] = c
-                c += extra
-        self.n_channels = c
-
-
-def _pixel_contributions(
-    layout: _Layout, mat: I64, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mirror_ok: F64
-) -> tuple[I64, I64, F64]:
-    """(pixel position in the input, channel, weight [sr-1]) of every contribution."""
-    rows, chans, weights = [], [], []
-    for k, m in enumerate(layout.mats):
-        sel = np.flatnonzero(mat == k)
-        if sel.size == 0:
-            continue
-        w = channels.main_weight(m, cos_i[sel], cos_o[sel], cos_h[sel], cos_d[sel], mirror_ok[sel])
-        rows.append(sel)
-        chans.append(np.full(sel.size, k))
-        weights.append(w)
-        if k in layout.block:
-            r, c, bw = channels.block_weights(m, cos_i[sel], cos_o[sel], cos_d[sel])
-            rows.append(sel[r])
-            chans.append(layout.block[k] + c)
-            weights.append(bw)
-    if not rows:
-        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
-    return np.concatenate(rows), np.concatenate(chans), np.concatenate(weights)
-
-
 def geometric_weights(
     target: Target,
     sun_dir: F64,
@@ -103,14 +61,14 @@ def geometric_weights(
     rays_per_batch: int = 1_000_000,
     on_batch: Callable[[int], None] | None = None,
     on_hits: Callable[..., None] | None = None,
-) -> tuple[F64, dict[int, _Kept], float, _Layout]:
+) -> tuple[F64, dict[int, _Kept], float, ChannelLayout]:
     """Channel weights w (N, C) [m² sr-1], kept pixel data, pixel pitch [m] and the layout.
 
     ``on_hits(epochs, origin, direction, hits, caster)``, if given, is called after each
     batch's primary ray cast with the batch's epoch indices (so that other lights, e.g.
     lasers for ranging, reuse the rays: :mod:`speclight.render.laser_returns`).
     """
-    layout = _Layout(target)
+    layout = ChannelLayout(target)
     centre, radius = target.bounding_sphere()
     n_ep, n_ch = len(sun_dir), layout.n_channels
     pixels = resolution_px * resolution_px
@@ -137,15 +95,12 @@ def geometric_weights(
         pos = origin[idx] + hits.t_m[idx, None] * direction[idx]
         idx = idx[~caster.occluded(pos, s[ep[idx]], n[idx])]
         e_idx = ep[idx]
-        half = s + o
-        norm = np.linalg.norm(half, axis=1, keepdims=True)
-        half = np.where(norm > 1e-12, half / np.maximum(norm, 1e-300), s)  # phase 180 deg
-        cos_h = np.einsum("mk,mk->m", n[idx], half[e_idx])
-        cos_d = np.einsum("mk,mk->m", s, half)[e_idx]
-        mirror = 2.0 * cos_o[idx, None] * n[idx] - o[e_idx]
-        mirror_ok = (np.einsum("mk,mk->m", mirror, s[e_idx]) >= channels.SUN_COS).astype(float)
+        half = half_vectors(s, o)
+        cos_h = dot_rows(n[idx], half[e_idx])
+        cos_d = dot_rows(s, half)[e_idx]
+        mirror_ok = mirror_in_sun(n[idx], cos_o[idx], o[e_idx], s[e_idx])
         mat = layout.part_mat[hits.part[idx]]
-        rows, chans, px_w = _pixel_contributions(
+        rows, chans, px_w = pixel_contributions(
             layout, mat, cos_i[idx], cos_o[idx], cos_h, cos_d, mirror_ok
         )
         flat = e_idx[rows] * n_ch + chans
@@ -182,9 +137,7 @@ def render_single(
     on_hits: Callable[..., None] | None = None,
 ) -> tuple[F64, dict[int, RenderImage]]:
     """Intensity (N, L) [W sr-1 nm-1] of valid epochs and the kept images (see module doc)."""
-    for m in target.materials:
-        if m.bsdf not in channels.SUPPORTED:
-            raise NotImplementedError(f"bsdf '{m.bsdf}' is not supported in single mode")
+    channels.check_supported(target.materials)
     keep = list(keep)
     w, kept, pitch, layout = geometric_weights(
         target,
@@ -227,3 +180,38 @@ def render_single(
             up_body=kp.up,
         )
     return intensity, images
+
+
+def material_contributions(
+    target: Target,
+    sun_dir: F64,
+    obs_dir: F64,
+    irradiance: F64,
+    wavelength_nm: F64,
+    caster: Caster,
+    resolution_px: int,
+) -> F64:
+    """Each material's share of the intensity (N, M, L) [W sr-1 nm-1] (see module doc).
+
+    Entry ``[:, k, :]`` is ``E(lambda) * (w_k R_k(lambda) + the block channels of k)`` over
+    the pixels that see material k (``target.materials`` order); the sum over k is the
+    intensity of :func:`render_single` (to rounding).
+    """
+    channels.check_supported(target.materials)
+    w, _, _, layout = geometric_weights(
+        target,
+        sun_dir,
+        obs_dir,
+        caster,
+        resolution_px,
+        rays_per_batch=channels.rays_per_batch(target.materials),
+    )
+    cos_half = np.sqrt(np.clip(0.5 * (1.0 + np.einsum("nk,nk->n", sun_dir, obs_dir)), 0.0, 1.0))
+    out = np.zeros((len(sun_dir), len(layout.mats), len(wavelength_nm)))
+    for k, m in enumerate(layout.mats):
+        out[:, k] = w[:, k, None] * channels.main_factor(m, cos_half, wavelength_nm)
+        if k in layout.block:
+            block = channels.block_factor(m, wavelength_nm)
+            start = layout.block[k]
+            out[:, k] += w[:, start : start + block.shape[0]] @ block
+    return out * irradiance[:, None, :]

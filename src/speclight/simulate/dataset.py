@@ -7,51 +7,46 @@ from typing import Any
 
 import numpy as np
 import xarray as xr
+from numpy.typing import NDArray
 
+from speclight import schema
 from speclight.constants import AU_M
 from speclight.info import engine_versions
 from speclight.scenario import LoadedScenario
-from speclight.simulate import variables as v
 from speclight.simulate.geometry_stage import Geometry
 
 
-def geometry_dataset(geo: Geometry) -> xr.Dataset:
-    """The geometry variables of SPEC section 4 on the ``time`` and ``xyz`` dimensions."""
-    t = ("time",)
-    txyz = ("time", "xyz")
-    data: dict[str, tuple[tuple[str, ...], Any]] = {
-        "range": (t, geo.range_m),
-        "azimuth": (t, geo.azimuth_deg),
-        "elevation": (t, geo.elevation_deg),
-        "phase_angle": (t, geo.phase_angle_deg),
-        "sunlit": (t, geo.sunlit_fraction),
-        "sun_direction_body": (txyz, geo.sun_direction_body),
-        "observer_direction_body": (txyz, geo.observer_direction_body),
-        "phase_vector_body": (txyz, geo.phase_vector_body),
-        "target_position_gcrs": (txyz, geo.r_target_gcrs_m),
-        "sun_distance": (t, geo.sun_distance_m / AU_M),
+def geometry_dataset(geo: Geometry, flags: NDArray[np.uint8] | None = None) -> xr.Dataset:
+    """The geometry variables on the ``time`` and ``xyz`` dimensions.
+
+    ``flags``: the run's flag bits (geometry and later stages), default ``geo.flags``.
+    """
+    data: dict[str, Any] = {
+        "range": geo.range_m,
+        "azimuth": geo.azimuth_deg,
+        "elevation": geo.elevation_deg,
+        "phase_angle": geo.phase_angle_deg,
+        "sunlit": geo.sunlit_fraction,
+        "sun_direction_body": geo.sun_direction_body,
+        "observer_direction_body": geo.observer_direction_body,
+        "phase_vector_body": geo.phase_vector_body,
+        "target_position_gcrs": geo.r_target_gcrs_m,
+        "sun_distance": geo.sun_distance_m / AU_M,
     }
     ds = xr.Dataset(
-        {name: (dims, np.asarray(values), v.attrs(name)) for name, (dims, values) in data.items()},
+        {name: schema.variable(name, np.asarray(values)) for name, values in data.items()},
         coords={"time": ("time", geo.time_utc), "xyz": ("xyz", np.array(["x", "y", "z"]))},
     )
-    ds["attitude_quaternion"] = (
-        ("time", "wxyz"),
-        geo.quaternion_body_to_gcrs,
-        v.attrs("attitude_quaternion"),
-    )
+    ds["attitude_quaternion"] = schema.variable("attitude_quaternion", geo.quaternion_body_to_gcrs)
     ds.coords["wxyz"] = ("wxyz", np.array(["w", "x", "y", "z"]))
-    masks = np.array(sorted(v.FLAG_MEANINGS), dtype=np.uint8)
-    ds["flags"] = (
-        t,
-        geo.flags,
-        {
-            **v.attrs("flags"),
-            "flag_masks": masks,
-            "flag_meanings": " ".join(v.FLAG_MEANINGS[int(m)] for m in masks),
-        },
+    masks = np.array(sorted(schema.FLAG_MEANINGS), dtype=np.uint8)
+    ds["flags"] = schema.variable(
+        "flags",
+        geo.flags if flags is None else flags,
+        flag_masks=masks,
+        flag_meanings=" ".join(schema.FLAG_MEANINGS[int(m)] for m in masks),
     )
-    ds["time"].attrs.update({"long_name": "epoch (UTC)", "standard_name": "time"})
+    ds["time"].attrs.update(schema.COORDINATES["time"])
     return ds
 
 

@@ -11,6 +11,7 @@ from numpy.typing import NDArray
 
 from speclight import attitude as att
 from speclight import orbit
+from speclight import schema as v
 from speclight.constants import C_M_S
 from speclight.errors import InputError
 from speclight.orbit.timescale import time_from_utc
@@ -22,7 +23,6 @@ from speclight.scenario.sections_geometry import (
     TimeGrid,
     TorqueFreeAttitude,
 )
-from speclight.simulate import variables as v
 
 
 @dataclass
@@ -157,19 +157,31 @@ def _at_emission(
     return r_target, ok, np.nan_to_num(tau_s)
 
 
-def compute_geometry(loaded: LoadedScenario) -> Geometry:
-    """Orbit, observer, Sun, shadow and attitude for every epoch of the scenario."""
+def scenario_geometry(
+    loaded: LoadedScenario, time_utc: NDArray[np.datetime64] | None = None
+) -> Geometry:
+    """Orbit, observer, Sun, shadow and attitude for every epoch of the scenario.
+
+    ``time_utc``: UTC epochs to use instead of the scenario's time grid (e.g. the times of a
+    measured light curve), ``datetime64``; the attitude's time origin stays ``time.start``.
+    """
     sc = loaded.scenario
-    time_utc = time_grid(sc.time)
+    start = np.datetime64(sc.time.start.replace(tzinfo=None), "ns")
+    if time_utc is None:
+        time_utc = time_grid(sc.time)
+    else:
+        time_utc = np.asarray(time_utc, dtype="datetime64[ns]").ravel()
+        if time_utc.size == 0:
+            raise InputError("no epochs given", source=loaded.source, field="time_utc")
     t = time_from_utc(time_utc)
-    t_s = (time_utc - time_utc[0]) / np.timedelta64(1, "s")
+    t_s = (time_utc - start) / np.timedelta64(1, "s")
     site = orbit.Site(sc.observer.latitude_deg, sc.observer.longitude_deg, sc.observer.altitude_m)
     trajectory = _trajectory(loaded, time_utc)
     r_target, ok = trajectory(t)
     delay_s = np.zeros(t_s.size)
     if sc.observer.light_time:
         r_target, ok, delay_s = _at_emission(trajectory, time_utc, r_target, ok, site, t)
-    geo = orbit.compute_geometry(
+    geo = orbit.observation_geometry(
         t,
         r_target,
         site,

@@ -6,12 +6,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import xarray as xr
+from numpy.typing import NDArray
 
+from speclight import schema as v
 from speclight.errors import InputError
+from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
-from speclight.simulate import variables as v
 from speclight.simulate.dataset import geometry_dataset, global_attributes
-from speclight.simulate.geometry_stage import Geometry, compute_geometry
+from speclight.simulate.geometry_stage import Geometry, scenario_geometry
 from speclight.simulate.radiometry import (
     atmosphere_transmission,
     instrument_response,
@@ -24,7 +26,8 @@ from speclight.simulate.spectral_dataset import add_images, add_spectral
 
 @dataclass
 class SimulationResult:
-    """The output dataset and the notes a user should read about the run."""
+    """The output dataset, the geometry it was computed on (reusable: see :func:`simulate`)
+    and the notes a user should read about the run."""
 
     dataset: xr.Dataset
     geometry: Geometry
@@ -50,7 +53,13 @@ def _visibility_notes(geo: Geometry) -> list[str]:
     return notes
 
 
-def simulate(loaded: LoadedScenario, progress: bool = False) -> SimulationResult:
+def simulate(
+    loaded: LoadedScenario,
+    progress: bool = False,
+    *,
+    time_utc: NDArray[np.datetime64] | None = None,
+    geometry: Geometry | None = None,
+) -> SimulationResult:
     """Run one scenario through the pipeline.
 
     Parameters
@@ -59,27 +68,47 @@ def simulate(loaded: LoadedScenario, progress: bool = False) -> SimulationResult
         A validated scenario (see :func:`speclight.scenario.load_scenario`).
     progress
         Show progress bars (for terminals).
+    time_utc
+        Simulate at these UTC epochs (``datetime64``, e.g. the times of a measured light
+        curve) instead of the scenario's time grid.
+    geometry
+        Reuse the geometry of an earlier run (``result.geometry``) and run only reflection ->
+        atmosphere -> instrument (and ranging): for the same orbit, attitude and observer with
+        changed materials, bands or render settings, e.g. in a fit. The caller keeps those
+        sections of the scenario unchanged; ``time_utc`` must then be ``None``.
 
     Returns
     -------
     SimulationResult
-        The dataset of SPEC section 4 and notes for the user.
+        The output dataset (see ``docs/scenario.md``) and notes for the user.
     """
+    if geometry is not None and time_utc is not None:
+        raise InputError("give time_utc or geometry, not both", field="time_utc")
     try:
-        return _simulate(loaded, progress)
+        return _simulate(loaded, progress, time_utc, geometry)
     except InputError as exc:
         if exc.source is None:  # say which scenario the bad field is in
             raise InputError(exc.message, source=loaded.source, field=exc.field) from exc
         raise
 
 
-def _simulate(loaded: LoadedScenario, progress: bool) -> SimulationResult:
+def _simulate(
+    loaded: LoadedScenario,
+    progress: bool,
+    time_utc: NDArray[np.datetime64] | None,
+    geometry: Geometry | None,
+) -> SimulationResult:
     sc = loaded.scenario
     target = build_target(loaded) if sc.target is not None else None  # once, and early
-    geo = compute_geometry(loaded)
+    # the one render variant of the run, handed to every render (Sun and lasers)
+    session = (
+        RenderSession.create(sc.render.mode, sc.render.variant, target.materials)
+        if target is not None
+        else None
+    )
+    geo = geometry if geometry is not None else scenario_geometry(loaded, time_utc)
     wavelength_nm = wavelength_grid_nm(sc.spectrum)
-    # None without lasers; sets flag bits
-    setup = prepare_ranging(loaded, geo, wavelength_nm, target=target)
+    setup = prepare_ranging(loaded, geo, wavelength_nm, target, session)  # None without lasers
     reflection = render_reflection(
         loaded,
         geo,
@@ -87,6 +116,7 @@ def _simulate(loaded: LoadedScenario, progress: bool) -> SimulationResult:
         progress=progress,
         on_hits=setup.on_hits_for if setup is not None else None,
         target=target,
+        session=session,
     )
     elevation = np.where(geo.observable, geo.elevation_deg, np.nan)
     transmission = atmosphere_transmission(loaded, wavelength_nm, elevation)
@@ -97,8 +127,14 @@ def _simulate(loaded: LoadedScenario, progress: bool) -> SimulationResult:
         )
     ranging = None
     if setup is not None:
-        ranging = laser_ranging(loaded, geo, wavelength_nm, setup, transmission, radiometry)
-    ds = geometry_dataset(geo)  # after rendering and ranging: they set flag bits
+        ranging = laser_ranging(loaded, geo, setup, transmission, radiometry)
+    # every stage's flag bits: geometry, render, lasers
+    flags = geo.flags.copy()
+    if reflection.flags is not None:
+        flags |= reflection.flags
+    if setup is not None:
+        flags |= setup.flags
+    ds = geometry_dataset(geo, flags)
     ds = add_spectral(ds, wavelength_nm, reflection, transmission, radiometry)
     ds = add_images(ds, reflection.images, reflection.part_names)
     extra: dict[str, str] = {"render_mode": sc.render.mode, "atmosphere_model": sc.atmosphere.model}

@@ -2,10 +2,10 @@
 
 Use from :func:`speclight.simulate.pipeline.simulate`::
 
-    setup = prepare_ranging(loaded, geo, wavelength_nm)           # None without lasers
+    setup = prepare_ranging(loaded, geo, wavelength_nm, target, session)  # None without lasers
     # optional, for speed in single mode: reuse the Sun render's primary rays
     #   render_intensity(..., on_hits=setup.on_hits_for(idx))     # idx: epochs rendered
-    ranging = laser_ranging(loaded, geo, wavelength_nm, setup, transmission, radiometry)
+    ranging = laser_ranging(loaded, geo, setup, transmission, radiometry)
     ds = ranging.add_to(ds)
 
 Per laser and epoch: the transmitter's own range, elevation and body-frame direction
@@ -14,14 +14,14 @@ divergence and range (:mod:`speclight.illumination.laser`); the uplink transmiss
 transmitter's elevation from its own altitude; the line shape on the grid. The target is
 rendered with each laser as light source (:mod:`speclight.render.laser_returns`), and the return is
 carried to the receiver with the downlink transmission, aperture and band response
-(:mod:`speclight.ranging.link`). A laser below its transmitter's horizon contributes nothing at
-that epoch and sets :data:`FLAG_LASER_BELOW_HORIZON`; the run goes on. In ``render.mode: path``
+(:mod:`speclight.ranging.link`; the range bins: :mod:`speclight.ranging.bins`). A laser below
+its transmitter's horizon contributes nothing at that epoch and sets the flag bit
+:data:`~speclight.schema.FLAG_LASER_BELOW_HORIZON` (returned in ``RangingSetup.flags``); the
+run goes on. In ``render.mode: path``
 the interreflections are added at their full optical path length
 (:mod:`speclight.render.laser_multibounce`, Monte Carlo with ``render.samples_per_pixel`` and
 ``render.seed``); single mode is single scattering, exact.
 
-Optional laser fields read when the scenario model has them (defaults in brackets):
-``pointing_offset_arcsec`` [0], ``beam_profile`` ['gaussian'], ``min_elevation_deg`` [0].
 The centre of mass is the body-frame origin.
 """
 
@@ -35,19 +35,19 @@ import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
-from speclight import atmosphere, instrument, orbit
+from speclight import atmosphere, instrument, orbit, schema
 from speclight.errors import InputError
 from speclight.illumination import laser as lz
 from speclight.instrument.photometry import photon_kernel
 from speclight.orbit.timescale import time_from_utc
-from speclight.ranging import band_histograms, transmitter_geometry
-from speclight.render.laser_returns import LaserLight, RangingAccumulator
+from speclight.ranging import link, transmitter_geometry
+from speclight.ranging.bins import RANGE_BINS, range_bin_edges_m
+from speclight.render.laser_returns import LaserLight, LaserReturnAccumulator
 from speclight.render.path import MAX_DEPTH as PATH_MAX_DEPTH
+from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
 from speclight.simulate.geometry_stage import Geometry
 from speclight.simulate.radiometry import Radiometry, atmosphere_params
-from speclight.simulate.reflection import build_target
-from speclight.simulate.variables import FLAG_LASER_BELOW_HORIZON
 from speclight.target import Target
 from speclight.wavelength_grid import grid_bin_bounds_nm
 
@@ -56,7 +56,6 @@ F64 = NDArray[np.float64]
 SUPPORT_THRESHOLD = 1e-9
 #: Smallest fraction of a laser line's energy that must fall inside the spectrum grid.
 MIN_LINE_FRACTION = 0.99
-RANGE_BINS = 200
 
 
 @dataclass
@@ -75,10 +74,13 @@ class LaserSetup:
 
 @dataclass
 class RangingSetup:
-    """Lasers and the render accumulator of one run."""
+    """Lasers, the render accumulator and the render session of one run, and the flag bits
+    (N,) this stage sets (:data:`~speclight.schema.FLAG_LASER_BELOW_HORIZON`)."""
 
     lasers: list[LaserSetup]
-    accumulator: RangingAccumulator
+    accumulator: LaserReturnAccumulator
+    session: RenderSession
+    flags: NDArray[np.uint8]
 
     def on_hits_for(self, epochs: NDArray[np.int64]) -> Callable[..., None]:
         """``on_hits`` callback for a render of ``geo`` epochs ``epochs`` (in that order)."""
@@ -136,9 +138,9 @@ def _laser(loaded: LoadedScenario, geo: Geometry, wl: F64, k: int, t: Any) -> La
             **atmosphere_params(loaded),
         )
         t_up[up] = full[:, support]
-    spectral = np.where(up[:, None], beam[:, None] * shape[support][None, :] * t_up, 0.0)
+    spectral = link.uplink_spectral_irradiance(beam, shape[support], t_up, up)
     lo, hi = grid_bin_bounds_nm(wl)
-    irradiance = np.where(geo.orbit_ok, spectral @ (hi - lo)[support], np.nan)
+    irradiance = link.uplink_irradiance_W_m2(spectral, (hi - lo)[support], geo.orbit_ok)
     direction = np.where(up[:, None], tx.direction_body, np.nan)
     return LaserSetup(
         cfg.name,
@@ -155,45 +157,37 @@ def prepare_ranging(
     loaded: LoadedScenario,
     geo: Geometry,
     wavelength_nm: F64,
+    target: Target | None,
+    session: RenderSession | None,
     range_bins: int = RANGE_BINS,
-    target: Target | None = None,
 ) -> RangingSetup | None:
     """Lasers' geometry and irradiance, and the accumulator; ``None`` without lasers/target.
 
-    ``target``: the scenario's target if already built (else it is built here).
-
-    Sets :data:`FLAG_LASER_BELOW_HORIZON` in ``geo.flags`` where a laser is below its horizon.
+    ``target`` and ``session``: the run's target and render session (built once per run).
     """
     sc = loaded.scenario
-    if not sc.illumination.lasers or sc.target is None:
+    if not sc.illumination.lasers or target is None or session is None:
         return None
     t = time_from_utc(geo.time_utc)
     lasers = [_laser(loaded, geo, wavelength_nm, k, t) for k in range(len(sc.illumination.lasers))]
+    flags = np.zeros(geo.t_s.size, dtype=np.uint8)
     for laser in lasers:
-        geo.flags[geo.orbit_ok & ~laser.above_horizon] |= FLAG_LASER_BELOW_HORIZON
-    if target is None:
-        target = build_target(loaded)
+        flags[geo.orbit_ok & ~laser.above_horizon] |= schema.FLAG_LASER_BELOW_HORIZON
     obs = np.where(geo.observable[:, None], geo.observer_direction_body, np.nan)
     com = np.zeros(3)
-    centre, radius = target.bounding_sphere()
-    r_max = float(np.linalg.norm(centre - com) + radius) * 1.001
     path = sc.render.mode == "path"
-    # one bounce lies within +-r_max; interreflections come later: the last bin of
-    # [-r_max, 3 r_max] in path mode collects the (rare) longer paths
-    n_bins = int(range_bins) * (2 if path else 1)
-    edges = np.linspace(-r_max, (3.0 if path else 1.0) * r_max, n_bins + 1)
-    acc = RangingAccumulator(
+    acc = LaserReturnAccumulator(
         target,
         obs,
         [la.light for la in lasers],
         wavelength_nm,
-        edges,
+        range_bin_edges_m(target, com, range_bins, multibounce=path),
         com,
         max_depth=PATH_MAX_DEPTH if path else 2,
         samples_per_pixel=sc.render.samples_per_pixel,
         seed=sc.render.seed,
     )
-    return RangingSetup(lasers, acc)
+    return RangingSetup(lasers, acc, session, flags)
 
 
 @dataclass
@@ -214,69 +208,33 @@ class RangingResult:
     notes: list[str] = field(default_factory=list)
 
     def add_to(self, ds: xr.Dataset) -> xr.Dataset:
-        """The dataset with the laser and ranging variables (CF units and long names)."""
+        """The dataset with the laser and ranging variables (:mod:`speclight.schema`)."""
         edges = self.range_bin_edges_m
         ds = ds.assign_coords(
             laser=("laser", np.array(self.laser_names, dtype=str)),
             range_bin=("range_bin", 0.5 * (edges[1:] + edges[:-1])),
         )
-        ds["laser"].attrs["long_name"] = "laser transmitter"
-        ds["range_bin"].attrs.update(
-            units="m",
-            long_name="one-way range offset from the centre of mass (bin centre), "
-            "negative = in front",
-            bounds="range_bin_bounds",
-        )
-        ds["range_bin_bounds"] = (("range_bin", "nv"), np.stack([edges[:-1], edges[1:]], 1))
-        tl, tb = ("time", "laser"), ("time", "band")
-        ds["laser_range"] = (tl, self.laser_range_m, _a("m", "transmitter-to-target distance"))
-        ds["laser_elevation"] = (
-            tl,
-            self.laser_elevation_deg,
-            _a("degree", "elevation of the target above the transmitter's horizon"),
-        )
-        ds["laser_irradiance"] = (
-            tl,
-            self.laser_irradiance_W_m2,
-            _a("W m-2", "laser irradiance at the target (mean power, after the uplink)"),
-        )
-        ds["laser_intensity"] = (
-            ("time", "wavelength"),
-            self.laser_intensity_W_sr_nm,
-            _a("W sr-1 nm-1", "radiant intensity of the target toward the observer from lasers"),
-        )
+        ds["laser"].attrs.update(schema.COORDINATES["laser"])
+        ds["range_bin"].attrs.update(schema.COORDINATES["range_bin"])
+        bounds = np.stack([edges[:-1], edges[1:]], 1)
+        ds["range_bin_bounds"] = (schema.BOUNDS["range_bin_bounds"], bounds)
+        ds["laser_range"] = schema.variable("laser_range", self.laser_range_m)
+        ds["laser_elevation"] = schema.variable("laser_elevation", self.laser_elevation_deg)
+        ds["laser_irradiance"] = schema.variable("laser_irradiance", self.laser_irradiance_W_m2)
+        ds["laser_intensity"] = schema.variable("laser_intensity", self.laser_intensity_W_sr_nm)
         if self.band_names:
-            ds["return_photons_per_pulse"] = (
-                ("time", "laser", "band"),
-                self.return_per_pulse,
-                _a("1", "detected return photo-electrons per laser pulse"),
+            ds["return_photons_per_pulse"] = schema.variable(
+                "return_photons_per_pulse", self.return_per_pulse
             )
-            ds["return_rate"] = (
-                tb,
-                self.return_rate_per_s,
-                _a("s-1", "detected laser return photo-electrons per second, all lasers"),
-            )
-            ds["range_histogram"] = (
-                ("time", "band", "range_bin"),
-                self.range_histogram_per_s,
-                _a("s-1", "detected laser return photo-electrons per second per range bin"),
-            )
-            ds["range_offset"] = (
-                tb,
-                self.range_offset_m,
-                _a("m", "mean return range minus range to the centre of mass (one-way)"),
-            )
+            ds["return_rate"] = schema.variable("return_rate", self.return_rate_per_s)
+            ds["range_histogram"] = schema.variable("range_histogram", self.range_histogram_per_s)
+            ds["range_offset"] = schema.variable("range_offset", self.range_offset_m)
         return ds
-
-
-def _a(units: str, long_name: str) -> dict[str, str]:
-    return {"units": units, "long_name": long_name}
 
 
 def laser_ranging(
     loaded: LoadedScenario,
     geo: Geometry,
-    wavelength_nm: F64,
     setup: RangingSetup,
     transmission: F64,
     radiometry: Radiometry | None,
@@ -285,8 +243,8 @@ def laser_ranging(
 
     Parameters
     ----------
-    loaded, geo, wavelength_nm
-        The run's scenario, geometry and grid [nm].
+    loaded, geo
+        The run's scenario and geometry.
     setup
         From :func:`prepare_ranging` (its accumulator may already hold the shared-ray epochs).
     transmission
@@ -294,24 +252,19 @@ def laser_ranging(
     radiometry
         The instrument curves (band response, optics, QE); ``None``: no band outputs.
     """
-    from speclight.render.api import make_caster
-    from speclight.render.variant import choose_variant
-
     sc = loaded.scenario
     acc = setup.accumulator
+    wavelength_nm = acc.wl
     if np.any(acc.active & ~acc.rendered):
-        caster = make_caster(acc.target, choose_variant(sc.render.variant, spectral=False))
-        acc.finish(caster, sc.render.resolution_px)
+        acc.finish(setup.session.caster(acc.target), sc.render.resolution_px)
     rr = acc.result()
     n, n_wl, k_las = geo.t_s.size, wavelength_nm.size, len(setup.lasers)
     obs = geo.observable
     intensity = np.zeros((n, n_wl))
+    for k, laser in enumerate(setup.lasers):
+        intensity[:, laser.light.support] += rr.intensity_W_sr_nm(k)
     bands = radiometry.band_names if radiometry is not None else []
-    n_b, n_bins = len(bands), len(rr.bin_edges_m) - 1
-    per_pulse = np.zeros((n, k_las, n_b))
-    hist = np.zeros((n, n_b, n_bins))
-    moment = np.zeros((n, n_b))
-    total = np.zeros((n, n_b))
+    n_bins = len(rr.bin_edges_m) - 1
     if radiometry is not None:
         area = instrument.aperture_area_m2(
             sc.telescope.aperture_diameter_m, sc.telescope.obstruction_diameter_m
@@ -324,23 +277,24 @@ def laser_ranging(
             np.ones(n_wl),
             radiometry.band_response * radiometry.qe,
         )
-    for k, laser in enumerate(setup.lasers):
-        sup = laser.light.support
-        i_k = rr.intensity_W_sr_nm(k)
-        intensity[:, sup] += i_k
-        if radiometry is None:
-            continue
-        with np.errstate(invalid="ignore"):
-            down = np.where(obs[:, None], transmission[:, sup], 0.0)
-            down = np.nan_to_num(down) * area / np.where(obs, geo.range_m, 1.0)[:, None] ** 2
-        conv = down[:, :, None] * kernel[:, sup].T[None, :, :]  # (N, S, B) [s-1 per W sr-1 nm-1]
-        rate = np.einsum("ns,nsb->nb", i_k, conv)
-        per_pulse[:, k] = rate / laser.repetition_rate_hz
-        hist += band_histograms(rr.histogram[k], conv)
-        moment += np.einsum("ns,nsb->nb", rr.moment_m[k], conv)
-        total += rate
-    with np.errstate(invalid="ignore", divide="ignore"):
-        offset = np.where(total > 0, moment / total, np.nan)
+        conversions = [
+            link.downlink_conversion(
+                transmission[:, la.light.support],
+                obs,
+                geo.range_m,
+                area,
+                kernel[:, la.light.support],
+            )
+            for la in setup.lasers
+        ]
+        returns = link.receiver_returns(
+            rr.histogram, rr.moment_m, conversions, [la.repetition_rate_hz for la in setup.lasers]
+        )
+        per_pulse, total = returns.per_pulse, returns.rate_per_s
+        hist, offset = returns.histogram_per_s, returns.offset_m
+    else:
+        per_pulse, total = np.zeros((n, k_las, 0)), np.zeros((n, 0))
+        hist, offset = np.zeros((n, 0, n_bins)), np.zeros((n, 0))
     nan_rows = ~obs
     intensity[nan_rows] = np.nan
     per_pulse[nan_rows] = np.nan

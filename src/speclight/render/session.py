@@ -1,0 +1,84 @@
+"""The render session of a run: the one Mitsuba variant and the ray casters every render uses.
+
+Mitsuba's variant is process-wide state. A run chooses it once, from the render mode and the
+target's materials, and hands the session to the Sun render, the laser render and everything
+else, so that no stage can switch it during the run:
+
+* ``path`` mode and RGL measured materials need a spectral variant (``*_spectral``);
+* single mode without them casts rays only, and the ``*_rgb`` variant is enough;
+* without Mitsuba (or with ``render.variant: numpy``) single mode casts rays with numpy.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from typing import Literal
+
+from speclight.errors import InputError
+from speclight.render.raycast import Caster, make_caster
+from speclight.render.rgl import is_rgl
+from speclight.render.variant import activate, choose_variant
+from speclight.target.materials import Material
+from speclight.target.parts import Target
+
+RenderMode = Literal["single", "path"]
+
+
+@dataclass
+class RenderSession:
+    """The variant chosen for a run, and its ray casters (one per target, built once).
+
+    Build it with :meth:`create`; ``variant`` is e.g. ``llvm_ad_rgb``, ``llvm_ad_spectral``,
+    ``scalar_spectral`` or ``numpy``.
+    """
+
+    mode: RenderMode
+    variant: str
+    _casters: dict[int, tuple[Target, Caster]] = field(default_factory=dict, repr=False)
+
+    @classmethod
+    def create(
+        cls, mode: str, requested: str | None, materials: Iterable[Material]
+    ) -> RenderSession:
+        """Choose the variant for ``mode`` and the target's ``materials``.
+
+        ``requested``: the scenario's ``render.variant`` (``None``/``"auto"`` for the best one).
+        """
+        if mode not in ("single", "path"):
+            raise InputError(
+                f"render.mode = '{mode}' must be 'single' or 'path'", field="render.mode"
+            )
+        rgl = any(is_rgl(m) for m in materials)
+        variant = choose_variant(requested, spectral=mode == "path" or rgl)
+        spectral = variant.endswith("_spectral")
+        if mode == "path" and not spectral:
+            raise InputError(
+                f"render.mode 'path' needs a *_spectral variant, got '{variant}' "
+                "(use 'auto', llvm_ad_spectral, cuda_ad_spectral or scalar_spectral)",
+                field="render.variant",
+            )
+        if mode == "single" and rgl and not (spectral and variant.startswith(("llvm_", "cuda_"))):
+            raise InputError(
+                "RGL .bsdf materials in render.mode 'single' need Mitsuba with a cuda_ad or "
+                f"llvm_ad spectral variant (render.variant is '{variant}'); install Mitsuba and "
+                "libLLVM >= 16, or use render.mode 'path'",
+                field="render.variant",
+            )
+        return cls(mode, variant)  # type: ignore[arg-type]
+
+    @property
+    def uses_mitsuba(self) -> bool:
+        """True when the variant is a Mitsuba one (not the numpy fallback)."""
+        return self.variant != "numpy"
+
+    def activate(self):  # type: ignore[no-untyped-def]
+        """Activate the session's variant and return the ``mitsuba`` module."""
+        return activate(self.variant)
+
+    def caster(self, target: Target) -> Caster:
+        """The ray caster of ``target`` in the session's variant (built once per target)."""
+        key = id(target)  # the target is kept with its caster, so the id stays its own
+        if key not in self._casters:
+            self._casters[key] = (target, make_caster(target, self.variant))
+        return self._casters[key][1]

@@ -1,0 +1,174 @@
+"""The output dataset's schema: every variable's dimensions, units and long name, in one place.
+
+``speclight.simulate`` writes its dataset through this module (:func:`variable`,
+:func:`coordinate`), and the readers (``speclight.plot``, the coming ``speclight.estimate``)
+read names, units and flag bits from it, so that a variable is described once.
+Units follow CF / UDUNITS spelling (``W sr-1 nm-1``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+T, TW, TB, TXYZ = ("time",), ("time", "wavelength"), ("time", "band"), ("time", "xyz")
+TL = ("time", "laser")
+IMG = ("image_time", "y", "x")
+
+
+@dataclass(frozen=True)
+class VariableInfo:
+    """Dimensions, CF units and long name of one output variable."""
+
+    dims: tuple[str, ...]
+    units: str
+    long_name: str
+    standard_name: str | None = None
+
+
+V = VariableInfo
+VARIABLES: dict[str, VariableInfo] = {
+    # geometry (time)
+    "range": V(T, "m", "distance from the observer to the target"),
+    "azimuth": V(T, "degree", "topocentric azimuth of the target, east of north"),
+    "elevation": V(T, "degree", "topocentric elevation of the target above the horizon"),
+    "phase_angle": V(
+        T, "degree", "angle between the target-to-Sun and target-to-observer directions"
+    ),
+    "sunlit": V(T, "1", "fraction of the solar disk visible from the target"),
+    "sun_direction_body": V(TXYZ, "1", "unit vector from the target to the Sun, body frame"),
+    "observer_direction_body": V(
+        TXYZ, "1", "unit vector from the target to the observer, body frame"
+    ),
+    "phase_vector_body": V(
+        TXYZ, "1", "unit bisector of the Sun and observer directions, body frame"
+    ),
+    "target_position_gcrs": V(TXYZ, "m", "geocentric target position, GCRS"),
+    "sun_distance": V(T, "au", "distance from the target to the Sun"),
+    "attitude_quaternion": V(
+        ("time", "wxyz"), "1", "body-to-GCRS rotation quaternion, scalar first (w, x, y, z)"
+    ),
+    "flags": V(T, "1", "why an epoch is not fully observable (bit mask)"),
+    # spectra and bands
+    "solar_irradiance": V(
+        TW, "W m-2 nm-1", "solar spectral irradiance at the target (before shadowing)"
+    ),
+    "intensity": V(
+        TW,
+        "W sr-1 nm-1",
+        "radiant intensity of the target toward the observer, above the atmosphere",
+    ),
+    "transmission": V(TW, "1", "atmospheric direct-beam transmission along the line of sight"),
+    "spectral_flux": V(TW, "W nm-1", "spectral power entering the telescope aperture"),
+    "count_rate": V(TB, "s-1", "detected photo-electrons per second in each band"),
+    "ab_magnitude": V(TB, "mag", "AB magnitude of the in-band irradiance at the aperture"),
+    "intensity_std": V(
+        TW, "W sr-1 nm-1", "Monte Carlo standard error of the intensity (0 in single mode)"
+    ),
+    "count_rate_measured": V(
+        TB, "s-1", "simulated background-subtracted measurement of the count rate (noisy)"
+    ),
+    "band_response": V(("band", "wavelength"), "1", "relative spectral response of each band"),
+    "optics_transmission": V(("wavelength",), "1", "transmission of the telescope optics"),
+    "detector_qe": V(("band", "wavelength"), "1", "detector quantum efficiency"),
+    # saved images
+    "image_radiance": V(
+        (*IMG, "wavelength"), "W m-2 sr-1 nm-1", "reflected spectral radiance per pixel"
+    ),
+    "image_depth": V(
+        IMG, "m", "distance along the line of sight behind the plane through the target centre"
+    ),
+    "image_part": V(IMG, "1", "index of the target part seen in each pixel (-1: none)"),
+    "image_pixel_size": V(("image_time",), "m", "pixel pitch at the target"),
+    "image_right_body": V(
+        ("image_time", "xyz"), "1", "body-frame direction of the image's right axis"
+    ),
+    "image_up_body": V(("image_time", "xyz"), "1", "body-frame direction of the image's up axis"),
+    # lasers and ranging
+    "laser_range": V(TL, "m", "transmitter-to-target distance"),
+    "laser_elevation": V(TL, "degree", "elevation of the target above the transmitter's horizon"),
+    "laser_irradiance": V(
+        TL, "W m-2", "laser irradiance at the target (mean power, after the uplink)"
+    ),
+    "laser_intensity": V(
+        TW, "W sr-1 nm-1", "radiant intensity of the target toward the observer from lasers"
+    ),
+    "return_photons_per_pulse": V(
+        ("time", "laser", "band"), "1", "detected return photo-electrons per laser pulse"
+    ),
+    "return_rate": V(TB, "s-1", "detected laser return photo-electrons per second, all lasers"),
+    "range_histogram": V(
+        ("time", "band", "range_bin"),
+        "s-1",
+        "detected laser return photo-electrons per second per range bin",
+    ),
+    "range_offset": V(TB, "m", "mean return range minus range to the centre of mass (one-way)"),
+}
+
+#: Attributes of the coordinates.
+COORDINATES: dict[str, dict[str, str]] = {
+    "time": {"long_name": "epoch (UTC)", "standard_name": "time"},
+    "wavelength": {
+        "units": "nm",
+        "long_name": "wavelength (bin centre)",
+        "standard_name": "wavelength",
+    },
+    "band": {"long_name": "photometric band"},
+    "image_time": {"long_name": "epochs whose images are saved"},
+    "laser": {"long_name": "laser transmitter"},
+    "range_bin": {
+        "units": "m",
+        "long_name": "one-way range offset from the centre of mass (bin centre), "
+        "negative = in front",
+        "bounds": "range_bin_bounds",
+    },
+}
+
+#: CF boundary variables (no attributes of their own: they take their coordinate's units).
+BOUNDS: dict[str, tuple[str, ...]] = {"range_bin_bounds": ("range_bin", "nv")}
+
+# Bits of the ``flags`` variable (CF flag_masks / flag_meanings).
+FLAG_ORBIT_FAILED = 1
+FLAG_BELOW_MIN_ELEVATION = 2
+FLAG_IN_SHADOW = 4
+FLAG_PENUMBRA = 8
+FLAG_RENDER_FAILED = 16
+FLAG_LASER_BELOW_HORIZON = 32
+
+FLAG_MEANINGS = {
+    FLAG_ORBIT_FAILED: "orbit_failed",
+    FLAG_BELOW_MIN_ELEVATION: "below_min_elevation",
+    FLAG_IN_SHADOW: "in_earth_shadow",
+    FLAG_PENUMBRA: "in_penumbra",
+    FLAG_RENDER_FAILED: "render_failed",
+    FLAG_LASER_BELOW_HORIZON: "laser_below_horizon",
+}
+#: Epochs with any of these bits have no measurement of the Sun's reflection.
+NOT_OBSERVABLE = FLAG_ORBIT_FAILED | FLAG_BELOW_MIN_ELEVATION | FLAG_IN_SHADOW | FLAG_RENDER_FAILED
+
+
+def attrs(name: str) -> dict[str, str]:
+    """CF attributes (units, long name, standard name) of an output variable."""
+    info = VARIABLES[name]
+    out = {"units": info.units, "long_name": info.long_name}
+    if info.standard_name:
+        out["standard_name"] = info.standard_name
+    return out
+
+
+def variable(name: str, data: Any, **extra_attrs: Any) -> tuple[tuple[str, ...], Any, dict]:
+    """``(dims, data, attrs)`` of an output variable, for ``ds[name] = variable(name, data)``."""
+    return VARIABLES[name].dims, data, {**attrs(name), **extra_attrs}
+
+
+def units(name: str) -> str:
+    """CF units of a variable or coordinate (``""`` if it has none)."""
+    if name in VARIABLES:
+        return VARIABLES[name].units
+    return COORDINATES.get(name, {}).get("units", "")
+
+
+def label(name: str) -> str:
+    """An axis label: the long name and the units in brackets."""
+    info = VARIABLES[name]
+    return f"{info.long_name} [{info.units}]"
