@@ -141,7 +141,7 @@ def test_bistatic_transmitter_lights_the_sphere_at_its_own_phase_angle():
     ],
 )
 def test_bad_laser_inputs_are_refused(field, value, match):
-    # the scenario model refuses some at load time; the stage checks the physics itself
+    # the scenario model refuses the physics at load time, the stage the line outside the grid
     with pytest.raises(InputError, match=match) as err:
         _run(_scenario([_laser(**{field: value})]))
     assert field in str(err.value)

@@ -148,6 +148,12 @@ def _choice(key: str, value: Any, choices: Sequence[str]) -> str:
     return found
 
 
+def model_keys(model: str, fields: Any) -> tuple[str, ...]:
+    """The parameters of ``model`` that ``fields`` (e.g. a scenario model class) has."""
+    names = getattr(fields, "model_fields", fields)
+    return tuple(k for k in _ALLOWED[model] if k in names)
+
+
 def check_model(model: str) -> AtmosphereModel:
     """Return ``model`` if it is a known atmosphere model name, else raise InputError."""
     if model not in MODELS:

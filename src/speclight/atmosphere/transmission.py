@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from speclight.atmosphere.params import AtmosphereModel, check_model, parse_params
+from speclight.atmosphere.params import AtmosphereModel, AtmosphereParams, check_model, parse_params
 from speclight.atmosphere.sixs import SixSUnavailable, sixs_transmission
 from speclight.atmosphere.spectrl2 import spectrl2_transmission
 from speclight.atmosphere.table import table_transmission
@@ -21,7 +21,8 @@ def transmission(
     wavelength_nm: ArrayLike,
     elevation_deg: ArrayLike,
     site_altitude_m: float,
-    **params: Any,
+    params: AtmosphereParams | None = None,
+    **keywords: Any,
 ) -> NDArray[np.float64]:
     """Direct-beam transmission spectrum along each line of sight.
 
@@ -36,7 +37,10 @@ def transmission(
         Elevation of the target above the observer's horizon (N,) [deg].
     site_altitude_m
         Observer altitude above mean sea level [m].
-    **params
+    params
+        Parameters already validated by :func:`~speclight.atmosphere.params.parse_params`
+        (the scenario layer does this once); or give them as keywords instead.
+    **keywords
         Model parameters, see :class:`speclight.atmosphere.params.AtmosphereParams`:
         ``water_vapour_cm`` (1.42), ``ozone_atm_cm`` (0.344), ``aod_500nm`` (0.1),
         ``angstrom_exponent`` (1.14); 6S: ``atmosphere_profile`` ('user'),
@@ -56,7 +60,9 @@ def transmission(
         ``fallback_to_spectrl2`` not set.
     """
     name = check_model(model)
-    p = parse_params(name, params)
+    if params is not None and keywords:
+        raise InputError("give params or keyword parameters, not both", field="atmosphere")
+    p = params if params is not None else parse_params(name, keywords)
     wl = check_wavelength_grid(wavelength_nm)
     el = np.atleast_1d(np.asarray(elevation_deg, dtype=np.float64))
     if el.ndim != 1:

@@ -1,8 +1,10 @@
-"""The one place that chooses and activates a Mitsuba / Dr.Jit variant.
+"""Which Mitsuba / Dr.Jit variants work here, the order of preference, and activation.
 
-Mitsuba's ``set_variant`` is process-wide state; every render call goes through
-:func:`activate`, so two call sites can never disagree. Order of preference: ``cuda_ad_*`` if a
-CUDA GPU works, ``llvm_ad_*`` if a usable libLLVM (>= 16) is found, else ``scalar_*``.
+Mitsuba's ``set_variant`` is process-wide state. A run chooses its variant once, in
+:class:`speclight.render.session.RenderSession` (the only caller of :func:`choose_variant`
+besides ``speclight info``), and every render of the run activates that same variant through
+:func:`activate`. Order of preference: ``cuda_ad_*`` if a CUDA GPU works, ``llvm_ad_*`` if a
+usable libLLVM (>= 16) is found, else ``scalar_*``.
 libLLVM must be chosen before Dr.Jit is first imported (``DRJIT_LIBLLVM_PATH``); version 15
 crashes Mitsuba's LLVM variants and is never used.
 """

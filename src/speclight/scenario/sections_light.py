@@ -8,7 +8,15 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, Discriminator, Field, Tag, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    Discriminator,
+    Field,
+    PrivateAttr,
+    Tag,
+    field_validator,
+    model_validator,
+)
 
 from speclight.scenario.sections_geometry import Strict, Vector3
 
@@ -227,6 +235,21 @@ class Laser(Strict):
         default=0.0, ge=-5, le=90, description="The transmitter's own horizon limit [deg]"
     )
 
+    @model_validator(mode="after")
+    def _physics(self) -> Laser:
+        # the rules of speclight.illumination.laser, applied once here (a divergence below the
+        # diffraction limit is an angle in the wrong unit); later stages take the values as is
+        from speclight.errors import InputError
+        from speclight.illumination import laser as lz
+
+        try:
+            lz.check_power_w(self.power_w)
+            lz.check_repetition_rate_hz(self.repetition_rate_hz)
+            lz.check_divergence_arcsec(self.divergence_arcsec, self.wavelength_nm)
+        except InputError as exc:
+            raise ValueError(exc.message) from None
+        return self
+
 
 class Illumination(Strict):
     sun: bool = True
@@ -238,11 +261,17 @@ class Illumination(Strict):
 
 
 class Atmosphere(Strict):
+    """The atmosphere model and its parameters.
+
+    The parameters' ranges and names are those of :mod:`speclight.atmosphere.params`, which
+    checks them when the scenario is loaded (:attr:`params`); the stages use the result.
+    """
+
     model: Literal["none", "spectrl2", "6s", "table"] = "spectrl2"
-    water_vapour_cm: float = Field(default=1.42, ge=0, le=10)
-    ozone_atm_cm: float = Field(default=0.344, ge=0, le=1)
-    aod_500nm: float = Field(default=0.1, ge=0, le=5)
-    angstrom_exponent: float = Field(default=1.14, ge=-1, le=4)
+    water_vapour_cm: float = 1.42
+    ozone_atm_cm: float = 0.344
+    aod_500nm: float = 0.1
+    angstrom_exponent: float = 1.14
     atmosphere_profile: str = Field(
         default="user",
         description="6S gas profile; 'user' takes water_vapour_cm and ozone_atm_cm",
@@ -250,12 +279,28 @@ class Atmosphere(Strict):
     aerosol_profile: str = "continental"
     table_file: str | None = None
     fallback_to_spectrl2: bool = False
+    _params: Any = PrivateAttr(default=None)
 
     @model_validator(mode="after")
     def _table(self) -> Atmosphere:
         if self.model == "table" and not self.table_file:
             raise ValueError("model 'table' needs table_file: a CSV of wavelength_nm x airmass")
+        from speclight.atmosphere.params import model_keys, parse_params
+        from speclight.errors import InputError
+
+        try:
+            self._params = parse_params(
+                self.model, {k: getattr(self, k) for k in model_keys(self.model, type(self))}
+            )
+        except InputError as exc:
+            raise ValueError(exc.message) from None
         return self
+
+    @property
+    def params(self) -> Any:
+        """The validated :class:`speclight.atmosphere.params.AtmosphereParams` (paths as
+        written; :func:`speclight.simulate.radiometry.atmosphere_params` resolves them)."""
+        return self._params
 
 
 class Spectrum(Strict):

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from speclight import atmosphere, instrument
+from speclight.atmosphere.params import AtmosphereParams
 from speclight.instrument.curves import DETECTOR_PRESETS
 from speclight.scenario import LoadedScenario
 from speclight.scenario.sections_light import ReflectanceFile, Spectrum
@@ -16,34 +17,17 @@ from speclight.wavelength_grid import grid_from_range_nm
 
 F64 = NDArray[np.float64]
 
-# Atmosphere parameters that each model takes (scenario names are the model's names).
-_ATMOSPHERE_KEYS: dict[str, tuple[str, ...]] = {
-    "none": (),
-    "spectrl2": ("water_vapour_cm", "ozone_atm_cm", "aod_500nm", "angstrom_exponent"),
-    "6s": (
-        "water_vapour_cm",
-        "ozone_atm_cm",
-        "aod_500nm",
-        "angstrom_exponent",
-        "atmosphere_profile",
-        "aerosol_profile",
-        "fallback_to_spectrl2",
-    ),
-    "table": ("table_file",),
-}
-
 
 def wavelength_grid_nm(spectrum: Spectrum) -> F64:
     """Bin centres from ``min_nm`` to ``max_nm`` (included when on the grid) [nm]."""
     return grid_from_range_nm(spectrum.min_nm, spectrum.max_nm, spectrum.step_nm)
 
 
-def atmosphere_params(loaded: LoadedScenario) -> dict[str, Any]:
-    """The scenario's parameters of its atmosphere model (paths resolved)."""
-    cfg = loaded.scenario.atmosphere
-    params: dict[str, Any] = {k: getattr(cfg, k) for k in _ATMOSPHERE_KEYS[cfg.model]}
-    if "table_file" in params:
-        params["table_file"] = loaded.resolve(params["table_file"])
+def atmosphere_params(loaded: LoadedScenario) -> AtmosphereParams:
+    """The scenario's atmosphere parameters (validated at load time), paths resolved."""
+    params: AtmosphereParams = loaded.scenario.atmosphere.params
+    if params.table_file is not None:
+        params = replace(params, table_file=loaded.resolve(str(params.table_file)))
     return params
 
 
@@ -54,7 +38,7 @@ def atmosphere_transmission(loaded: LoadedScenario, wavelength_nm: F64, elevatio
         wavelength_nm,
         elevation_deg,
         loaded.scenario.observer.altitude_m,
-        **atmosphere_params(loaded),
+        params=atmosphere_params(loaded),
     )
 
 

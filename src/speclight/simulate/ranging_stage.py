@@ -113,11 +113,9 @@ def _laser(loaded: LoadedScenario, geo: Geometry, wl: F64, k: int, t: Any) -> La
     cfg = loaded.scenario.illumination.lasers[k]
     where = f"illumination.lasers[{k}]"
     # (simulate() prefixes the scenario file to these messages)
-    power = lz.check_power_w(cfg.power_w, field=f"{where}.power_w")
-    rate = lz.check_repetition_rate_hz(cfg.repetition_rate_hz, f"{where}.repetition_rate_hz")
-    theta = lz.check_divergence_arcsec(
-        cfg.divergence_arcsec, cfg.wavelength_nm, f"{where}.divergence_arcsec"
-    )
+    # power, rate and divergence were checked when the scenario was loaded (Laser model)
+    power, rate = cfg.power_w, cfg.repetition_rate_hz
+    theta = cfg.divergence_arcsec * lz.ARCSEC_RAD
     site = orbit.Site(cfg.latitude_deg, cfg.longitude_deg, cfg.altitude_m)
     tx = transmitter_geometry(site, t, geo.r_target_gcrs_m, geo.quaternion_body_to_gcrs)
     min_el = cfg.min_elevation_deg
@@ -135,7 +133,7 @@ def _laser(loaded: LoadedScenario, geo: Geometry, wl: F64, k: int, t: Any) -> La
             wl,
             elev[up],
             cfg.altitude_m,
-            **atmosphere_params(loaded),
+            params=atmosphere_params(loaded),
         )
         t_up[up] = full[:, support]
     spectral = link.uplink_spectral_irradiance(beam, shape[support], t_up, up)

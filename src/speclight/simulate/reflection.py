@@ -5,6 +5,8 @@ from __future__ import annotations
 import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -15,21 +17,71 @@ from speclight.illumination import solar_irradiance_W_m2_nm
 from speclight.render.result import RenderImage
 from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
+from speclight.scenario.sections_light import (
+    Conductor,
+    Dielectric,
+    ReflectanceFile,
+    ReflectancePairs,
+)
+from speclight.scenario.sections_light import Material as MaterialModel
 from speclight.simulate.geometry_stage import Geometry
-from speclight.target import Target, target_from_spec
+from speclight.target import Material, Reflectance, Target
+from speclight.target.from_values import BUILTIN_SHAPES
+from speclight.target.mesh_io import load_mesh
 
 F64 = NDArray[np.float64]
 
 
 def build_target(loaded: LoadedScenario) -> Target:
-    """The scenario's target (shape and materials) in its body frame."""
+    """The scenario's target (shape and materials) in its body frame.
+
+    Built from the validated scenario models (``target.shape``, ``target.materials``): the
+    scenario layer has already checked every key, size and name, so nothing is re-checked.
+    """
     cfg = loaded.scenario.target
     assert cfg is not None
-    shape = cfg.shape.model_dump(exclude_none=True)
-    if cfg.shape.builtin is not None:
-        shape.pop("scale_m_per_unit", None)
-    materials = {name: m.model_dump(exclude_none=True) for name, m in cfg.materials.items()}
-    return target_from_spec(shape, materials, base_dir=loaded.base_dir)
+    mats = {name: _material(loaded, name, m) for name, m in cfg.materials.items()}
+    shape = cfg.shape
+    if shape.mesh_file is not None:
+        files = [shape.mesh_file] if isinstance(shape.mesh_file, str) else shape.mesh_file
+        paths = [loaded.resolve(f) for f in files]
+        return load_mesh(paths, mats, scale_m_per_unit=float(shape.scale_m_per_unit))
+    assert shape.builtin is not None
+    builder, sizes = BUILTIN_SHAPES[shape.builtin]
+    kwargs = {k: getattr(shape, k) for k in sizes if getattr(shape, k) is not None}
+    kwargs = {k: tuple(v) if isinstance(v, list) else v for k, v in kwargs.items()}
+    return builder(materials=mats, **kwargs)  # type: ignore[operator]
+
+
+def _reflectance(loaded: LoadedScenario, spec: Any, field: str) -> Reflectance:
+    """A :class:`Reflectance` from a validated scenario reflectance (number or model)."""
+    if isinstance(spec, ReflectanceFile):
+        return Reflectance.table_file(loaded.resolve(spec.file), field=field)
+    if isinstance(spec, ReflectancePairs):
+        return Reflectance.pairs(spec.wavelength_nm, spec.value, field=field)
+    if isinstance(spec, Conductor):
+        return Reflectance.conductor(spec.conductor)
+    if isinstance(spec, Dielectric):
+        return Reflectance.dielectric(spec.dielectric)
+    return Reflectance.constant(float(spec), field=field)
+
+
+def _material(loaded: LoadedScenario, name: str, m: MaterialModel) -> Material:
+    field = f"target.materials.{name}"
+    table = m.brdf_table
+    if table is not None and Path(table).suffix:  # a file, not a shipped table name
+        table = str(loaded.resolve(table))
+    diffuse = m.diffuse_reflectance
+    return Material(
+        name=name,
+        bsdf=m.bsdf,
+        reflectance=_reflectance(loaded, m.reflectance, f"{field}.reflectance"),
+        roughness=None if m.roughness is None else float(m.roughness),
+        diffuse_reflectance=None
+        if diffuse is None
+        else _reflectance(loaded, diffuse, f"{field}.diffuse_reflectance"),
+        brdf_table=table,
+    )
 
 
 @dataclass

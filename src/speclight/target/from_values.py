@@ -20,7 +20,8 @@ from speclight.target.mesh_io import load_mesh
 from speclight.target.parts import Target
 from speclight.target.reflectance import Reflectance
 
-_BUILTINS = {
+#: Built-in shapes: name -> (builder, its size keywords).
+BUILTIN_SHAPES = {
     "sphere": (shapes.sphere, ("radius_m",)),
     "plate": (shapes.plate, ("width_m", "height_m")),
     "cube": (shapes.cube, ("edge_m",)),
@@ -120,13 +121,13 @@ def target_from_spec(
             scale_m_per_unit=float(shape.get("scale_m_per_unit", 1.0)),
         )
     kind = shape.get("builtin")
-    if kind not in _BUILTINS:
+    if kind not in BUILTIN_SHAPES:
         raise InputError(
-            f"target.shape needs 'builtin' ({', '.join(_BUILTINS)}) or 'mesh_file'; got "
-            f"{kind!r}{did_you_mean(str(kind), _BUILTINS)}",
+            f"target.shape needs 'builtin' ({', '.join(BUILTIN_SHAPES)}) or 'mesh_file'; got "
+            f"{kind!r}{did_you_mean(str(kind), BUILTIN_SHAPES)}",
             field="target.shape.builtin",
         )
-    builder, sizes = _BUILTINS[kind]
+    builder, sizes = BUILTIN_SHAPES[kind]
     _check_keys(shape, ("builtin", *sizes), "target.shape")
     kwargs = {
         k: (tuple(v) if isinstance(v, list) else v) for k, v in shape.items() if k != "builtin"

@@ -1,0 +1,104 @@
+"""Layout rules of the package (docs/design.md), checked on the source itself.
+
+* no import cycles between speclight's modules, counting imports inside functions too
+  (a lazy import hides a cycle from Python, not from the reader);
+* Mitsuba and Dr.Jit are imported only inside ``speclight.render``;
+* the render variant is chosen in one place (``render/session.py`` calls ``choose_variant``);
+* no two modules share a file name (a newcomer can tell them apart), ``__init__`` aside;
+* physical constants are defined once (``speclight.constants``).
+"""
+
+import ast
+import re
+from collections import Counter
+from pathlib import Path
+
+import speclight
+
+ROOT = Path(speclight.__file__).parent
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for path in ROOT.rglob("*.py"):
+        rel = path.relative_to(ROOT.parent).with_suffix("")
+        parts = list(rel.parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        out[".".join(parts)] = path
+    return out
+
+
+def _imports(path: Path, modules: dict[str, Path]) -> set[str]:
+    """speclight modules imported anywhere in the file (a package import counts as its
+    ``__init__``; ``from pkg import name`` counts the submodule when ``name`` is one)."""
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        names = []
+        if isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+        for name in names:
+            if name in modules:
+                found.add(name)
+    return found
+
+
+def test_no_import_cycles():
+    modules = _modules()
+    graph = {m: _imports(p, modules) - {m} for m, p in modules.items()}
+    # a package's __init__ re-exports its modules: importing a module of a package runs the
+    # package's __init__ first, which is not a dependency of the module on its siblings
+    for m in graph:
+        graph[m] = {d for d in graph[m] if not (m.startswith(d + ".") and d != "speclight")}
+    state: dict[str, int] = {}
+    cycles = []
+
+    def visit(m: str, stack: list[str]) -> None:
+        state[m] = 1
+        for d in sorted(graph[m]):
+            if state.get(d) == 1:
+                cycles.append([*stack[stack.index(d) :], d] if d in stack else [m, d])
+            elif d not in state:
+                visit(d, [*stack, d])
+        state[m] = 2
+
+    for m in sorted(graph):
+        if m not in state:
+            visit(m, [m])
+    # package __init__ files re-exporting submodules that import the package are not cycles
+    # of code; keep only cycles between plain modules
+    real = [c for c in cycles if not any(modules[x].name == "__init__.py" for x in c)]
+    assert not real, "import cycles:\n" + "\n".join(" -> ".join(c) for c in real)
+
+
+def test_mitsuba_only_inside_render():
+    pattern = re.compile(r"^\s*(import|from)\s+(mitsuba|drjit)\b", re.M)
+    outside = [
+        str(p.relative_to(ROOT))
+        for p in ROOT.rglob("*.py")
+        if pattern.search(p.read_text()) and p.relative_to(ROOT).parts[0] != "render"
+    ]
+    assert not outside
+
+
+def test_the_variant_is_chosen_in_one_place():
+    callers = [
+        str(p.relative_to(ROOT))
+        for p in ROOT.rglob("*.py")
+        if re.search(r"\bchoose_variant\(", p.read_text())
+    ]
+    # variant.py defines it, session.py chooses the run's variant, info.py reports the default
+    assert sorted(callers) == ["info.py", "render/session.py", "render/variant.py"]
+
+
+def test_module_file_names_are_unique():
+    names = Counter(p.name for p in ROOT.rglob("*.py") if p.name != "__init__.py")
+    assert [n for n, c in names.items() if c > 1] == []
+
+
+def test_physical_constants_are_defined_once():
+    pattern = re.compile(r"(299[_ ]?792[_ ]?458|6\.62607015|149[_ ]?597[_ ]?870)")
+    places = [str(p.relative_to(ROOT)) for p in ROOT.rglob("*.py") if pattern.search(p.read_text())]
+    assert places == ["constants.py"]
