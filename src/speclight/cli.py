@@ -1,7 +1,7 @@
 """The ``speclight`` command line (SPEC section 2).
 
 Exit codes: 0 success, 2 bad input (the message names the file, the field and what is
-accepted), 1 internal error.
+accepted), 1 internal error or an output the file system refused (full disk).
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from typing import Annotated, Any
 import typer
 
 from speclight.errors import InputError
+from speclight.io.output import OutputWriteError
 
 app = typer.Typer(
     add_completion=False,
@@ -35,6 +36,8 @@ def _guarded(func: Callable[[], Any]) -> Any:
         return func()
     except InputError as exc:
         _fail(str(exc), 2)
+    except OutputWriteError as exc:
+        _fail(str(exc), 1)
     except KeyboardInterrupt:
         _fail("interrupted", 130)
     except typer.Exit:
@@ -58,19 +61,26 @@ def simulate(
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing output.")] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")] = False,
 ) -> None:
-    """Run one scenario and write its NetCDF dataset (geometry, spectra, bands) to OUTPUT."""
+    """Run one scenario and write its NetCDF dataset (geometry, spectra, bands) to OUTPUT.
+
+    OUTPUT is claimed before the work starts: a bad folder, the scenario file itself, an
+    existing file without --force, or another run writing it is refused at once (exit 2).
+    """
 
     def run() -> None:
-        from speclight.io.netcdf import check_writable, write_dataset
-        from speclight.scenario import load_example, load_scenario
-        from speclight.simulate import simulate as run_simulation
+        from speclight.io.output import OutputClaim
 
         if (scenario is None) == (example is None):
             raise InputError("give a scenario file or --example NAME (one of them)")
-        check_writable(output, force)
-        loaded = load_example(example) if example else load_scenario(scenario)  # type: ignore[arg-type]
-        result = run_simulation(loaded, progress=sys.stderr.isatty() and not quiet)
-        write_dataset(result.dataset, output, force=force)
+        inputs = {"scenario file": scenario} if scenario is not None else {}
+        with OutputClaim(output, force=force, inputs=inputs) as claim:
+            from speclight.io.netcdf import dataset_bytes
+            from speclight.scenario import load_example, load_scenario
+            from speclight.simulate import simulate as run_simulation
+
+            loaded = load_example(example) if example else load_scenario(scenario)  # type: ignore[arg-type]
+            result = run_simulation(loaded, progress=sys.stderr.isatty() and not quiet)
+            claim.write(dataset_bytes(result.dataset))
         if not quiet:
             for note in result.notes:
                 typer.echo(note)
