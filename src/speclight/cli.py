@@ -1,21 +1,30 @@
 """The ``speclight`` command line (SPEC section 2).
 
 Exit codes: 0 success, 2 bad input (the message names the file, the field and what is
-accepted), 1 internal error.
+accepted), 1 internal error or an output the file system refused (full disk), 128 + N when
+ended by signal N: 130 for Ctrl-C (SIGINT), 143 for SIGTERM, 129 for SIGHUP. An interrupted
+run removes its temporary file and its output lock; one killed by SIGKILL leaves them to be
+removed by the next run writing to the same folder (see :mod:`speclight.io.output`).
 """
 
 from __future__ import annotations
 
+import signal
 import sys
+import threading
 import traceback
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from types import FrameType
 from typing import Annotated, Any
 
 import typer
 
 from speclight.errors import InputError
+from speclight.io.held_signals import INTERRUPTING_SIGNALS
+from speclight.io.output import OutputWriteError
 
 app = typer.Typer(
     add_completion=False,
@@ -25,6 +34,62 @@ app = typer.Typer(
 )
 
 
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP, raised like ``KeyboardInterrupt`` (which ``except Exception`` skips).
+
+    Parameters
+    ----------
+    signum
+        The signal received.
+    """
+
+    def __init__(self, signum: int) -> None:
+        self.signum = signum
+        super().__init__(signal.Signals(signum).name)
+
+
+#: Signals received during this command (a library may drop the exception of one).
+_received: list[int] = []
+
+
+def _on_signal(signum: int, frame: FrameType | None) -> None:
+    _received.append(signum)
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
+    raise Terminated(signum)
+
+
+def _raise_if_signalled() -> None:
+    """Raise for a signal whose exception was dropped (printed as "Exception ignored")."""
+    if _received:
+        _on_signal(_received[0], None)
+
+
+def _quiet_unraisable(unraisable: Any) -> None:
+    if not isinstance(unraisable.exc_value, (KeyboardInterrupt, Terminated)):
+        sys.__unraisablehook__(unraisable)
+
+
+@contextmanager
+def _signals_end_the_run() -> Iterator[None]:
+    """SIGINT, SIGTERM and SIGHUP raise in the block; ignored ones stay ignored (nohup)."""
+    _received.clear()
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {}
+    for signum in INTERRUPTING_SIGNALS:
+        if signal.getsignal(signum) in (signal.SIG_DFL, signal.default_int_handler):
+            previous[signum] = signal.signal(signum, _on_signal)
+    hook, sys.unraisablehook = sys.unraisablehook, _quiet_unraisable
+    try:
+        yield
+    finally:
+        sys.unraisablehook = hook
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
 def _fail(message: str, code: int) -> None:
     typer.echo(f"error: {message}", err=True)
     raise typer.Exit(code)
@@ -32,11 +97,18 @@ def _fail(message: str, code: int) -> None:
 
 def _guarded(func: Callable[[], Any]) -> Any:
     try:
-        return func()
+        with _signals_end_the_run():
+            result = func()
+            _raise_if_signalled()
+            return result
     except InputError as exc:
         _fail(str(exc), 2)
+    except OutputWriteError as exc:
+        _fail(str(exc), 1)
     except KeyboardInterrupt:
-        _fail("interrupted", 130)
+        _fail("interrupted", 128 + signal.SIGINT)
+    except Terminated as exc:
+        _fail(f"terminated by {exc}", 128 + exc.signum)
     except typer.Exit:
         raise
     except Exception:  # an internal error: say so, with the traceback for a bug report
@@ -49,28 +121,36 @@ def simulate(
     scenario: Annotated[
         Path | None, typer.Argument(help="Scenario YAML file (see `speclight example`).")
     ] = None,
-    output: Annotated[Path, typer.Option("--output", "-o", help="Output NetCDF file.")] = Path(
-        "speclight.nc"
-    ),
+    output: Annotated[
+        str, typer.Option("--output", "-o", metavar="FILE", help="Output NetCDF file.")
+    ] = "speclight.nc",
     example: Annotated[
         str | None, typer.Option("--example", help="Run a built-in scenario instead of a file.")
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing output.")] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")] = False,
 ) -> None:
-    """Run one scenario and write its NetCDF dataset (geometry, spectra, bands) to OUTPUT."""
+    """Run one scenario and write its NetCDF dataset (geometry, spectra, bands) to OUTPUT.
+
+    OUTPUT is claimed before the work starts: a bad name or folder, the scenario file itself,
+    an existing file without --force, or another run writing it is refused at once (exit 2).
+    """
 
     def run() -> None:
-        from speclight.io.netcdf import check_writable, write_dataset
-        from speclight.scenario import load_example, load_scenario
-        from speclight.simulate import simulate as run_simulation
+        from speclight.io.output import OutputClaim
 
         if (scenario is None) == (example is None):
             raise InputError("give a scenario file or --example NAME (one of them)")
-        check_writable(output, force)
-        loaded = load_example(example) if example else load_scenario(scenario)  # type: ignore[arg-type]
-        result = run_simulation(loaded, progress=sys.stderr.isatty() and not quiet)
-        write_dataset(result.dataset, output, force=force)
+        inputs = {"scenario file": scenario} if scenario is not None else {}
+        with OutputClaim(output, force=force, inputs=inputs) as claim:
+            from speclight.io.netcdf import dataset_bytes
+            from speclight.scenario import load_example, load_scenario
+            from speclight.simulate import simulate as run_simulation
+
+            loaded = load_example(example) if example else load_scenario(scenario)  # type: ignore[arg-type]
+            result = run_simulation(loaded, progress=sys.stderr.isatty() and not quiet)
+            _raise_if_signalled()
+            claim.write(dataset_bytes(result.dataset))
         if not quiet:
             for note in result.notes:
                 typer.echo(note)
@@ -99,9 +179,9 @@ def example_cmd(
 @app.command()
 def plot(
     dataset: Annotated[Path, typer.Argument(help="A dataset written by `speclight simulate`.")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="Figure file (.png, .pdf).")] = (
-        Path("speclight.png")
-    ),
+    output: Annotated[
+        str, typer.Option("--output", "-o", metavar="FILE", help="Figure file (.png, .pdf).")
+    ] = "speclight.png",
     epoch: Annotated[
         str | None,
         typer.Option(
@@ -123,16 +203,31 @@ def plot(
     force: Annotated[bool, typer.Option("--force", help="Overwrite existing figures.")] = False,
 ) -> None:
     """Plot a dataset: light curves, spectrogram and geometry in OUTPUT; the one-epoch chain,
-    images and ranging figures beside it (OUTPUT-chain.png, ...)."""
+    images and ranging figures beside it (OUTPUT-chain.png, ...).
+
+    OUTPUT is claimed as `simulate` claims its output; none of the figures may be DATASET.
+    """
 
     def run() -> None:
+        from speclight.io.output import FIELD, OutputClaim
         from speclight.plot import plot_files
+        from speclight.plot.figures import KINDS, figure_paths
 
         chosen: int | str | None = epoch
         if epoch is not None and epoch.strip().lstrip("-").isdigit():
             chosen = int(epoch)
         kinds = None if not kind else ["overview", *[k for k in kind if k != "overview"]]
-        written = plot_files(dataset, output, force=force, epoch=chosen, band=band, kinds=kinds)
+        with OutputClaim(output, force=force, inputs={"dataset": dataset}) as claim:
+            for figure in figure_paths(claim.path, KINDS).values():
+                if figure.exists() and figure.samefile(dataset):
+                    raise InputError(
+                        f"the figure {figure} would overwrite the dataset {dataset}; "
+                        "choose another name",
+                        field=FIELD,
+                    )
+            written = plot_files(
+                dataset, claim.path, force=force, epoch=chosen, band=band, kinds=kinds
+            )
         for path in written:
             typer.echo(f"wrote {path}")
 

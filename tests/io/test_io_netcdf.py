@@ -2,6 +2,12 @@
 
 from __future__ import annotations
 
+import errno
+import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +16,7 @@ import xarray as xr
 
 from speclight.errors import InputError
 from speclight.io import write_dataset
+from speclight.io.output import OutputWriteError
 
 
 def _dataset() -> xr.Dataset:
@@ -49,3 +56,68 @@ def test_failed_write_leaves_nothing(tmp_path: Path) -> None:
 def test_missing_folder_is_an_input_error(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="does not exist"):
         write_dataset(_dataset(), tmp_path / "nope" / "a.nc")
+
+
+def test_output_gets_the_usual_permissions(tmp_path: Path) -> None:
+    previous = os.umask(0o022)
+    try:
+        out = write_dataset(_dataset(), tmp_path / "a.nc")
+    finally:
+        os.umask(previous)
+    assert out.stat().st_mode & 0o777 == 0o644
+
+
+def test_full_disk_is_one_clear_error_and_leaves_nothing(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    real_write = os.write
+    calls = []
+
+    def disk_fills_up(fd: int, data: bytes) -> int:
+        calls.append(fd)
+        if len(calls) == 1:
+            return real_write(fd, bytes(data)[:100])  # the first bytes fit
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, "write", disk_fills_up)
+    with pytest.raises(OutputWriteError, match=r"a\.nc: No space left on device; nothing was"):
+        write_dataset(_dataset(), tmp_path / "a.nc")
+    monkeypatch.undo()
+    assert len(calls) >= 2  # the lock's PID, then the data until the disk was full
+    assert list(tmp_path.iterdir()) == []
+
+
+SERIALISE_SLOWLY = """
+import sys
+import numpy as np
+import xarray as xr
+from speclight.io import write_dataset
+
+rng = np.random.default_rng(0)
+ds = xr.Dataset({"v": (("t", "w"), rng.random((1500, 1500)))})  # about 0.4 s to compress
+print("writing", flush=True)
+try:
+    write_dataset(ds, sys.argv[1])
+except KeyboardInterrupt:
+    sys.exit(130)
+print("wrote")
+"""
+
+
+def test_ctrl_c_while_hdf5_writes_is_not_lost(tmp_path: Path) -> None:
+    # h5py drops a KeyboardInterrupt raised in its callbacks ("Exception ignored in ..."):
+    # the write went on and the program ended normally. The interrupt must reach the caller.
+    out = tmp_path / "big.nc"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", SERIALISE_SLOWLY, str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert proc.stdout is not None and proc.stdout.readline() == "writing\n"
+    time.sleep(0.15)
+    proc.send_signal(signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=30)
+    assert proc.returncode == 130, stdout + stderr
+    assert "Exception ignored" not in stderr and "wrote" not in stdout
+    assert list(tmp_path.iterdir()) == []

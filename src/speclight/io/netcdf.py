@@ -1,35 +1,21 @@
 """Write the output dataset as NetCDF4 (CF conventions), atomically.
 
-The file is written to a temporary name beside the target and moved into place only
-when complete, so a failed run never leaves a half-written file; an existing file is
-replaced only when ``force`` is set.
+The dataset is serialised in memory first (HDF5 then never touches the disk, so a full disk
+is an ordinary ``OSError`` instead of a crash inside HDF5) and written by
+:class:`~speclight.io.output.OutputClaim`, which moves the file into place only when
+complete: a failed or interrupted run never leaves a half-written file, and an existing file
+is replaced only when ``force`` is set. The memory needed is about twice the file's size.
 """
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
-from speclight.errors import InputError
-
-
-def check_writable(path: str | Path, force: bool = False) -> Path:
-    """Fail early (before any work) if ``path`` exists and ``force`` is not set."""
-    path = Path(path)
-    if path.exists() and not force:
-        raise InputError(
-            f"{path} exists; choose another name or pass --force to overwrite it",
-            field="--output",
-        )
-    if path.is_dir():
-        raise InputError(f"{path} is a folder; give a file name such as out.nc", field="--output")
-    if not path.parent.exists():
-        raise InputError(f"folder {path.parent} does not exist", field="--output")
-    return path
+from speclight.io.held_signals import hold_signals
+from speclight.io.output import OutputClaim
 
 
 def _encoding(ds: xr.Dataset) -> dict[str, dict[str, object]]:
@@ -40,6 +26,17 @@ def _encoding(ds: xr.Dataset) -> dict[str, dict[str, object]]:
     if "time" in ds.coords:
         enc["time"] = {"units": "microseconds since 1970-01-01T00:00:00", "dtype": np.int64}
     return enc
+
+
+def dataset_bytes(ds: xr.Dataset) -> memoryview:
+    """The NetCDF4 file of ``ds`` (h5netcdf), in memory.
+
+    SIGINT, SIGTERM and SIGHUP are held back while HDF5 writes (it would drop the exception
+    of an interrupt, see :mod:`speclight.io.held_signals`) and act when it is done.
+    """
+    with hold_signals():
+        data = ds.to_netcdf(None, engine="h5netcdf", encoding=_encoding(ds))
+    return memoryview(data)
 
 
 def write_dataset(ds: xr.Dataset, path: str | Path, force: bool = False) -> Path:
@@ -58,14 +55,14 @@ def write_dataset(ds: xr.Dataset, path: str | Path, force: bool = False) -> Path
     -------
     Path
         The written file.
+
+    Raises
+    ------
+    InputError
+        ``path`` exists (without ``force``), is a folder, is in a missing or unwritable
+        folder, or is being written by another run.
+    OutputWriteError
+        The file system refused the write (full disk...); nothing was left behind.
     """
-    path = check_writable(path, force)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        ds.to_netcdf(tmp_name, engine="h5netcdf", encoding=_encoding(ds))
-        os.replace(tmp_name, path)
-    except BaseException:
-        Path(tmp_name).unlink(missing_ok=True)
-        raise
-    return path
+    with OutputClaim(path, force=force) as claim:
+        return claim.write(dataset_bytes(ds))
