@@ -87,6 +87,7 @@ def test_paths_that_are_not_files_are_refused_without_blocking(
         (fifo, "not a regular file"),
         (tmp_path / "missing.csv", "does not exist"),
         (tmp_path / "missing.csv" / "below.csv", "does not exist"),
+        (tmp_path / "nul\0byte.csv", "not a valid path"),
     ]
     if Path("/dev/zero").exists():
         cases.append((Path("/dev/zero"), "not a regular file"))

@@ -64,6 +64,8 @@ def read_user_bytes(path: str | Path, field: str) -> bytes:
         raise InputError(f"file {src!r} does not exist", source=src, field=field) from None
     except OSError as exc:
         raise InputError(f"cannot read {src!r}: {exc.strerror}", source=src, field=field) from None
+    except ValueError:  # a NUL character in the path
+        raise InputError(f"{src!r} is not a valid path", source=src, field=field) from None
     if stat.S_ISDIR(mode):
         raise InputError(f"{src!r} is a folder; give the path of a file", source=src, field=field)
     if not stat.S_ISREG(mode):
