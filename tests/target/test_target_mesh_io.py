@@ -186,7 +186,7 @@ DEGENERATE = {
     "0134-zero-area-faces-only": (
         "v 0 0 0\nv 1 0 0\nv 2 0 0\ng sides\nf 1 2 3\nf 1 1 1\n",
         1.0,
-        r"part 'sides' has no face of positive area \(its 2 faces",
+        r"part 'sides' has no face of positive area \(all its 2 face\(s\)",
     ),
     "0135-all-vertices-identical": (
         "v 0 0 0\nv 0 0 0\nv 0 0 0\ng sides\nf 1 2 3\n",

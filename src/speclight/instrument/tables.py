@@ -21,6 +21,7 @@ bytes that are not UTF-8.
 
 from __future__ import annotations
 
+import codecs
 import os
 import re
 import stat
@@ -94,25 +95,36 @@ def read_user_text(path: str | Path, field: str) -> str:
     """
     data = read_user_bytes(path, field)
     src = str(Path(path).expanduser())
-    nul = data.find(b"\0")
-    if nul >= 0:
-        line = data.count(b"\n", 0, nul) + 1
+    if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
         raise InputError(
-            f"line {line} holds a NUL byte: this is a binary file "
-            "(or UTF-16 text), not a text table; save it as UTF-8 text",
+            "is UTF-16 text (it starts with a UTF-16 byte-order mark); save it as UTF-8 text",
             source=src,
             field=field,
         )
+    if data.startswith(codecs.BOM_UTF8):
+        data = data[len(codecs.BOM_UTF8) :]
+    nul = data.find(b"\0")
     try:
-        return data.decode("utf-8-sig")
+        text, bad = data.decode("utf-8"), -1
     except UnicodeDecodeError as exc:
-        line = data.count(b"\n", 0, exc.start) + 1
+        text, bad = "", exc.start
+    if nul >= 0 and (bad < 0 or nul < bad):
+        line = data.count(b"\n", 0, nul) + 1
         raise InputError(
-            f"line {line} holds byte 0x{data[exc.start]:02x}, which is not UTF-8: this is a "
-            "binary file or another encoding, not a text table; save it as UTF-8 text",
+            f"line {line} holds a NUL byte: this is a binary file (or UTF-16 text), not a "
+            "text table; save it as UTF-8 text",
             source=src,
             field=field,
-        ) from None
+        )
+    if bad >= 0:
+        line = data.count(b"\n", 0, bad) + 1
+        raise InputError(
+            f"line {line} holds byte 0x{data[bad]:02x}, which is not UTF-8: this is a binary "
+            "file or another encoding, not a text table; save it as UTF-8 text",
+            source=src,
+            field=field,
+        )
+    return text
 
 
 def read_table(path: str | Path, field: str) -> tuple[list[str] | None, NDArray[np.float64]]:

@@ -353,8 +353,8 @@ def _checked_part(
     if not good.any():
         raise _fail(
             path,
-            f"part '{name}' has no face of positive area (its {len(f)} faces all have repeated "
-            "or collinear vertices)",
+            f"part '{name}' has no face of positive area (all its {len(f)} face(s) have "
+            "repeated or collinear vertices)",
         )
     if not good.all():
         warnings.warn(
