@@ -84,3 +84,19 @@ def test_table_must_cover_grid_and_name_airmasses(tmp_path: Path) -> None:
     g = write_table(tmp_path / "g.csv", "wavelength_nm, 1.0, 0.5, 4.0", 1.0)
     with pytest.raises(InputError, match="airmass >= 1"):
         transmission("table", GRID_NM, [60.0], 0.0, table_file=g)
+
+
+def test_table_with_nan_or_garbage_is_refused_with_the_line(tmp_path: Path) -> None:
+    # Reproducers fuzz/0314 (a table of 'nan' gave NaN count rates with no flag) and
+    # fuzz/0309 (binary garbage raised UnicodeDecodeError, an internal error).
+    nan = write_table(tmp_path / "nan.csv", "wavelength_nm, 1.0, 2.0, 4.0", 1.0)
+    lines = nan.read_text().splitlines()
+    lines[5] = "390, nan, nan, nan"
+    nan.write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError, match=r"line 6 .*'nan'.*not a finite number") as err:
+        transmission("table", GRID_NM, [60.0], 0.0, table_file=nan)
+    assert err.value.source == str(nan) and err.value.field == "atmosphere.table_file"
+    garbage = tmp_path / "garbage.csv"
+    garbage.write_bytes(bytes.fromhex("1e746b79c84295ebda3c6c5133f46f88"))
+    with pytest.raises(InputError, match=r"garbage\.csv.*byte 0xc8, which is not UTF-8"):
+        transmission("table", GRID_NM, [60.0], 0.0, table_file=garbage)

@@ -1,5 +1,7 @@
 """Reflectance specs, materials, shapes and part-to-material maps."""
 
+import struct
+
 import numpy as np
 import pytest
 
@@ -15,6 +17,8 @@ from speclight.target import (
     refractive_index,
     sphere,
 )
+from speclight.target.brdf_table import load_brdf_table
+from speclight.target.rgl_file import read_tensor_file
 
 
 def test_fresnel_dielectric_normal_incidence_and_grazing():
@@ -83,3 +87,66 @@ def test_shapes_areas_and_part_maps():
         cube(1.0, {"+xx": m, "*": m})
     with pytest.raises(InputError, match="no material for part"):
         cube(1.0, {"+x": m})
+
+
+#: The first bytes of the audit's garbage files (fuzz/0172/refl.csv, fuzz/0191/brdf.csv).
+GARBAGE = bytes.fromhex("1e746b79c84295ebda3c6c5133f46f8860da135bf96ae44a")
+
+
+def test_reflectance_table_file_bad_content_names_file_and_line(tmp_path):
+    # Reproducer fuzz/0172: binary garbage raised UnicodeDecodeError (an internal error).
+    cases = {
+        "garbage.csv": (GARBAGE, r"garbage\.csv.*line 1 holds byte 0xc8, which is not UTF-8"),
+        "nan.csv": (b"wavelength_nm,reflectance\n400,0.5\n600,nan\n", r"line 3 .*not a finite"),
+        "two_headers.csv": (b"wavelength\nreflectance\n400,0.5\n", r"line 2 .*not two numbers"),
+        "one_row.csv": (b"400,0.5\n", r">= 2 .*pairs"),
+    }
+    for name, (content, message) in cases.items():
+        (tmp_path / name).write_bytes(content)
+        with pytest.raises(InputError, match=message) as err:
+            Reflectance.table_file(tmp_path / name, field="target.materials.bus.reflectance")
+        assert err.value.source == str(tmp_path / name)
+        assert err.value.field == "target.materials.bus.reflectance"
+    (tmp_path / "folder.csv").mkdir()
+    with pytest.raises(InputError, match="is a folder"):
+        Reflectance.table_file(tmp_path / "folder.csv")
+    with pytest.raises(InputError, match="finite numbers"):
+        Reflectance.pairs([400, 600], [0.2, float("nan")])
+
+
+def test_brdf_table_bad_content_names_file_and_line(tmp_path):
+    # Reproducer fuzz/0191: binary garbage raised UnicodeDecodeError (an internal error).
+    good = ["0 0 10 180 0.3", "10 0 20 180 0.2", "20 0 30 180 0.1", "30 0 0 180 0.1"]
+    cases = {
+        "garbage.csv": (GARBAGE, r"line 1 holds byte 0xc8, which is not UTF-8"),
+        "nan.csv": ("\n".join(["# lambda = 532 nm", *good[:2], "20 0 30 180 nan"]).encode(),
+                    r"line 4 '20 0 30 180 nan' is not 5 finite numbers"),
+        "text.csv": ("\n".join([*good, "a b c d e"]).encode(), r"line 5 'a b c d e'"),
+        "short.csv": ("\n".join(good[:2]).encode(), r"at least 3 rows.*found 2"),
+        "negative.csv": ("\n".join([*good, "5 0 5 180 -1"]).encode(), r"line 5.*must be >= 0"),
+        # Every sample at theta_h = theta_d = 5 deg, i.e. one point: no area to interpolate.
+        "one_point.csv": ("\n".join(["0 0 10 180 0.3"] * 3).encode(), r"do not span an area"),
+    }  # fmt: skip
+    for name, (content, message) in cases.items():
+        (tmp_path / name).write_bytes(content)
+        with pytest.raises(InputError, match=message) as err:
+            load_brdf_table(str(tmp_path / name))
+        assert err.value.source == str(tmp_path / name)
+    (tmp_path / "folder.csv").mkdir()
+    with pytest.raises(InputError, match="is a folder"):
+        load_brdf_table(str(tmp_path / "folder.csv"))
+
+
+def test_tensor_file_with_a_lying_shape_is_refused(tmp_path):
+    # A field of 2**40 x 2**40 floats: the product overflowed int64 to 0 and numpy then
+    # failed to reshape (a ValueError, an internal error) instead of reporting truncation.
+    header = b"tensor_file\0" + bytes([1, 0]) + struct.pack("<I", 1)
+    header += struct.pack("<H", 7) + b"spectra" + struct.pack("<HBQ", 2, 10, 0)
+    header += struct.pack("<2Q", 2**40, 2**40)
+    f = tmp_path / "lying.bsdf"
+    f.write_bytes(header)
+    with pytest.raises(InputError, match="'spectra' runs past the end of the file"):
+        read_tensor_file(f)
+    (tmp_path / "folder.bsdf").mkdir()
+    with pytest.raises(InputError, match="is a folder"):
+        read_tensor_file(tmp_path / "folder.bsdf")

@@ -9,12 +9,22 @@ Units are taken from the header when it names them (``wavelength_nm``, ``wavelen
 wavelengths below 30 are micrometres (no optical table in nm has all its wavelengths below
 30 nm, and none in micrometres reaches 30 um), values above 1.5 are percent (a fraction
 cannot exceed 1). An inference is announced with a :class:`UserWarning` saying what was
-assumed; a header that contradicts its values is an error.
+assumed; a header that contradicts its values is an error. Every value must be a finite
+number: a NaN or inf in a table is an error that names the line, not NaN count rates later.
+
+:func:`read_user_bytes` and :func:`read_user_text` read any user file (tables, meshes,
+material files) with the checks that make a bad path an :class:`InputError` rather than a
+hang or a traceback: a missing path, a folder, a FIFO or device (checked with ``os.stat``
+before opening, so a FIFO cannot block), an unreadable file, and for text NUL bytes or
+bytes that are not UTF-8.
 """
 
 from __future__ import annotations
 
+import codecs
+import os
 import re
+import stat
 import warnings
 from pathlib import Path
 
@@ -31,21 +41,106 @@ PERCENT_THRESHOLD = 1.5
 _SPLIT = re.compile(r"[,;\t ]+")
 
 
+def read_user_bytes(path: str | Path, field: str) -> bytes:
+    """The bytes of a user file, after checking that it is a readable regular file.
+
+    Parameters
+    ----------
+    path
+        The file (``~`` is expanded).
+    field
+        Scenario field that named the file, for the error message.
+
+    Raises
+    ------
+    InputError
+        If the path does not exist, is a folder, is not a regular file (a FIFO, a device
+        such as ``/dev/zero``, a socket) or cannot be read.
+    """
+    p = Path(path).expanduser()
+    src = str(p)
+    try:
+        mode = os.stat(p).st_mode
+    except (FileNotFoundError, NotADirectoryError):
+        raise InputError(f"file {src!r} does not exist", source=src, field=field) from None
+    except OSError as exc:
+        raise InputError(f"cannot read {src!r}: {exc.strerror}", source=src, field=field) from None
+    except ValueError:  # a NUL character in the path
+        raise InputError(f"{src!r} is not a valid path", source=src, field=field) from None
+    if stat.S_ISDIR(mode):
+        raise InputError(f"{src!r} is a folder; give the path of a file", source=src, field=field)
+    if not stat.S_ISREG(mode):
+        raise InputError(
+            f"{src!r} is not a regular file (a FIFO, device or socket); give the path of a file",
+            source=src,
+            field=field,
+        )
+    try:
+        return p.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read {src!r}: {exc.strerror}", source=src, field=field) from None
+
+
+def read_user_text(path: str | Path, field: str) -> str:
+    """The text of a user file: UTF-8 (a byte-order mark is dropped), checked as in
+    :func:`read_user_bytes`.
+
+    To be merged with ``speclight.input_files.read_user_text``, which has the same job.
+
+    Raises
+    ------
+    InputError
+        As :func:`read_user_bytes`, and if the file holds NUL bytes (binary, or UTF-16) or
+        bytes that are not UTF-8; the message gives the line of the first bad byte.
+    """
+    data = read_user_bytes(path, field)
+    src = str(Path(path).expanduser())
+    if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        raise InputError(
+            "is UTF-16 text (it starts with a UTF-16 byte-order mark); save it as UTF-8 text",
+            source=src,
+            field=field,
+        )
+    if data.startswith(codecs.BOM_UTF8):
+        data = data[len(codecs.BOM_UTF8) :]
+    nul = data.find(b"\0")
+    try:
+        text, bad = data.decode("utf-8"), -1
+    except UnicodeDecodeError as exc:
+        text, bad = "", exc.start
+    if nul >= 0 and (bad < 0 or nul < bad):
+        line = data.count(b"\n", 0, nul) + 1
+        raise InputError(
+            f"line {line} holds a NUL byte: this is a binary file (or UTF-16 text), not a "
+            "text table; save it as UTF-8 text",
+            source=src,
+            field=field,
+        )
+    if bad >= 0:
+        line = data.count(b"\n", 0, bad) + 1
+        raise InputError(
+            f"line {line} holds byte 0x{data[bad]:02x}, which is not UTF-8: this is a binary "
+            "file or another encoding, not a text table; save it as UTF-8 text",
+            source=src,
+            field=field,
+        )
+    return text
+
+
 def read_table(path: str | Path, field: str) -> tuple[list[str] | None, NDArray[np.float64]]:
     """Read a numeric table; return the header names (or None) and the data (n, k).
 
     Raises
     ------
     InputError
-        If the file is missing, a row is not numeric, the column counts differ or there
-        are fewer than 2 rows or 2 columns.
+        If the file cannot be read as text (see :func:`read_user_text`), a row is not
+        numeric or holds a NaN or inf, the column counts differ or there are fewer than 2
+        rows or 2 columns.
     """
     p = Path(path).expanduser()
-    if not p.is_file():
-        raise InputError(f"table file {str(p)!r} does not exist", source=str(p), field=field)
     header: list[str] | None = None
     rows: list[list[float]] = []
-    for lineno, raw in enumerate(p.read_text(encoding="utf-8-sig").splitlines(), start=1):
+    for lineno, raw in enumerate(read_user_text(p, field).splitlines(), start=1):
         line = raw.strip()
         if not line or line.startswith("#"):
             continue
@@ -62,6 +157,14 @@ def read_table(path: str | Path, field: str) -> tuple[list[str] | None, NDArray[
                 source=str(p),
                 field=field,
             ) from None
+        bad = [c for c, v in zip(parts, values, strict=True) if not np.isfinite(v)]
+        if bad:
+            raise InputError(
+                f"line {lineno} {line!r} holds {bad[0]!r}, which is not a finite number; a "
+                "table needs a number in every column (cut the rows that have no value)",
+                source=str(p),
+                field=field,
+            )
         if rows and len(values) != len(rows[0]):
             raise InputError(
                 f"line {lineno} has {len(values)} columns, earlier lines {len(rows[0])}",
@@ -71,14 +174,26 @@ def read_table(path: str | Path, field: str) -> tuple[list[str] | None, NDArray[
         rows.append(values)
     data = np.asarray(rows, dtype=np.float64)
     if data.ndim != 2 or data.shape[0] < 2 or data.shape[1] < 2:
+        found = f"{len(rows)} row(s) of {len(rows[0])} column(s)" if rows else "no numeric row"
         raise InputError(
-            "a table needs at least 2 rows of 'wavelength, value' columns",
+            f"a table needs at least 2 rows of 'wavelength, value' columns; found {found}",
             source=str(p),
             field=field,
         )
     if header is not None and len(header) != data.shape[1]:
         header = None
     return header, data
+
+
+def _check_finite(values: NDArray[np.float64], what: str, source: str, field: str) -> None:
+    bad = ~np.isfinite(values)
+    if np.any(bad):
+        raise InputError(
+            f"{what} hold {int(bad.sum())} value(s) that are not finite numbers "
+            f"(first: {float(values[bad].flat[0])!r}); give a finite number for every wavelength",
+            source=source,
+            field=field,
+        )
 
 
 def _unit_in(name: str, tokens: tuple[str, ...]) -> bool:
@@ -92,6 +207,10 @@ def wavelength_to_nm(
     """Convert a wavelength column to nm, from its header name or its magnitude."""
     says_um = name is not None and _unit_in(name, ("um", "µm", "micron", "microns", "micrometre"))
     says_nm = name is not None and _unit_in(name, ("nm", "nanometre", "nanometer"))
+    _check_finite(values, "the wavelengths", source, field)
+    if values.size == 0 or np.any(values <= 0):
+        low = f"{values.min():g}" if values.size else "none"
+        raise InputError(f"wavelengths must be > 0, got {low}", source=source, field=field)
     top = float(np.nanmax(values))
     if says_nm and top < UM_THRESHOLD:
         raise InputError(
@@ -133,6 +252,7 @@ def value_to_fraction(
         "%" in name or _unit_in(name, ("percent", "pct", "percentage"))
     )
     says_frac = name is not None and _unit_in(name, ("fraction", "frac"))
+    _check_finite(values, "the values", source, field)
     top = float(np.nanmax(values))
     if says_frac and top > PERCENT_THRESHOLD:
         raise InputError(

@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError, did_you_mean
+from speclight.instrument.tables import read_user_text
 
 SHIPPED_BRDF: tuple[str, ...] = ("starlink_v1p5_chassis_532nm", "starlink_v1p5_solar_array_532nm")
 GRID_H_DEG = np.linspace(0.0, 90.0, 361)
@@ -65,6 +66,35 @@ def half_angles_deg(
     return np.abs(theta_o_signed_deg - theta_i_deg) / 2.0, (theta_i_deg + theta_o_signed_deg) / 2.0
 
 
+def _parse_rows(text: str, source: str) -> NDArray[np.float64]:
+    """The (n, 5) rows ``phi_i theta_i phi_o theta_o brdf`` of a table, checked."""
+    rows: list[list[float]] = []
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        tokens = line.split("#", 1)[0].split()
+        if not tokens:
+            continue
+        try:
+            row = [float(t) for t in tokens]
+        except ValueError:
+            row = []
+        if len(row) != 5 or not np.all(np.isfinite(row)):
+            raise InputError(
+                f"line {lineno} {line.strip()[:60]!r} is not 5 finite numbers "
+                "'phi_i theta_i phi_o theta_o brdf' (deg, sr-1)",
+                source=source,
+            )
+        if row[4] < 0:
+            raise InputError(f"line {lineno}: BRDF {row[4]:g} sr-1 must be >= 0", source=source)
+        rows.append(row)
+    if len(rows) < 3:
+        raise InputError(
+            f"BRDF table needs at least 3 rows 'phi_i theta_i phi_o theta_o brdf', found "
+            f"{len(rows)}",
+            source=source,
+        )
+    return np.asarray(rows, dtype=np.float64)
+
+
 @cache
 def load_brdf_table(name_or_path: str) -> MeasuredBRDF:
     """Read a shipped (by name) or user BRDF table (see the module doc for the format)."""
@@ -73,24 +103,16 @@ def load_brdf_table(name_or_path: str) -> MeasuredBRDF:
         text, source = res.read_text(), name_or_path
     else:
         p = Path(name_or_path)
-        if not p.is_file():
+        if not p.exists():
             raise InputError(
                 f"BRDF table '{name_or_path}' is neither a file nor a shipped table"
                 f"{did_you_mean(name_or_path, SHIPPED_BRDF)} (shipped: {', '.join(SHIPPED_BRDF)})",
                 field="brdf_table",
             )
-        text, source = p.read_text(), str(p)
+        text, source = read_user_text(p, "brdf_table"), str(p)
     m = re.search(r"lambda\s*=\s*([0-9.]+)\s*nm", text)
     wavelength = float(m.group(1)) if m else float("nan")
-    try:
-        rows = np.loadtxt(text.splitlines(), comments="#", ndmin=2)
-    except ValueError as exc:
-        raise InputError(f"cannot parse BRDF table: {exc}", source=source) from None
-    if rows.shape[1] != 5 or np.any(rows[:, 4] < 0):
-        raise InputError(
-            "BRDF table needs 5 columns phi_i theta_i phi_o theta_o brdf (deg, sr-1 >= 0)",
-            source=source,
-        )
+    rows = _parse_rows(text, source)
     zen_i, az_i, zen_o, az_o, f = rows.T
     # In-plane samples: signed outgoing zenith, positive on the side opposite the source.
     same_plane = np.isclose(np.cos(np.radians(az_i - az_o)) ** 2, 1.0)
@@ -103,10 +125,19 @@ def load_brdf_table(name_or_path: str) -> MeasuredBRDF:
     th, td = half_angles_deg(np.abs(zen_i), theta_o)
     keep = (np.abs(theta_o) < 90.0) & (np.abs(zen_i) < 90.0)
     from scipy.interpolate import LinearNDInterpolator, NearestNDInterpolator
+    from scipy.spatial import QhullError
 
     pts = np.c_[th[keep], td[keep]]
     hh, dd = np.meshgrid(GRID_H_DEG, GRID_D_DEG, indexing="ij")
-    lin = LinearNDInterpolator(pts, f[keep])(hh, dd)
+    try:
+        lin = LinearNDInterpolator(pts, f[keep])(hh, dd)
+    except (QhullError, ValueError):
+        raise InputError(
+            f"the {int(keep.sum())} samples with incidence and exitance zenith below 90 deg do "
+            "not span an area in (theta_h, theta_d): measure at least 3 geometries that are "
+            "not on one line",
+            source=source,
+        ) from None
     near = NearestNDInterpolator(pts, f[keep])(hh, dd)
     grid = np.where(np.isfinite(lin), lin, near)
     return MeasuredBRDF(grid, wavelength, source)

@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError
+from speclight.instrument.tables import read_user_text
 from speclight.target.optical_constants import (
     check_nk_name,
     fresnel_reflectance,
@@ -69,6 +70,13 @@ class Reflectance:
                 source=source or None,
                 field=field,
             )
+        if not np.all(np.isfinite(v)):
+            raise InputError(
+                f"reflectance table values must be finite numbers in [0, 1], got "
+                f"{np.count_nonzero(~np.isfinite(v))} NaN or inf",
+                source=source or None,
+                field=field,
+            )
         if np.any(~((v >= 0) & (v <= 1))):
             raise InputError(
                 f"reflectance table values must be in [0, 1] (got {v.min():g}..{v.max():g}); "
@@ -82,30 +90,44 @@ class Reflectance:
     def table_file(cls, path: str | Path, *, field: str = "reflectance") -> Reflectance:
         """Read a two-column text/CSV table: wavelength [nm], reflectance [0..1].
 
-        Lines starting with ``#`` and a non-numeric header line are skipped; commas,
+        Text after ``#`` is a comment and one non-numeric header line is skipped; commas,
         semicolons or whitespace separate the columns.
+
+        Raises
+        ------
+        InputError
+            If the file cannot be read as text (a folder, a FIFO, binary content; see
+            :func:`speclight.instrument.tables.read_user_text`), a line is not two finite
+            numbers, or the table has fewer than 2 rows.
         """
         p = Path(path)
-        try:
-            lines = p.read_text().splitlines()
-        except OSError as exc:
-            raise InputError(
-                f"cannot read reflectance table: {exc}", source=str(p), field=field
-            ) from exc
-        rows = []
-        for line in lines:
+        src = str(p)
+        rows: list[tuple[float, float]] = []
+        header_seen = False
+        for lineno, line in enumerate(read_user_text(p, field).splitlines(), start=1):
             s = line.split("#", 1)[0].replace(",", " ").replace(";", " ").split()
             if not s:
                 continue
             try:
-                rows.append((float(s[0]), float(s[1])))
+                row = (float(s[0]), float(s[1]))
             except (ValueError, IndexError):
-                if rows:
+                if rows or header_seen:
                     raise InputError(
-                        f"line {line!r} is not two numbers (wavelength_nm, reflectance)",
-                        source=str(p),
+                        f"line {lineno} {line.strip()!r} is not two numbers "
+                        "(wavelength_nm, reflectance); only the first line may be a header",
+                        source=src,
                         field=field,
                     ) from None
+                header_seen = True
+                continue
+            if not np.all(np.isfinite(row)):
+                raise InputError(
+                    f"line {lineno} {line.strip()!r} holds a value that is not a finite "
+                    "number; give a wavelength and a reflectance in [0, 1] on every line",
+                    source=src,
+                    field=field,
+                )
+            rows.append(row)
         a = np.array(rows, dtype=float).reshape(-1, 2)
         return cls.pairs(a[:, 0], a[:, 1], source=str(p), field=field)
 

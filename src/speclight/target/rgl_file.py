@@ -31,6 +31,7 @@ jacobian       uint8 (1,)                 1: multiply by ndf / (4 sigma)
 
 from __future__ import annotations
 
+import math
 import struct
 from dataclasses import dataclass
 from functools import cache
@@ -40,6 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
+from speclight.instrument.tables import read_user_bytes
 from speclight.target.reflectance import Reflectance
 
 RGL_SUFFIX = ".bsdf"
@@ -73,7 +75,7 @@ def is_rgl_path(name_or_path: str | None) -> bool:
 def read_tensor_file(path: str | Path) -> dict[str, NDArray[np.generic]]:
     """All fields of a Mitsuba tensor file as numpy arrays (see the module doc for the layout)."""
     p = Path(path)
-    raw = p.read_bytes()
+    raw = read_user_bytes(p, "brdf_table")
     if len(raw) < 18 or raw[:12] != _MAGIC:
         raise InputError(
             f"'{p}' is not a Mitsuba tensor file (it must start with 'tensor_file'); RGL "
@@ -87,7 +89,7 @@ def read_tensor_file(path: str | Path) -> dict[str, NDArray[np.generic]]:
     try:
         for _ in range(n_fields):
             (n_name,) = struct.unpack_from("<H", raw, pos)
-            name = raw[pos + 2 : pos + 2 + n_name].decode("utf-8")
+            name = raw[pos + 2 : pos + 2 + n_name].decode("utf-8", "replace")
             pos += 2 + n_name
             ndim, code, offset = struct.unpack_from("<HBQ", raw, pos)
             pos += 11
@@ -98,7 +100,7 @@ def read_tensor_file(path: str | Path) -> dict[str, NDArray[np.generic]]:
                     f"'{p}': field '{name}' has unknown dtype code {code}", source=str(p)
                 )
             dt = np.dtype(DTYPE_CODES[code])
-            count = int(np.prod(shape, dtype=np.int64))
+            count = math.prod(shape)  # Python integers: a lying header cannot overflow
             if offset + count * dt.itemsize > len(raw):
                 raise InputError(
                     f"'{p}': field '{name}' runs past the end of the file (truncated?)",
@@ -166,7 +168,7 @@ def load_rgl_info(path: str) -> RGLInfo:
         The file is missing, not a tensor file, or lacks a field, dtype or shape that the
         plugin requires (the message names the file and what is wrong).
     """
-    if not Path(path).is_file():
+    if not Path(path).exists():
         raise InputError(
             f"RGL material file '{path}' does not exist (brdf_table ending in .bsdf must be the "
             "path of an RGL database file; relative paths are taken from the scenario's folder)",
