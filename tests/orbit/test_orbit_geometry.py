@@ -94,7 +94,7 @@ def test_site_rejects_bad_coordinates() -> None:
         Site(45.0, 0.0, 355e3)
 
 
-def test_compute_geometry_bundle() -> None:
+def test_observation_geometry_bundle() -> None:
     t = _times(500)
     r, _ = tle_position_gcrs_m(parse_tle(f"{L1}\n{L2}"), t)
     r[7] = np.nan  # a failed epoch stays a NaN row, the others are unaffected

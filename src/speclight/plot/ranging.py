@@ -7,10 +7,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from speclight import schema
 from speclight.plot.style import (
-    FLAG_BELOW_MIN_ELEVATION,
-    FLAG_ORBIT_FAILED,
-    FLAG_RENDER_FAILED,
     band_styles,
     epoch_summary,
     flags,
@@ -19,7 +17,9 @@ from speclight.plot.style import (
     shade_unobservable,
 )
 
-EXCLUDED_FOR_LASER = FLAG_ORBIT_FAILED | FLAG_BELOW_MIN_ELEVATION | FLAG_RENDER_FAILED
+EXCLUDED_FOR_LASER = (
+    schema.FLAG_ORBIT_FAILED | schema.FLAG_BELOW_MIN_ELEVATION | schema.FLAG_RENDER_FAILED
+)
 
 
 def has_ranging(ds: xr.Dataset) -> bool:
@@ -27,8 +27,9 @@ def has_ranging(ds: xr.Dataset) -> bool:
     return "range_offset" in ds or "range_histogram" in ds
 
 
-def _units(ds: xr.Dataset, name: str, default: str) -> str:
-    return str(ds[name].attrs.get("units", default))
+def _units(ds: xr.Dataset, name: str) -> str:
+    """The file's units of a variable, else the schema's."""
+    return str(ds[name].attrs.get("units", schema.units(name)))
 
 
 def strongest_return_epoch(ds: xr.Dataset) -> int | None:
@@ -65,7 +66,7 @@ def ranging_figure(ds: xr.Dataset, epoch: int | None) -> Any:
             offset = ds["range_offset"]
             if "band" not in offset.dims:
                 offset = offset.expand_dims(band=["all"])
-            unit = _units(ds, "range_offset", "m")
+            unit = _units(ds, "range_offset")
             scale, unit = (1e3, "mm") if unit == "m" else (1.0, unit)
             shade_unobservable(ax, ds)
             for b, name in enumerate(offset["band"].values):
@@ -97,7 +98,7 @@ def ranging_figure(ds: xr.Dataset, epoch: int | None) -> Any:
                 f"{str(bin_dim).replace('_', ' ')}: one-way range minus range to the centre of mass"
                 + (f" [{unit}]" if unit else "")
             )
-            hunit = _units(ds, "range_histogram", "1").replace("s-1", "s$^{-1}$")
+            hunit = _units(ds, "range_histogram").replace("s-1", "s$^{-1}$")
             ax.set_ylabel(f"returns per bin [{hunit}]")
             ax.set_title(
                 f"range histogram, {epoch_summary(ds, epoch)}", loc="left", fontsize="medium"

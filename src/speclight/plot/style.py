@@ -14,14 +14,14 @@ import xarray as xr
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
-
-# Flag bits of the dataset (speclight.schema, CF flag_masks).
-FLAG_ORBIT_FAILED = 1
-FLAG_BELOW_MIN_ELEVATION = 2
-FLAG_IN_SHADOW = 4
-FLAG_PENUMBRA = 8
-FLAG_RENDER_FAILED = 16
-NOT_OBSERVABLE = FLAG_ORBIT_FAILED | FLAG_BELOW_MIN_ELEVATION | FLAG_IN_SHADOW | FLAG_RENDER_FAILED
+from speclight.schema import (  # the dataset's flag bits (CF flag_masks)
+    FLAG_BELOW_MIN_ELEVATION,
+    FLAG_IN_SHADOW,
+    FLAG_ORBIT_FAILED,
+    FLAG_PENUMBRA,
+    FLAG_RENDER_FAILED,
+    NOT_OBSERVABLE,
+)
 
 DPI = 120
 WIDTH_IN = 10.0
