@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
+from speclight.input_files import read_user_text
 from speclight.orbit.frames import EarthOrientation, TimeLike, as_time, earth_orientation
 from speclight.orbit.interpolate import lagrange_interpolate
 from speclight.orbit.timescale import time_from_utc
@@ -119,7 +120,7 @@ def read_cpf(path: str | Path) -> Cpf:
         (the message names the file, the line number and the record).
     """
     p = str(path)
-    lines = Path(path).read_text().splitlines()
+    lines = read_user_text(path, "orbit.cpf_file", what="CPF file").split("\n")
     head: dict[str, list[str]] = {}
     times: list[np.datetime64] = []
     pos: list[list[float]] = []

@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError, did_you_mean
+from speclight.input_files import read_user_text
 from speclight.orbit.cpf import interpolate_table_m
 from speclight.orbit.frames import EarthOrientation, TimeLike, earth_orientation
 
@@ -68,28 +69,31 @@ def read_ephemeris_csv(path: str | Path) -> Ephemeris:
     frame: str | None = None
     rows: list[tuple[int, list[str]]] = []
     header: list[str] | None = None
-    with open(path, newline="") as f:
-        for lineno, line in enumerate(f, start=1):
-            s = line.strip()
-            if not s:
-                continue
-            if s.startswith("#"):
-                key, _, value = s.lstrip("#").partition(":")
-                if key.strip().lower() == "frame":
-                    frame = value.strip().upper()
-                    if frame not in FRAMES:
-                        raise InputError(
-                            f"line {lineno}: frame {value.strip()!r} is not accepted"
-                            f"{did_you_mean(frame, FRAMES)} (choices: GCRS, ITRF)",
-                            source=p,
-                            field="frame",
-                        )
-                continue
+    text = read_user_text(path, "orbit.ephemeris_file", what="ephemeris file")
+    for lineno, line in enumerate(text.split("\n"), start=1):
+        s = line.strip()
+        if not s:
+            continue
+        if s.startswith("#"):
+            key, _, value = s.lstrip("#").partition(":")
+            if key.strip().lower() == "frame":
+                frame = value.strip().upper()
+                if frame not in FRAMES:
+                    raise InputError(
+                        f"line {lineno}: frame {value.strip()!r} is not accepted"
+                        f"{did_you_mean(frame, FRAMES)} (choices: GCRS, ITRF)",
+                        source=p,
+                        field="frame",
+                    )
+            continue
+        try:
             cells = [c.strip() for c in next(csv.reader([s]))]
-            if header is None:
-                header = [c.lower() for c in cells]
-            else:
-                rows.append((lineno, cells))
+        except csv.Error as exc:  # e.g. a field above the csv module's size limit
+            raise InputError(f"line {lineno}: not a CSV row ({exc})", source=p) from None
+        if header is None:
+            header = [c.lower() for c in cells]
+        else:
+            rows.append((lineno, cells))
     if frame is None:
         raise InputError(
             "no frame given: add a comment line '# frame: GCRS' or '# frame: ITRF' before "
