@@ -99,19 +99,21 @@ def _decode(data: bytes, refuse: Callable[[str], InputError]) -> str:
     if data.startswith(_UTF16_BOMS):
         raise refuse(f"it is UTF-16 text (byte-order mark {data[:2].hex(' ')}); {save}")
     nul = data.find(b"\x00")
+    try:
+        text = data.decode("utf-8")  # not utf-8-sig: its error offsets skip the mark
+    except UnicodeDecodeError as exc:
+        if nul < 0 or exc.start < nul:  # report the first bad byte
+            bad = data[exc.start : exc.start + 1].hex()
+            raise refuse(
+                f"byte 0x{bad} at {_where(data, exc.start)} is not UTF-8: the file is binary "
+                f"or in another encoding (Latin-1, Windows-1252...); {save}"
+            ) from None
     if nul >= 0:
         raise refuse(
             f"a NUL byte at {_where(data, nul)}: the file is binary or not UTF-8 text "
             f"(UTF-16 without a byte-order mark?); {save}"
         )
-    try:
-        return data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        bad = data[exc.start : exc.start + 1].hex()
-        raise refuse(
-            f"byte 0x{bad} at {_where(data, exc.start)} is not UTF-8: the file is binary or "
-            f"in another encoding (Latin-1, Windows-1252...); {save}"
-        ) from None
+    return text.removeprefix("\ufeff")
 
 
 def _where(data: bytes, offset: int) -> str:

@@ -57,7 +57,9 @@ def test_file_above_the_size_limit(tmp_path: Path) -> None:
         (b"Kugel\n1 0136\xe4", "byte 0xe4 at line 2, column 7 (byte 12) is not UTF-8"),
         ("name: x".encode("utf-16"), "it is UTF-16 text (byte-order mark ff fe)"),
         ("name: x".encode("utf-16-be"), "a NUL byte at line 1, column 1 (byte 0)"),
-        (b"\x1etky\xc8B\x95", "byte 0xc8 at line 1, column 5 (byte 4) is not UTF-8"),
+        # the first of the bad bytes is named (fuzz/0360 has a NUL after byte 0xc8)
+        (b"\x1etky\xc8B\x95\x00", "byte 0xc8 at line 1, column 5 (byte 4) is not UTF-8"),
+        (b"\xef\xbb\xbfab\n\xff", "byte 0xff at line 2, column 1 (byte 6) is not UTF-8"),
     ],
 )
 def test_bytes_that_are_not_utf8_say_where(tmp_path: Path, data: bytes, fragment: str) -> None:
