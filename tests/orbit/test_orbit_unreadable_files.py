@@ -12,9 +12,13 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+import yaml
+from typer.testing import CliRunner
 
+from speclight.cli import app
 from speclight.errors import InputError
 from speclight.orbit import read_cpf, read_ephemeris_csv, read_tles
+from speclight.scenario import example_text
 
 READERS: dict[str, tuple[Callable[[Path], object], str]] = {
     "tle": (read_tles, "orbit.tle_file: cannot read TLE file"),
@@ -60,3 +64,18 @@ def test_unreadable_orbit_file_is_an_input_error(
     with pytest.raises(InputError) as exc:
         read(path)
     assert str(exc.value).startswith(f"{path}: {field}: {fragment}")
+
+
+def test_cli_exits_2_with_one_line_for_a_fifo_tle_file(tmp_path: Path) -> None:
+    # fuzz/0073: the run hung on open() until killed after 60 s
+    data = yaml.safe_load(example_text("lcs1"))
+    data["orbit"] = {"tle_file": "fifo", "norad_id": 1361}
+    os.mkfifo(tmp_path / "fifo")
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(yaml.safe_dump(data))
+    result = CliRunner().invoke(app, ["simulate", str(scenario), "-o", str(tmp_path / "o.nc")])
+    assert result.exit_code == 2
+    assert result.stderr == (
+        f"error: {tmp_path / 'fifo'}: orbit.tle_file: cannot read TLE file: it is a FIFO (named "
+        "pipe), not a regular file; give the path of a text file\n"
+    )
