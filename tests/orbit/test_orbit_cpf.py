@@ -188,3 +188,83 @@ def test_shipped_sample_file() -> None:
     r_true, _ = tle_position_gcrs_m(parse_tle(f"{L1}\n{L2}"), t)
     assert ok.all()
     assert np.linalg.norm(r - r_true, axis=1).max() < CPF_INTERPOLATION_TOLERANCE_M
+
+
+SAMPLE_CPF = Path(speclight.__file__).parent / "data/cpf/lcs1_20201127_speclight_sgp4.cpf"
+
+
+def _sample_with(tmp_path: Path, seconds_of_day: str, record: str) -> tuple[Path, int]:
+    """The shipped sample with the record 10 at ``seconds_of_day`` replaced; its line."""
+    lines = SAMPLE_CPF.read_text().splitlines()
+    lineno = next(
+        i
+        for i, ln in enumerate(lines, 1)
+        if ln.startswith("10 ") and ln.split()[3] == seconds_of_day
+    )
+    lines[lineno - 1] = record
+    return _write(tmp_path, "\n".join(lines) + "\n", "edited.cpf"), lineno
+
+
+@pytest.mark.parametrize(
+    "position",
+    [
+        "inf 0 0",  # fuzz/0089: overflowed the light-time step into a skyfield IndexError
+        "nan nan nan",  # issue 9 item 8: flagged below_min_elevation, not orbit_failed
+        "1e300 1e300 1e300",
+        "0.000 0.000 0.000",
+    ],
+)
+def test_a_corrupt_record_fails_the_epochs_around_it_only(tmp_path: Path, position: str) -> None:
+    path, lineno = _sample_with(tmp_path, "63360.000000", f"10 0 59180 63360.000000 0 {position}")
+    cpf = read_cpf(path)
+    assert cpf.unusable_lines == (lineno,)
+    t = np.datetime64("2020-11-27T17:20:00", "ns") + np.arange(0, 1801, 30) * np.timedelta64(1, "s")
+    r, ok = cpf_position_gcrs_m(cpf, t)
+    # the neighbours of the 17:36 record are at 17:32 and 17:40
+    around = (t > np.datetime64("2020-11-27T17:32")) & (t < np.datetime64("2020-11-27T17:40"))
+    assert (ok == ~around).all() and np.isnan(r[around]).all()
+    r_true, _ = tle_position_gcrs_m(parse_tle(f"{L1}\n{L2}"), t)
+    assert np.linalg.norm(r[ok] - r_true[ok], axis=1).max() < CPF_INTERPOLATION_TOLERANCE_M
+
+
+def test_a_file_of_corrupt_records_is_an_input_error(tmp_path: Path) -> None:
+    lines = CPF_V1.splitlines()
+    for i in (4, 5, 6):
+        lines[i] = lines[i].rsplit(None, 3)[0] + " nan nan nan"
+    with pytest.raises(InputError) as exc:
+        read_cpf(_write(tmp_path, "\n".join(lines) + "\n"))
+    assert "4 position records (type 10, direction 0), 1 of them usable; need >= 2" in str(
+        exc.value
+    )
+    assert "Line 5: position [nan, nan, nan] m is not a finite point 6,000 to 2,000,000 km" in str(
+        exc.value
+    )
+
+
+@pytest.mark.parametrize(
+    ("bad_line", "lineno", "fragment"),
+    [
+        # fuzz/0102: round(1e20 * 1e9) did not fit a timedelta64 (OverflowError)
+        ("10 0 57994 1e20 0 -5121237.102 -1208834.590 4440154.417", 6, "seconds of day 1e20"),
+        ("10 0 57994 nan 0 -5121237.102 -1208834.590 4440154.417", 6, "seconds of day nan"),
+        ("10 0 999999 0.0 0 -5121237.102 -1208834.590 4440154.417", 6, "MJD 999999 is not a day"),
+        ("H5  x.2510", 3, "record H5 has an unreadable field"),
+    ],
+)
+def test_record_fields_out_of_range_name_the_line(
+    tmp_path: Path, bad_line: str, lineno: int, fragment: str
+) -> None:
+    lines = CPF_V1.splitlines()
+    lines[lineno - 1] = bad_line
+    path = _write(tmp_path, "\n".join(lines) + "\n", "bad.cpf")
+    with pytest.raises(InputError) as exc:
+        read_cpf(path)
+    msg = str(exc.value)
+    assert msg.startswith(f"{path}: line {lineno}: ") and fragment in msg and bad_line in msg
+
+
+def test_header_year_beyond_numpy_times_is_an_input_error(tmp_path: Path) -> None:
+    # year 99999 wrapped around silently to 1793 before
+    text = CPF_V1.replace("2017 08 29 00 06 00", "99999 08 29 00 06 00")
+    with pytest.raises(InputError, match=r"line 2: H2 has an unreadable field \(year 99999"):
+        read_cpf(_write(tmp_path, text))

@@ -8,6 +8,7 @@ References: the TLE column layout and checksum rule of Vallado et al. (2006), AI
 from __future__ import annotations
 
 from importlib.resources import files
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -125,3 +126,14 @@ def test_failed_epochs_are_nan_rows_not_exceptions() -> None:
     r, ok = tle_position_gcrs_m(tle, times)
     assert ok.tolist() == [True, True, False, False]
     assert np.isnan(r[~ok]).all() and np.isfinite(r[ok]).all()
+
+
+def test_latin1_name_line_names_the_file_and_line(tmp_path: Path) -> None:
+    # fuzz/0068: 'Kugel äöü' written in Latin-1 above a good element set (was a traceback)
+    path = tmp_path / "cal.tle"
+    path.write_bytes("Kugel äöü\n".encode("latin-1") + f"{L1}\n{L2}\n".encode())
+    with pytest.raises(InputError) as exc:
+        read_tles(path)
+    msg = str(exc.value)
+    assert msg.startswith(f"{path}: orbit.tle_file: cannot read TLE file: byte 0xe4 at line 1")
+    assert "Latin-1" in msg and "save it as UTF-8" in msg

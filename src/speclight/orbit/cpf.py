@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
+from speclight.input_files import read_user_text
 from speclight.orbit.frames import EarthOrientation, TimeLike, as_time, earth_orientation
 from speclight.orbit.interpolate import lagrange_interpolate
 from speclight.orbit.timescale import time_from_utc
@@ -40,6 +41,12 @@ FRAME_NAMES = {
     2: "geocentric space-fixed, mean of date J2000",
 }
 _SKIPPED = {"H3", "H4", "H6", "H7", "H8", "00", "30", "40", "50", "60", "70"}
+#: Geocentric distances [m] a position of an Earth-orbiting target can have: from below the
+#: Earth's polar radius (6,357 km) to beyond the Sun-Earth L1/L2 points (1.5 million km).
+#: A table position outside them is a corrupted record (or a unit mistake).
+PLAUSIBLE_RADIUS_M = (6.0e6, 2.0e9)
+#: Span of ``datetime64[ns]`` (beyond it numpy wraps around silently), as MJDs: 1678-2262.
+_MJD_RANGE = (-66_000, 147_000)
 
 
 @dataclass(frozen=True)
@@ -72,6 +79,11 @@ class Cpf:
         (M, 3) positions [m].
     v_itrf_m_s
         (M, 3) velocities [m/s] from records 20, or None when the file has none.
+    unusable_lines
+        Line numbers of position records left out of the table: a position that is not a
+        finite number or whose geocentric distance is outside :data:`PLAUSIBLE_RADIUS_M`.
+        Epochs around them fall in a gap and are not valid (see
+        :func:`cpf_position_gcrs_m`).
     """
 
     path: str
@@ -89,6 +101,7 @@ class Cpf:
     times_utc: NDArray[np.datetime64]
     r_itrf_m: NDArray[np.float64]
     v_itrf_m_s: NDArray[np.float64] | None
+    unusable_lines: tuple[int, ...] = ()
 
 
 def _err(path: str, lineno: int, line: str, what: str, fix: str) -> InputError:
@@ -97,7 +110,22 @@ def _err(path: str, lineno: int, line: str, what: str, fix: str) -> InputError:
 
 def _datetime(fields: list[str]) -> np.datetime64:
     y, mo, d, h, mi, s = (int(f) for f in fields)
+    if not 1678 < y < 2262:  # datetime64[ns] would wrap around silently
+        raise ValueError(f"year {y} is outside 1678-2262")
     return np.datetime64(f"{y:04d}-{mo:02d}-{d:02d}T{h:02d}:{mi:02d}:{s:02d}", "ns")
+
+
+def _record_time(
+    lineno: int, line: str, path: str, mjd_field: str, sod_field: str
+) -> np.datetime64:
+    """UTC epoch of a record 10 from its MJD and seconds-of-day fields."""
+    fix = "Expected: 10 direction MJD seconds-of-day leap-second x y z."
+    mjd, sod = int(mjd_field), float(sod_field)
+    if not _MJD_RANGE[0] < mjd < _MJD_RANGE[1]:
+        raise _err(path, lineno, line, f"MJD {mjd_field} is not a day of 1678-2262", fix)
+    if not 0.0 <= sod < 86401.0:  # 86400.x only during a leap second
+        raise _err(path, lineno, line, f"seconds of day {sod_field} is outside 0-86400", fix)
+    return MJD0 + np.timedelta64(mjd, "D") + np.timedelta64(round(sod * 1e9), "ns")
 
 
 def read_cpf(path: str | Path) -> Cpf:
@@ -119,13 +147,15 @@ def read_cpf(path: str | Path) -> Cpf:
         (the message names the file, the line number and the record).
     """
     p = str(path)
-    lines = Path(path).read_text().splitlines()
+    lines = read_user_text(path, "orbit.cpf_file", what="CPF file").split("\n")
     head: dict[str, list[str]] = {}
     times: list[np.datetime64] = []
     pos: list[list[float]] = []
+    pos_lines: list[int] = []
     vel: list[list[float]] = []
     vel_times: list[np.datetime64] = []
     version = 0
+    com: float | None = None
     for lineno, raw in enumerate(lines, start=1):
         line = raw.rstrip()
         if not line.strip():
@@ -176,6 +206,7 @@ def read_cpf(path: str | Path) -> Cpf:
                 head["H2"] = tok
             elif rec == "H5":
                 head["H5"] = tok
+                com = float(tok[1]) if len(tok) > 1 else None
             elif rec == "H9":
                 head["H9"] = tok
             elif rec == "10":
@@ -189,9 +220,9 @@ def read_cpf(path: str | Path) -> Cpf:
                     )
                 if int(tok[1]) != 0:
                     continue
-                t = MJD0 + np.timedelta64(int(tok[2]), "D")
-                times.append(t + np.timedelta64(round(float(tok[3]) * 1e9), "ns"))
+                times.append(_record_time(lineno, line, p, tok[2], tok[3]))
                 pos.append([float(v) for v in tok[5:8]])
+                pos_lines.append(lineno)
             elif rec == "20":
                 if len(tok) != 5:
                     raise _err(
@@ -228,10 +259,10 @@ def read_cpf(path: str | Path) -> Cpf:
     for rec in ("H1", "H2"):
         if rec not in head:
             raise InputError(f"missing {rec} header record; is this an ILRS CPF file?", source=p)
-    if len(times) < 2:
-        raise InputError(
-            f"{len(times)} position records (type 10, direction 0); need >= 2", source=p
-        )
+    r_arr = np.array(pos, dtype=np.float64).reshape(-1, 3)
+    usable = plausible_position(r_arr)
+    if np.count_nonzero(usable) < 2:
+        raise InputError(_too_few_records(r_arr, usable, pos_lines), source=p)
     h1, h2 = head["H1"], head["H2"]
     lineno_h2 = next(i for i, ln in enumerate(lines, 1) if ln[:2].upper() == "H2")
     try:
@@ -264,8 +295,7 @@ def read_cpf(path: str | Path) -> Cpf:
         )
     v_arr = None
     if vel and len(vel) == len(times) and vel_times == times:
-        v_arr = np.array(vel, dtype=np.float64)
-    com = float(head["H5"][1]) if "H5" in head and len(head["H5"]) > 1 else None
+        v_arr = np.array(vel, dtype=np.float64)[usable]
     return Cpf(
         path=p,
         version=version,
@@ -279,9 +309,37 @@ def read_cpf(path: str | Path) -> Cpf:
         step_s=step_s,
         reference_frame=frame,
         com_offset_m=com,
-        times_utc=t_arr,
-        r_itrf_m=np.array(pos, dtype=np.float64),
+        times_utc=t_arr[usable],
+        r_itrf_m=r_arr[usable],
         v_itrf_m_s=v_arr,
+        unusable_lines=tuple(ln for ln, ok in zip(pos_lines, usable, strict=True) if not ok),
+    )
+
+
+def plausible_position(r_m: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Rows of ``r_m`` (M, 3) [m] that are finite and :data:`PLAUSIBLE_RADIUS_M` from the
+    geocentre: positions an Earth-orbiting target can have."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        radius_m = np.linalg.norm(r_m, axis=1)
+    return (
+        np.isfinite(radius_m)
+        & (radius_m >= PLAUSIBLE_RADIUS_M[0])
+        & (radius_m <= PLAUSIBLE_RADIUS_M[1])
+    )
+
+
+def _too_few_records(r_m: NDArray[np.float64], usable: NDArray[np.bool_], lines: list[int]) -> str:
+    msg = (
+        f"{len(lines)} position records (type 10, direction 0), {np.count_nonzero(usable)} "
+        "of them usable; need >= 2"
+    )
+    if usable.all():
+        return msg
+    i = int(np.flatnonzero(~usable)[0])
+    lo_km, hi_km = (v / 1e3 for v in PLAUSIBLE_RADIUS_M)
+    return (
+        f"{msg}. Line {lines[i]}: position {r_m[i].tolist()} m is not a finite point "
+        f"{lo_km:,.0f} to {hi_km:,.0f} km from the geocentre"
     )
 
 
@@ -295,8 +353,8 @@ def interpolate_table_m(
 
     Time differences are taken in TAI from split Julian dates, so they are exact to
     ~1e-11 s and correct across leap seconds. Returns (N, 3) positions and the ok mask
-    (False, NaN row, outside the table's span, or, if ``max_gap_s`` is given, inside a
-    gap between two records longer than ``max_gap_s`` [s]).
+    (False, NaN row, outside the table's span, where the result is not finite, or, if
+    ``max_gap_s`` is given, inside a gap between two records longer than ``max_gap_s`` [s]).
     """
     t = as_time(t)
     tn = time_from_utc(np.asarray(times_utc, dtype="datetime64[ns]"))
@@ -307,9 +365,11 @@ def interpolate_table_m(
     r, ok = lagrange_interpolate(x_nodes, r_m, x)
     if max_gap_s is not None and x_nodes.size > 1:
         i = np.clip(np.searchsorted(x_nodes, x, side="right") - 1, 0, x_nodes.size - 2)
-        in_gap = (x_nodes[i + 1] - x_nodes[i]) > max_gap_s
+        inside = (x > x_nodes[i]) & (x < x_nodes[i + 1])  # a record's own epoch is known
+        in_gap = inside & ((x_nodes[i + 1] - x_nodes[i]) > max_gap_s)
         ok &= ~in_gap
-        r[~ok] = np.nan
+    ok &= np.all(np.isfinite(r), axis=1)  # a non-finite table value never passes as valid
+    r[~ok] = np.nan
     return r, ok
 
 
@@ -331,7 +391,8 @@ def cpf_position_gcrs_m(
     -------
     r_gcrs_m : ndarray
         (N, 3) [m]; NaN rows outside the file's span and inside gaps longer than 1.5
-        times the step announced in H2.
+        times the step announced in H2, including the gap that a left-out record
+        (:attr:`Cpf.unusable_lines`) leaves.
     ok : ndarray of bool
         (N,) True where valid.
     """

@@ -9,9 +9,16 @@ Format::
     ...
 
 Times are ISO 8601 UTC (a trailing ``Z`` is allowed), strictly increasing; at least two
-rows. Positions are interpolated with the 10-point Lagrange scheme shared with the CPF
-reader (:mod:`speclight.orbit.interpolate`) in the file's frame; ITRF results are then
-rotated to GCRS at each epoch.
+rows. Positions are finite numbers whose geocentric distance is that of an Earth orbit
+(:data:`~speclight.orbit.cpf.PLAUSIBLE_RADIUS_M`, 6,000 to 2 million km); a table in
+metres under ``_km`` headers (or the other way round) is refused with that diagnosis.
+
+Positions are interpolated with the 10-point Lagrange scheme shared with the CPF reader
+(:mod:`speclight.orbit.interpolate`) in the file's frame; ITRF results are then rotated to
+GCRS at each epoch. A hole in the table is not bridged: epochs between two rows more than
+:data:`MAX_GAP_STEPS` times the table's median step apart are not valid (a table need not
+be evenly spaced, so the threshold leaves room for uneven steps; the CPF reader uses 1.5
+times the step its header announces).
 """
 
 from __future__ import annotations
@@ -25,12 +32,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError, did_you_mean
-from speclight.orbit.cpf import interpolate_table_m
+from speclight.input_files import read_user_text
+from speclight.orbit.cpf import PLAUSIBLE_RADIUS_M, interpolate_table_m, plausible_position
 from speclight.orbit.frames import EarthOrientation, TimeLike, earth_orientation
 
 FRAMES = ("GCRS", "ITRF")
 UNITS = {"m": 1.0, "km": 1000.0}
 ACCEPTED_HEADERS = "time_utc,x_m,y_m,z_m  or  time_utc,x_km,y_km,z_km"
+#: Epochs in a gap between rows longer than this many median table steps are not valid.
+MAX_GAP_STEPS = 3.0
+#: Span of ``datetime64[ns]``; numpy wraps times beyond it around silently.
+_TIME_RANGE = (np.datetime64("1678-01-01T00:00:00", "s"), np.datetime64("2262-01-01T00:00:00", "s"))
 
 
 @dataclass(frozen=True)
@@ -61,35 +73,41 @@ def read_ephemeris_csv(path: str | Path) -> Ephemeris:
     Raises
     ------
     InputError
-        Missing or unknown frame, unaccepted column headers or units, unreadable values,
-        fewer than 2 rows, or times not strictly increasing.
+        The file is missing or not UTF-8 text (see
+        :func:`~speclight.input_files.read_user_text`), missing or unknown frame,
+        unaccepted column headers or units, unreadable or non-finite values, positions
+        that are no Earth orbit in the stated unit, fewer than 2 rows, or times not
+        strictly increasing.
     """
     p = str(path)
     frame: str | None = None
     rows: list[tuple[int, list[str]]] = []
     header: list[str] | None = None
-    with open(path, newline="") as f:
-        for lineno, line in enumerate(f, start=1):
-            s = line.strip()
-            if not s:
-                continue
-            if s.startswith("#"):
-                key, _, value = s.lstrip("#").partition(":")
-                if key.strip().lower() == "frame":
-                    frame = value.strip().upper()
-                    if frame not in FRAMES:
-                        raise InputError(
-                            f"line {lineno}: frame {value.strip()!r} is not accepted"
-                            f"{did_you_mean(frame, FRAMES)} (choices: GCRS, ITRF)",
-                            source=p,
-                            field="frame",
-                        )
-                continue
+    text = read_user_text(path, "orbit.ephemeris_file", what="ephemeris file")
+    for lineno, line in enumerate(text.split("\n"), start=1):
+        s = line.strip()
+        if not s:
+            continue
+        if s.startswith("#"):
+            key, _, value = s.lstrip("#").partition(":")
+            if key.strip().lower() == "frame":
+                frame = value.strip().upper()
+                if frame not in FRAMES:
+                    raise InputError(
+                        f"line {lineno}: frame {value.strip()!r} is not accepted"
+                        f"{did_you_mean(frame, FRAMES)} (choices: GCRS, ITRF)",
+                        source=p,
+                        field="frame",
+                    )
+            continue
+        try:
             cells = [c.strip() for c in next(csv.reader([s]))]
-            if header is None:
-                header = [c.lower() for c in cells]
-            else:
-                rows.append((lineno, cells))
+        except csv.Error as exc:  # e.g. a field above the csv module's size limit
+            raise InputError(f"line {lineno}: not a CSV row ({exc})", source=p) from None
+        if header is None:
+            header = [c.lower() for c in cells]
+        else:
+            rows.append((lineno, cells))
     if frame is None:
         raise InputError(
             "no frame given: add a comment line '# frame: GCRS' or '# frame: ITRF' before "
@@ -120,7 +138,7 @@ def read_ephemeris_csv(path: str | Path) -> Ephemeris:
             source=p,
             field="header",
         )
-    scale = UNITS[units.pop()]
+    unit = units.pop()
     if len(rows) < 2:
         raise InputError(f"{len(rows)} data rows; need at least 2", source=p)
     times = []
@@ -129,9 +147,8 @@ def read_ephemeris_csv(path: str | Path) -> Ephemeris:
         try:
             if len(cells) != 4:
                 raise ValueError(f"{len(cells)} columns instead of 4")
-            ts = cells[0][:-1] if cells[0].upper().endswith("Z") else cells[0]
-            times.append(np.datetime64(ts, "ns"))
-            pos.append([float(c) * scale for c in cells[1:]])
+            times.append(_utc(cells[0]))
+            pos.append([float(c) for c in cells[1:]])
         except ValueError as exc:
             raise InputError(
                 f"line {lineno}: cannot read {','.join(cells)!r} ({exc}); expected an ISO UTC "
@@ -146,17 +163,84 @@ def read_ephemeris_csv(path: str | Path) -> Ephemeris:
             "increase strictly",
             source=p,
         )
-    r = np.array(pos, dtype=np.float64)
-    if not np.all(np.isfinite(r)):
-        raise InputError("positions must be finite numbers", source=p)
-    return Ephemeris(path=p, frame=frame, times_utc=t_arr, r_m=r)  # type: ignore[arg-type]
+    r_m = _positions_m(p, unit, np.array(pos, dtype=np.float64), [ln for ln, _ in rows])
+    return Ephemeris(path=p, frame=frame, times_utc=t_arr, r_m=r_m)  # type: ignore[arg-type]
+
+
+def _utc(cell: str) -> np.datetime64:
+    """A UTC time cell as ``datetime64[ns]``; ValueError if it is not a time of 1678-2262."""
+    t = np.datetime64(cell[:-1] if cell.upper().endswith("Z") else cell)
+    if np.isnat(t):
+        raise ValueError("not a time")
+    if not _TIME_RANGE[0] <= t < _TIME_RANGE[1]:
+        raise ValueError("the time is outside 1678-2262")
+    return t.astype("datetime64[ns]")
+
+
+def _positions_m(
+    path: str, unit: str, r_file: NDArray[np.float64], lines: list[int]
+) -> NDArray[np.float64]:
+    """Positions [m] from the file's values in ``unit``; InputError for non-finite values
+    and for positions that are no Earth orbit (naming the metres/km mix-up if it is one)."""
+    finite = np.all(np.isfinite(r_file), axis=1)
+    if not finite.all():
+        i = int(np.flatnonzero(~finite)[0])
+        raise InputError(
+            f"line {lines[i]}: position {r_file[i].tolist()} {unit} is not three finite numbers",
+            source=path,
+        )
+    with np.errstate(over="ignore"):
+        r_m = r_file * UNITS[unit]
+    ok = plausible_position(r_m)
+    if ok.all():
+        return r_m
+    lo_km, hi_km = (v / 1e3 for v in PLAUSIBLE_RADIUS_M)
+    with np.errstate(over="ignore"):
+        radius_km = np.linalg.norm(r_m, axis=1) / 1e3
+    i = int(np.flatnonzero(~ok)[0])
+    msg = (
+        f"line {lines[i]}: position {r_file[i].tolist()} {unit} is "
+        f"{radius_km[i]:,.6g} km from the geocentre; an Earth orbit is {lo_km:,.0f} to "
+        f"{hi_km:,.0f} km"
+    )
+    other = "m" if unit == "km" else "km"
+    with np.errstate(over="ignore"):
+        mislabelled = plausible_position(r_file * UNITS[other]).all()
+    if not mislabelled:
+        raise InputError(msg, source=path)
+    raise InputError(
+        f"the positions look like {'metres' if other == 'm' else 'kilometres'} labelled "
+        f"{unit} ({msg}; a factor of 1000 makes every row an Earth orbit); write the header "
+        f"time_utc,x_{other},y_{other},z_{other} or convert the values",
+        source=path,
+        field="header",
+    )
 
 
 def ephemeris_position_gcrs_m(
     eph: Ephemeris, t: TimeLike, orientation: EarthOrientation | None = None
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """Interpolated GCRS position [m] (N, 3) and ok mask (False outside the table's span)."""
-    r, ok = interpolate_table_m(eph.times_utc, eph.r_m, t)
+    """Interpolated GCRS position of the target.
+
+    Parameters
+    ----------
+    eph
+        From :func:`read_ephemeris_csv`.
+    t
+        Epochs (N), skyfield ``Time`` or UTC ``datetime64``.
+    orientation
+        Precomputed Earth orientation for ``t`` (ITRF tables only).
+
+    Returns
+    -------
+    r_gcrs_m : ndarray
+        (N, 3) [m]; NaN rows outside the table's span and inside gaps longer than
+        :data:`MAX_GAP_STEPS` times the table's median step.
+    ok : ndarray of bool
+        (N,) True where valid.
+    """
+    step_s = float(np.median(np.diff(eph.times_utc) / np.timedelta64(1, "s")))
+    r, ok = interpolate_table_m(eph.times_utc, eph.r_m, t, max_gap_s=MAX_GAP_STEPS * step_s)
     if eph.frame == "GCRS":
         return r, ok
     eo = orientation if orientation is not None else earth_orientation(t)

@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from sgp4.api import Satrec
 
 from speclight.errors import InputError
+from speclight.input_files import read_user_text
 from speclight.orbit.frames import EarthOrientation, TimeLike, as_time, earth_orientation
 
 #: Column template of each line ('N' a digit, 'A' a letter/character, 'C' a classification).
@@ -166,9 +167,18 @@ def parse_tle(text: str, source: str = "orbit.tle") -> Tle:
 
 
 def read_tles(path: str | Path) -> list[Tle]:
-    """Read every element set of a TLE/3LE file (name lines optional)."""
+    """Read every element set of a TLE/3LE file (name lines optional).
+
+    Raises
+    ------
+    InputError
+        The file is missing, not a regular UTF-8 text file (see
+        :func:`~speclight.input_files.read_user_text`), holds no element set, or one of
+        its sets is malformed (the message names the line).
+    """
     p = Path(path)
-    lines = [ln.strip() for ln in p.read_text().splitlines()]
+    text = read_user_text(p, "orbit.tle_file", what="TLE file")
+    lines = [ln.strip() for ln in text.split("\n")]  # line numbers as in the file
     out: list[Tle] = []
     for i, ln in enumerate(lines):
         if re.match(r"^1 ", ln) and i + 1 < len(lines) and lines[i + 1].startswith("2 "):

@@ -1,7 +1,11 @@
 """Read a scenario YAML file into a validated :class:`~speclight.scenario.Scenario`.
 
 Errors are :class:`~speclight.errors.InputError` naming the file and line, the field path,
-the value and what is accepted; misspelt keys get a did-you-mean.
+the value and what is accepted; misspelt keys get a did-you-mean. The file must be UTF-8
+text (:func:`~speclight.input_files.read_user_text`); a key given twice in one mapping is an
+error (YAML would keep the last silently), and so is nesting deeper than
+:data:`MAX_NESTING` levels (a scenario needs about five; far deeper, PyYAML's recursive
+parser exhausts Python's stack).
 """
 
 from __future__ import annotations
@@ -14,7 +18,48 @@ import yaml
 from pydantic import BaseModel, ValidationError
 
 from speclight.errors import InputError, did_you_mean
+from speclight.input_files import read_user_text
 from speclight.scenario.scenario_model import Scenario
+
+#: Largest scenario file read [bytes]; scenarios are a few kB (tables live in their own files).
+MAX_SCENARIO_BYTES = 4 * 1024 * 1024
+#: Deepest nesting of mappings and lists accepted in a scenario.
+MAX_NESTING = 64
+_OPENERS = (
+    yaml.BlockMappingStartToken,
+    yaml.BlockSequenceStartToken,
+    yaml.FlowMappingStartToken,
+    yaml.FlowSequenceStartToken,
+)
+_CLOSERS = (yaml.BlockEndToken, yaml.FlowMappingEndToken, yaml.FlowSequenceEndToken)
+
+
+class _ScenarioLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, refusing duplicate keys and locating unreadable values."""
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+        seen: dict[tuple[str, str], yaml.error.Mark] = {}
+        for key, _ in node.value:
+            if not isinstance(key, yaml.ScalarNode) or key.tag == "tag:yaml.org,2002:merge":
+                continue
+            first = seen.setdefault((key.tag, key.value), key.start_mark)
+            if first is not key.start_mark:
+                raise yaml.constructor.ConstructorError(
+                    None,
+                    None,
+                    f"key '{key.value}' is given twice in one mapping, on {_at(first)} and "
+                    f"{_at(key.start_mark)}; YAML would keep the last silently: remove one",
+                    key.start_mark,
+                )
+        return super().construct_mapping(node, deep=deep)
+
+    def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:
+        try:
+            return super().construct_object(node, deep=deep)
+        except (ValueError, TypeError, OverflowError) as exc:  # e.g. 2020-13-01, !!int x
+            raise yaml.constructor.ConstructorError(
+                None, None, f"cannot read {node.value!r} as {node.tag} ({exc})", node.start_mark
+            ) from exc
 
 
 @dataclass(frozen=True)
@@ -41,10 +86,7 @@ def load_scenario(path: str | Path) -> LoadedScenario:
         If the file is missing, is not valid YAML, or a field is invalid.
     """
     path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise InputError(f"cannot read scenario file: {exc.strerror}", source=str(path)) from exc
+    text = read_user_text(path, what="scenario file", max_bytes=MAX_SCENARIO_BYTES)
     return parse_scenario(text, source=str(path), base_dir=path.resolve().parent)
 
 
@@ -53,8 +95,11 @@ def parse_scenario(
 ) -> LoadedScenario:
     """Validate scenario YAML text (see :func:`load_scenario`)."""
     try:
-        data = yaml.safe_load(text)
-        root = yaml.compose(text)
+        _check_nesting(text, source)
+        data = yaml.load(text, Loader=_ScenarioLoader)  # a SafeLoader subclass
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except RecursionError:  # a backstop: _check_nesting keeps far below Python's limit
+        raise InputError(f"nested too deeply (limit {MAX_NESTING} levels)", source=source) from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"{source}:{mark.line + 1}:{mark.column + 1}" if mark else source
@@ -71,6 +116,27 @@ def parse_scenario(
     except ValidationError as exc:
         raise InputError(_describe(exc, data, root), source=source) from None
     return LoadedScenario(scenario, text, source, base_dir or Path.cwd())
+
+
+def _at(mark: yaml.error.Mark) -> str:
+    return f"line {mark.line + 1} (column {mark.column + 1})"
+
+
+def _check_nesting(text: str, source: str) -> None:
+    """Refuse nesting deeper than :data:`MAX_NESTING` (from the tokens: no recursion)."""
+    depth = 0
+    for token in yaml.scan(text, Loader=yaml.SafeLoader):
+        if isinstance(token, _OPENERS):
+            depth += 1
+            if depth > MAX_NESTING:
+                mark = token.start_mark
+                raise InputError(
+                    f"mappings and lists are nested more than {MAX_NESTING} levels deep "
+                    "(a scenario needs about five); is this a scenario file?",
+                    source=f"{source}:{mark.line + 1}:{mark.column + 1}",
+                )
+        elif isinstance(token, _CLOSERS):
+            depth -= 1
 
 
 def _data_path(loc: tuple[Any, ...], data: Any) -> tuple[list[Any], Any, bool]:

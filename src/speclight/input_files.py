@@ -1,0 +1,126 @@
+"""Safe reading of the text files a user names (scenario, TLE, CPF, ephemeris...).
+
+:func:`read_user_text` turns every way a named file can be unusable into an
+:class:`~speclight.errors.InputError` that names the file and the scenario field: a path
+that does not exist, a folder, anything that is not a regular file (a FIFO or a device
+such as ``/dev/zero``: refused from ``os.stat`` before opening, so nothing blocks or
+reads forever), a file above a size limit, and bytes that are not UTF-8 text (the message
+says where the first bad byte is).
+"""
+
+from __future__ import annotations
+
+import codecs
+import os
+import stat
+from collections.abc import Callable
+from pathlib import Path
+
+from speclight.errors import InputError
+
+#: Largest text input file read [bytes]. A CPF or CSV ephemeris at a 1 s step for a week
+#: is about 50 MB; anything larger is refused rather than read into memory.
+MAX_TEXT_BYTES = 256 * 1024 * 1024
+
+_KINDS = (
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
+_UTF16_BOMS = (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)
+
+
+def read_user_text(
+    path: str | Path,
+    field: str | None = None,
+    *,
+    what: str = "file",
+    max_bytes: int = MAX_TEXT_BYTES,
+) -> str:
+    """Read a user's UTF-8 text file, refusing anything else with a clear error.
+
+    Parameters
+    ----------
+    path
+        The file.
+    field
+        Scenario field that names the file (e.g. ``orbit.tle_file``), for the message.
+    what
+        What the file is, for the message (e.g. ``"TLE file"``).
+    max_bytes
+        Size limit [bytes].
+
+    Returns
+    -------
+    str
+        The text, a UTF-8 byte-order mark removed and line ends turned into ``"\\n"``
+        (as Python's text mode does).
+
+    Raises
+    ------
+    InputError
+        Missing path, a folder, not a regular file, larger than ``max_bytes``, not
+        readable, or not UTF-8 text (binary, UTF-16, Latin-1...).
+    """
+    source = str(path)
+
+    def refuse(problem: str) -> InputError:
+        return InputError(f"cannot read {what}: {problem}", source=source, field=field)
+
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise refuse("no such file") from None
+    except NotADirectoryError:
+        raise refuse("a part of the path is a file, not a folder") from None
+    except OSError as exc:
+        raise refuse(exc.strerror or str(exc)) from None
+    if stat.S_ISDIR(st.st_mode):
+        raise refuse("it is a folder; give the path of a file in it")
+    if not stat.S_ISREG(st.st_mode):
+        kind = next((name for test, name in _KINDS if test(st.st_mode)), "not a regular file")
+        raise refuse(f"it is {kind}, not a regular file; give the path of a text file")
+    if st.st_size > max_bytes:
+        raise refuse(f"it is {_size(st.st_size)}, above the limit of {_size(max_bytes)}")
+    try:
+        with open(path, "rb") as f:
+            data = f.read(max_bytes + 1)
+    except OSError as exc:
+        raise refuse(exc.strerror or str(exc)) from None
+    if len(data) > max_bytes:  # grew since os.stat
+        raise refuse(f"it is larger than the limit of {_size(max_bytes)}")
+    return _decode(data, refuse).replace("\r\n", "\n").replace("\r", "\n")
+
+
+def _decode(data: bytes, refuse: Callable[[str], InputError]) -> str:
+    """UTF-8 text of ``data``; ``refuse(problem)`` builds the error otherwise."""
+    save = "save it as UTF-8"
+    if data.startswith(_UTF16_BOMS):
+        raise refuse(f"it is UTF-16 text (byte-order mark {data[:2].hex(' ')}); {save}")
+    nul = data.find(b"\x00")
+    try:
+        text = data.decode("utf-8")  # not utf-8-sig: its error offsets skip the mark
+    except UnicodeDecodeError as exc:
+        if nul < 0 or exc.start < nul:  # report the first bad byte
+            bad = data[exc.start : exc.start + 1].hex()
+            raise refuse(
+                f"byte 0x{bad} at {_where(data, exc.start)} is not UTF-8: the file is binary "
+                f"or in another encoding (Latin-1, Windows-1252...); {save}"
+            ) from None
+    if nul >= 0:
+        raise refuse(
+            f"a NUL byte at {_where(data, nul)}: the file is binary or not UTF-8 text "
+            f"(UTF-16 without a byte-order mark?); {save}"
+        )
+    return text.removeprefix("\ufeff")
+
+
+def _where(data: bytes, offset: int) -> str:
+    line = data.count(b"\n", 0, offset) + 1
+    column = offset - (data.rfind(b"\n", 0, offset) + 1) + 1
+    return f"line {line}, column {column} (byte {offset})"
+
+
+def _size(n_bytes: int) -> str:
+    return f"{n_bytes / 2**20:.1f} MiB" if n_bytes >= 2**20 else f"{n_bytes} bytes"
