@@ -1,8 +1,8 @@
-"""Safe reading of the text files a user names (scenario, TLE, CPF, ephemeris...).
+"""Safe reading of the files a user names (scenario, orbit files, tables, meshes, materials).
 
-:func:`read_user_text` turns every way a named file can be unusable into an
-:class:`~speclight.errors.InputError` that names the file and the scenario field: a path
-that does not exist, a folder, anything that is not a regular file (a FIFO or a device
+:func:`read_user_bytes` and :func:`read_user_text` turn every way a named file can be
+unusable into an :class:`~speclight.errors.InputError` that names the file and the
+scenario field: a path that does not exist, a folder, anything that is not a regular file (a FIFO or a device
 such as ``/dev/zero``: refused from ``os.stat`` before opening, so nothing blocks or
 reads forever), a file above a size limit, and bytes that are not UTF-8 text (the message
 says where the first bad byte is).
@@ -31,6 +31,69 @@ _KINDS = (
 _UTF16_BOMS = (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)
 
 
+def read_user_bytes(
+    path: str | Path,
+    field: str | None = None,
+    *,
+    what: str = "file",
+    max_bytes: int = MAX_TEXT_BYTES,
+) -> bytes:
+    """The bytes of a user's file (tables, meshes, material files), refusing anything that is
+    not a readable regular file with a clear error.
+
+    Parameters
+    ----------
+    path
+        The file (``~`` is expanded).
+    field
+        Scenario field that names the file (e.g. ``orbit.tle_file``), for the message.
+    what
+        What the file is, for the message (e.g. ``"TLE file"``).
+    max_bytes
+        Size limit [bytes].
+
+    Raises
+    ------
+    InputError
+        Missing path, a folder, not a regular file (a FIFO or device: refused from
+        ``os.stat`` before opening, so nothing blocks), an invalid path, larger than
+        ``max_bytes``, or not readable.
+    """
+    path = Path(path).expanduser()
+    source = str(path)
+
+    def refuse(problem: str) -> InputError:
+        return InputError(f"cannot read {what}: {problem}", source=source, field=field)
+
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise refuse("no such file: it does not exist") from None
+    except NotADirectoryError:
+        raise refuse(
+            "no such file: it does not exist (a part of the path is a file, not a folder)"
+        ) from None
+    except OSError as exc:
+        raise refuse(exc.strerror or str(exc)) from None
+    except ValueError:  # a NUL character in the path
+        raise refuse("not a valid path (it holds a NUL character)") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise refuse("it is a folder; give the path of a file in it")
+    if not stat.S_ISREG(st.st_mode):
+        kind = next((name for test, name in _KINDS if test(st.st_mode)), "not a regular file")
+        raise refuse(f"it is {kind}, not a regular file; give the path of a file")
+    if st.st_size > max_bytes:
+        raise refuse(f"it is {_size(st.st_size)}, above the limit of {_size(max_bytes)}")
+    try:
+        with open(path, "rb") as f:
+            data = f.read(max_bytes + 1)
+    except OSError as exc:
+        raise refuse(exc.strerror or str(exc)) from None
+    if len(data) > max_bytes:  # grew since os.stat
+        raise refuse(f"it is larger than the limit of {_size(max_bytes)}")
+    return data
+
+
 def read_user_text(
     path: str | Path,
     field: str | None = None,
@@ -40,16 +103,7 @@ def read_user_text(
 ) -> str:
     """Read a user's UTF-8 text file, refusing anything else with a clear error.
 
-    Parameters
-    ----------
-    path
-        The file.
-    field
-        Scenario field that names the file (e.g. ``orbit.tle_file``), for the message.
-    what
-        What the file is, for the message (e.g. ``"TLE file"``).
-    max_bytes
-        Size limit [bytes].
+    Parameters are those of :func:`read_user_bytes`.
 
     Returns
     -------
@@ -60,36 +114,15 @@ def read_user_text(
     Raises
     ------
     InputError
-        Missing path, a folder, not a regular file, larger than ``max_bytes``, not
-        readable, or not UTF-8 text (binary, UTF-16, Latin-1...).
+        As :func:`read_user_bytes`, and if the bytes are not UTF-8 text (binary, UTF-16,
+        Latin-1...): the message says where the first bad byte is.
     """
-    source = str(path)
+    data = read_user_bytes(path, field, what=what, max_bytes=max_bytes)
+    source = str(Path(path).expanduser())
 
     def refuse(problem: str) -> InputError:
         return InputError(f"cannot read {what}: {problem}", source=source, field=field)
 
-    try:
-        st = os.stat(path)
-    except FileNotFoundError:
-        raise refuse("no such file") from None
-    except NotADirectoryError:
-        raise refuse("a part of the path is a file, not a folder") from None
-    except OSError as exc:
-        raise refuse(exc.strerror or str(exc)) from None
-    if stat.S_ISDIR(st.st_mode):
-        raise refuse("it is a folder; give the path of a file in it")
-    if not stat.S_ISREG(st.st_mode):
-        kind = next((name for test, name in _KINDS if test(st.st_mode)), "not a regular file")
-        raise refuse(f"it is {kind}, not a regular file; give the path of a text file")
-    if st.st_size > max_bytes:
-        raise refuse(f"it is {_size(st.st_size)}, above the limit of {_size(max_bytes)}")
-    try:
-        with open(path, "rb") as f:
-            data = f.read(max_bytes + 1)
-    except OSError as exc:
-        raise refuse(exc.strerror or str(exc)) from None
-    if len(data) > max_bytes:  # grew since os.stat
-        raise refuse(f"it is larger than the limit of {_size(max_bytes)}")
     return _decode(data, refuse).replace("\r\n", "\n").replace("\r", "\n")
 
 

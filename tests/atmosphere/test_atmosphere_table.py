@@ -98,5 +98,5 @@ def test_table_with_nan_or_garbage_is_refused_with_the_line(tmp_path: Path) -> N
     assert err.value.source == str(nan) and err.value.field == "atmosphere.table_file"
     garbage = tmp_path / "garbage.csv"
     garbage.write_bytes(bytes.fromhex("1e746b79c84295ebda3c6c5133f46f88"))
-    with pytest.raises(InputError, match=r"garbage\.csv.*byte 0xc8, which is not UTF-8"):
+    with pytest.raises(InputError, match=r"garbage\.csv.*byte 0xc8 at line 1, .*is not UTF-8"):
         transmission("table", GRID_NM, [60.0], 0.0, table_file=garbage)

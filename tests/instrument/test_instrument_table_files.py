@@ -55,9 +55,9 @@ def no_hang() -> Iterator[None]:
 @pytest.mark.parametrize(
     ("content", "message"),
     [
-        (GARBAGE, r"line 1 holds byte 0xc8, which is not UTF-8"),
+        (GARBAGE, r"byte 0xc8 at line 1, .*is not UTF-8"),
         ("wavelength_nm,value\n450,0.5\n".encode("utf-16"), r"is UTF-16 text.*save it as UTF-8"),
-        (b"wavelength_nm,value\n450,0.5\n500\x00,0.6\n", r"line 3 holds a NUL byte"),
+        (b"wavelength_nm,value\n450,0.5\n500\x00,0.6\n", r"a NUL byte at line 3"),
         (b"wavelength_nm,value\n450,nan\n500,nan\n550,nan\n", r"line 2 .*'nan'.*not a finite"),
         (b"wavelength_nm,value\n450,0.5\n500,inf\n", r"line 3 .*'inf'.*not a finite"),
         (b"wavelength_nm,value\n450,0.5\n", r"at least 2 rows.*found 1 row\(s\) of 2"),

@@ -12,9 +12,9 @@ import numpy as np
 import yaml
 
 import speclight
+from speclight import schema as v
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import variables as v
-from speclight.simulate.geometry_stage import compute_geometry
+from speclight.simulate.geometry_stage import scenario_geometry
 
 SAMPLE_CPF = Path(speclight.__file__).parent / "data/cpf/lcs1_20201127_speclight_sgp4.cpf"
 HOLE_CSV = Path(__file__).parent / "data" / "lcs1_itrf_6h_hole.csv"
@@ -27,7 +27,7 @@ def _flags(
     data["orbit"] = orbit
     data["time"] = {"start": start, "stop": stop, "step_s": step_s}
     loaded = parse_scenario(yaml.safe_dump(data), source="s.yaml", base_dir=tmp_path)
-    return compute_geometry(loaded).flags
+    return scenario_geometry(loaded).flags
 
 
 def test_nan_cpf_record_is_flagged_orbit_failed(tmp_path: Path) -> None:

@@ -77,5 +77,5 @@ def test_cli_exits_2_with_one_line_for_a_fifo_tle_file(tmp_path: Path) -> None:
     assert result.exit_code == 2
     assert result.stderr == (
         f"error: {tmp_path / 'fifo'}: orbit.tle_file: cannot read TLE file: it is a FIFO (named "
-        "pipe), not a regular file; give the path of a text file\n"
+        "pipe), not a regular file; give the path of a file\n"
     )

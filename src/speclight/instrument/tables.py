@@ -12,19 +12,13 @@ cannot exceed 1). An inference is announced with a :class:`UserWarning` saying w
 assumed; a header that contradicts its values is an error. Every value must be a finite
 number: a NaN or inf in a table is an error that names the line, not NaN count rates later.
 
-:func:`read_user_bytes` and :func:`read_user_text` read any user file (tables, meshes,
-material files) with the checks that make a bad path an :class:`InputError` rather than a
-hang or a traceback: a missing path, a folder, a FIFO or device (checked with ``os.stat``
-before opening, so a FIFO cannot block), an unreadable file, and for text NUL bytes or
-bytes that are not UTF-8.
+Files are read with :func:`speclight.input_files.read_user_text`, which makes a bad path (a
+missing file, a folder, a FIFO, a device) or bytes that are not UTF-8 text a clear error.
 """
 
 from __future__ import annotations
 
-import codecs
-import os
 import re
-import stat
 import warnings
 from pathlib import Path
 
@@ -32,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
+from speclight.input_files import read_user_text
 
 #: Wavelengths whose maximum is below this are read as micrometres when the header is silent.
 UM_THRESHOLD = 30.0
@@ -39,92 +34,6 @@ UM_THRESHOLD = 30.0
 PERCENT_THRESHOLD = 1.5
 
 _SPLIT = re.compile(r"[,;\t ]+")
-
-
-def read_user_bytes(path: str | Path, field: str) -> bytes:
-    """The bytes of a user file, after checking that it is a readable regular file.
-
-    Parameters
-    ----------
-    path
-        The file (``~`` is expanded).
-    field
-        Scenario field that named the file, for the error message.
-
-    Raises
-    ------
-    InputError
-        If the path does not exist, is a folder, is not a regular file (a FIFO, a device
-        such as ``/dev/zero``, a socket) or cannot be read.
-    """
-    p = Path(path).expanduser()
-    src = str(p)
-    try:
-        mode = os.stat(p).st_mode
-    except (FileNotFoundError, NotADirectoryError):
-        raise InputError(f"file {src!r} does not exist", source=src, field=field) from None
-    except OSError as exc:
-        raise InputError(f"cannot read {src!r}: {exc.strerror}", source=src, field=field) from None
-    except ValueError:  # a NUL character in the path
-        raise InputError(f"{src!r} is not a valid path", source=src, field=field) from None
-    if stat.S_ISDIR(mode):
-        raise InputError(f"{src!r} is a folder; give the path of a file", source=src, field=field)
-    if not stat.S_ISREG(mode):
-        raise InputError(
-            f"{src!r} is not a regular file (a FIFO, device or socket); give the path of a file",
-            source=src,
-            field=field,
-        )
-    try:
-        return p.read_bytes()
-    except OSError as exc:
-        raise InputError(f"cannot read {src!r}: {exc.strerror}", source=src, field=field) from None
-
-
-def read_user_text(path: str | Path, field: str) -> str:
-    """The text of a user file: UTF-8 (a byte-order mark is dropped), checked as in
-    :func:`read_user_bytes`.
-
-    To be merged with ``speclight.input_files.read_user_text``, which has the same job.
-
-    Raises
-    ------
-    InputError
-        As :func:`read_user_bytes`, and if the file holds NUL bytes (binary, or UTF-16) or
-        bytes that are not UTF-8; the message gives the line of the first bad byte.
-    """
-    data = read_user_bytes(path, field)
-    src = str(Path(path).expanduser())
-    if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
-        raise InputError(
-            "is UTF-16 text (it starts with a UTF-16 byte-order mark); save it as UTF-8 text",
-            source=src,
-            field=field,
-        )
-    if data.startswith(codecs.BOM_UTF8):
-        data = data[len(codecs.BOM_UTF8) :]
-    nul = data.find(b"\0")
-    try:
-        text, bad = data.decode("utf-8"), -1
-    except UnicodeDecodeError as exc:
-        text, bad = "", exc.start
-    if nul >= 0 and (bad < 0 or nul < bad):
-        line = data.count(b"\n", 0, nul) + 1
-        raise InputError(
-            f"line {line} holds a NUL byte: this is a binary file (or UTF-16 text), not a "
-            "text table; save it as UTF-8 text",
-            source=src,
-            field=field,
-        )
-    if bad >= 0:
-        line = data.count(b"\n", 0, bad) + 1
-        raise InputError(
-            f"line {line} holds byte 0x{data[bad]:02x}, which is not UTF-8: this is a binary "
-            "file or another encoding, not a text table; save it as UTF-8 text",
-            source=src,
-            field=field,
-        )
-    return text
 
 
 def read_table(path: str | Path, field: str) -> tuple[list[str] | None, NDArray[np.float64]]:

@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError, did_you_mean
-from speclight.instrument.tables import read_user_text
+from speclight.input_files import read_user_text
 
 SHIPPED_BRDF: tuple[str, ...] = ("starlink_v1p5_chassis_532nm", "starlink_v1p5_solar_array_532nm")
 GRID_H_DEG = np.linspace(0.0, 90.0, 361)

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
-from speclight.instrument.tables import read_user_bytes
+from speclight.input_files import read_user_bytes
 from speclight.target.materials import Material
 from speclight.target.parts import Part, Target, assign_materials
 

@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError
-from speclight.instrument.tables import read_user_text
+from speclight.input_files import read_user_text
 from speclight.target.optical_constants import (
     check_nk_name,
     fresnel_reflectance,

@@ -41,7 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
-from speclight.instrument.tables import read_user_bytes
+from speclight.input_files import read_user_bytes
 from speclight.target.reflectance import Reflectance
 
 RGL_SUFFIX = ".bsdf"
