@@ -1,11 +1,11 @@
 """Safe reading of the files a user names (scenario, orbit files, tables, meshes, materials).
 
 :func:`read_user_bytes` and :func:`read_user_text` turn every way a named file can be
-unusable into an :class:`~speclight.errors.InputError` that names the file and the
-scenario field: a path that does not exist, a folder, anything that is not a regular file (a FIFO or a device
-such as ``/dev/zero``: refused from ``os.stat`` before opening, so nothing blocks or
-reads forever), a file above a size limit, and bytes that are not UTF-8 text (the message
-says where the first bad byte is).
+unusable into an :class:`~speclight.errors.InputError` that names the file and the scenario
+field: a path that does not exist, a folder, anything that is not a regular file (a FIFO or
+a device such as ``/dev/zero``: refused from ``os.stat`` before opening, so nothing blocks
+or reads forever), a file above a size limit, and (for text) bytes that are not UTF-8 (the
+message says where the first bad byte is).
 """
 
 from __future__ import annotations
