@@ -40,6 +40,11 @@ class Caster(Protocol):
     def occluded(self, origin: F64, direction: F64, normal: F64) -> NDArray[np.bool_]: ...
 
 
+def _no_hits() -> Hits:
+    """The hits of zero rays."""
+    return Hits(np.zeros(0, bool), np.zeros(0), np.zeros((0, 3)), np.zeros(0, np.int64))
+
+
 def _offset(target: Target) -> float:
     """Shadow-ray start offset along the normal [m]: 1e-5 of the target size."""
     return 1e-5 * target.bounding_sphere()[1]
@@ -224,6 +229,8 @@ class MitsubaCaster:
         return mi.Ray3f(mi.Point3f(o), mi.Vector3f(d))
 
     def intersect(self, origin: F64, direction: F64) -> Hits:
+        if len(origin) == 0:  # Dr.Jit aborts the process on empty arrays (jit_var unknown)
+            return _no_hits()
         mi, dr = self.mi, self.dr
         si = self.scene.ray_intersect(self._rays(origin, direction))
         valid = si.is_valid()
@@ -246,6 +253,8 @@ class MitsubaCaster:
         return Hits(hit, np.where(hit, t, np.nan), n, part_np)
 
     def occluded(self, origin: F64, direction: F64, normal: F64) -> NDArray[np.bool_]:
+        if len(origin) == 0:  # no lit pixel in the batch: Dr.Jit aborts on empty arrays
+            return np.zeros(0, dtype=bool)
         # Offset like Mitsuba's spawn_ray: along the normal, scaled by the coordinate size.
         scale = (1.0 + np.abs(origin).max(axis=1, keepdims=True)) * 2e-5
         o = origin + scale * normal
