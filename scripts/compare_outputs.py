@@ -46,8 +46,13 @@ CASES: list[tuple[str, str, dict[str, Any]]] = [
     (
         "calsphere-path-disk",
         "calsphere",
-        {"render.mode": "path", "render.resolution_px": 32, "render.samples_per_pixel": 4,
-         "illumination.solar_disk": True, "time.step_s": 60.0},
+        {
+            "render.mode": "path",
+            "render.resolution_px": 32,
+            "render.samples_per_pixel": 4,
+            "illumination.solar_disk": True,
+            "time.step_s": 60.0,
+        },
     ),
 ]
 

@@ -97,7 +97,8 @@ def main_weight(m: Material, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mir
         th = np.degrees(np.arccos(np.clip(cos_h, -1.0, 1.0)))
         td = np.degrees(np.arccos(np.clip(cos_d, -1.0, 1.0)))
         return table(th, td) * cos_i
-    raise NotImplementedError(f"bsdf '{m.bsdf}' is not supported (supported: {SUPPORTED})")
+    check_supported([m])  # raises the InputError naming the material and the accepted names
+    raise AssertionError(f"bsdf '{m.bsdf}' is in SUPPORTED but has no pixel weight")
 
 
 def main_factor(m: Material, cos_half_phase: F64, wavelength_nm: F64) -> F64:

@@ -13,6 +13,7 @@ from numpy.typing import NDArray
 
 from speclight import schema
 from speclight.constants import AU_M
+from speclight.errors import InputError
 from speclight.illumination import solar_irradiance_W_m2_nm
 from speclight.render.result import RenderImage
 from speclight.render.session import RenderSession
@@ -26,8 +27,10 @@ from speclight.scenario.sections_light import (
 from speclight.scenario.sections_light import Material as MaterialModel
 from speclight.simulate.geometry_stage import Geometry
 from speclight.target import Material, Reflectance, Target
+from speclight.target.brdf_table import load_brdf_table
 from speclight.target.from_values import BUILTIN_SHAPES
 from speclight.target.mesh_io import load_mesh
+from speclight.target.rgl_file import is_rgl_path
 
 F64 = NDArray[np.float64]
 
@@ -71,6 +74,11 @@ def _material(loaded: LoadedScenario, name: str, m: MaterialModel) -> Material:
     table = m.brdf_table
     if table is not None and Path(table).suffix:  # a file, not a shipped table name
         table = str(loaded.resolve(table))
+    if m.bsdf == "measured" and table is not None and not is_rgl_path(table):
+        try:  # read the lab table now (it is cached), not halfway through the run
+            load_brdf_table(table)
+        except InputError as exc:
+            raise InputError(exc.message, source=exc.source, field=f"{field}.brdf_table") from None
     diffuse = m.diffuse_reflectance
     return Material(
         name=name,
