@@ -16,9 +16,13 @@ MAX_EPOCHS = 10_000_000
 
 
 class Strict(BaseModel):
-    """Base model: unknown keys are errors, values are validated on assignment."""
+    """Base model: unknown keys are errors, values are validated on assignment, and no
+    number may be infinite or NaN (YAML's ``.inf`` and ``.nan``: no field has a meaning for
+    them, and they would pass a bound such as ``gt=0`` or slip through a range check)."""
 
-    model_config = ConfigDict(extra="forbid", validate_assignment=True, frozen=False)
+    model_config = ConfigDict(
+        extra="forbid", validate_assignment=True, frozen=False, allow_inf_nan=False
+    )
 
 
 class TimeGrid(Strict):
@@ -129,7 +133,7 @@ class AxesOrientation(Strict):
             if any(v is not None for v in radec):
                 raise ValueError("give either quaternion or the z/x axis RA/Dec, not both")
             norm = sum(c * c for c in self.quaternion) ** 0.5
-            if abs(norm - 1.0) > 1e-6:
+            if not abs(norm - 1.0) <= 1e-6:  # written so that a NaN norm fails too
                 raise ValueError(f"quaternion {self.quaternion} has norm {norm:.6g}; it must be 1")
         elif any(v is None for v in radec):
             raise ValueError(

@@ -1,0 +1,79 @@
+"""Limits known before a run is started: every one is refused at load time with an
+:class:`InputError` naming the field, the value and what is accepted (issue 9, item 5).
+
+Each scenario is built from a built-in example with one field changed; the reproducer of the
+bad-input audit it stands for is named in the test (``/work/shared/repro/fuzz/NNNN-*``).
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+import pytest
+import yaml
+
+from speclight.errors import InputError
+from speclight.scenario import example_text, parse_scenario
+
+
+def _example(name: str = "calsphere") -> dict[str, Any]:
+    return yaml.safe_load(example_text(name))
+
+
+def _set(d: dict[str, Any], path: str, value: Any) -> dict[str, Any]:
+    d = copy.deepcopy(d)
+    node = d
+    keys = path.split(".")
+    for key in keys[:-1]:
+        node = node[int(key)] if isinstance(node, list) else node.setdefault(key, {})
+    if isinstance(node, list):
+        node[int(keys[-1])] = value
+    else:
+        node[keys[-1]] = value
+    return d
+
+
+def _refused(d: dict[str, Any]) -> str:
+    with pytest.raises(InputError) as err:
+        parse_scenario(yaml.safe_dump(d), source="test.yaml")
+    return str(err.value)
+
+
+# --- non-finite numbers ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("path", "value"),
+    [
+        ("time.step_s", float("inf")),  # fuzz/0022-step-s-inf
+        ("observer.latitude_deg", float("nan")),
+        ("observer.altitude_m", float("-inf")),
+        ("attitude.quaternion.0", float("inf")),
+        ("target.shape.radius_m", float("inf")),
+        ("target.materials.body.reflectance", float("nan")),
+        ("spectrum.step_nm", float("nan")),
+        ("instrument.exposure_s", float("inf")),
+        ("instrument.noise.dark_current_e_per_s", float("inf")),
+        ("instrument.bands.0.gaussian.center_nm", float("inf")),
+    ],
+)
+def test_non_finite_numbers_are_refused(path: str, value: float) -> None:
+    msg = _refused(_set(_example(), path, value))
+    assert f"{path} = {value!r}: Input should be a finite number" in msg
+
+
+def test_non_finite_list_entries_are_refused() -> None:
+    d = _set(_example("box-wing"), "target.shape.bus_size_m", [1.0, float("inf"), 1.5])
+    assert "target.shape.bus_size_m.1 = inf: Input should be a finite number" in _refused(d)
+
+
+def test_nan_quaternion_fails_the_unit_norm_check() -> None:
+    # issue 9 item 8: abs(nan - 1) > 1e-6 is False, so [nan, 0, 0, 0] passed the check
+    from speclight.scenario.sections_geometry import AxesOrientation
+
+    unchecked = AxesOrientation.model_construct(quaternion=[float("nan"), 0.0, 0.0, 0.0])
+    with pytest.raises(ValueError, match=r"norm nan; it must be 1"):
+        unchecked._one_form()  # the norm check on its own, behind the finite-number check
+    d = _set(_example(), "attitude", {"model": "fixed", "quaternion": [float("nan"), 0, 0, 0]})
+    assert "attitude.quaternion.0 = nan: Input should be a finite number" in _refused(d)
