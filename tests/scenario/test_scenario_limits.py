@@ -77,3 +77,37 @@ def test_nan_quaternion_fails_the_unit_norm_check() -> None:
         unchecked._one_form()  # the norm check on its own, behind the finite-number check
     d = _set(_example(), "attitude", {"model": "fixed", "quaternion": [float("nan"), 0, 0, 0]})
     assert "attitude.quaternion.0 = nan: Input should be a finite number" in _refused(d)
+
+
+# --- seeds -------------------------------------------------------------------------------
+
+
+def test_render_seed_above_mitsubas_32_bits_is_refused_at_load() -> None:
+    # fuzz/0290-seed-2-64: render.seed 2**64 was accepted and failed only when the NetCDF
+    # attribute was written, after the whole run
+    for seed in (2**64, 2**32):
+        msg = _refused(_set(_example(), "render.seed", seed))
+        assert f"render.seed = {seed}: Input should be less than or equal to 4294967295" in msg
+
+
+def test_noise_seed_above_64_bits_is_refused_at_load() -> None:
+    msg = _refused(_set(_example(), "instrument.noise.seed", 2**64))
+    assert "instrument.noise.seed = 18446744073709551616: Input should be less than" in msg
+
+
+def test_largest_seeds_are_written_to_netcdf() -> None:
+    # what the limits promise: the largest accepted seeds reach the file (the writer is the
+    # one that failed on 2**64) and numpy's generator takes the noise seed
+    import numpy as np
+    import xarray as xr
+
+    from speclight.io.netcdf import dataset_bytes
+    from speclight.scenario.sections_light import MAX_NOISE_SEED, MAX_RENDER_SEED
+    from speclight.simulate.dataset import global_attributes
+
+    d = _set(_example(), "render.seed", MAX_RENDER_SEED)
+    loaded = parse_scenario(yaml.safe_dump(_set(d, "instrument.noise.seed", MAX_NOISE_SEED)))
+    ds = xr.Dataset(attrs=global_attributes(loaded))
+    back = xr.open_dataset(bytes(dataset_bytes(ds)), engine="h5netcdf")
+    assert int(back.attrs["seed"]) == MAX_RENDER_SEED
+    np.random.default_rng(loaded.scenario.instrument.noise.seed)  # type: ignore[union-attr]

@@ -25,6 +25,14 @@ ConductorName = Literal["Al", "Ag", "Au"]
 DielectricName = Literal["SiO2", "Si", "GaAs", "Kapton"]
 BuiltinShape = Literal["sphere", "plate", "cube", "cylinder", "box_wing"]
 
+#: Largest ``render.seed``: Mitsuba's sampler seed is a 32-bit unsigned integer
+#: (``mi.render(seed=...)`` takes a ``UInt32``; :mod:`speclight.render.path` reduces its
+#: per-pass seeds modulo 2**32), so a larger seed would repeat the images of a smaller one.
+MAX_RENDER_SEED = 2**32 - 1
+#: Largest ``instrument.noise.seed``: numpy's ``SeedSequence`` takes any integer >= 0, the
+#: NetCDF writer (h5netcdf) stores integer attributes up to uint64; 2**64 failed at write time.
+MAX_NOISE_SEED = 2**64 - 1
+
 
 class ReflectanceFile(Strict):
     file: str = Field(description="CSV of wavelength and reflectance (header names the units)")
@@ -319,7 +327,7 @@ class Render(Strict):
     mode: Literal["single", "path"] = "single"
     resolution_px: int = Field(default=256, ge=8, le=8192)
     samples_per_pixel: int = Field(default=16, ge=1, le=1_000_000)
-    seed: int = Field(default=0, ge=0)
+    seed: int = Field(default=0, ge=0, le=MAX_RENDER_SEED)
     variant: str | None = Field(default=None, description="Force a Mitsuba variant")
     save_images_at: list[int] = Field(
         default_factory=list, description="Epoch indices whose images and depth maps are saved"
@@ -357,7 +365,7 @@ class Band(Strict):
 
 class Noise(Strict):
     enabled: bool = True
-    seed: int = Field(default=0, ge=0)
+    seed: int = Field(default=0, ge=0, le=MAX_NOISE_SEED)
     sky_background_mag_arcsec2: float = Field(default=21.0, ge=10, le=30)
     aperture_radius_arcsec: float = Field(default=3.0, gt=0)
     dark_current_e_per_s: float = Field(default=0.0, ge=0)
