@@ -111,3 +111,42 @@ def test_largest_seeds_are_written_to_netcdf() -> None:
     back = xr.open_dataset(bytes(dataset_bytes(ds)), engine="h5netcdf")
     assert int(back.attrs["seed"]) == MAX_RENDER_SEED
     np.random.default_rng(loaded.scenario.instrument.noise.seed)  # type: ignore[union-attr]
+
+
+# --- time window inside the shipped ephemeris ----------------------------------------------
+
+
+def test_ephemeris_span_constant_is_the_shipped_de421_file() -> None:
+    # reference: the segment table of skyfield-data's de421.bsp (every body, the same span)
+    from speclight.orbit.timescale import load_ephemeris
+    from speclight.scenario.sections_geometry import EPHEMERIS_SPAN_TDB_JD
+
+    segments = [s.spk_segment for s in load_ephemeris().segments]
+    assert min(s.start_jd for s in segments) == EPHEMERIS_SPAN_TDB_JD[0]
+    assert max(s.end_jd for s in segments) == EPHEMERIS_SPAN_TDB_JD[1]
+
+
+@pytest.mark.parametrize(
+    ("start", "stop"),
+    [
+        ("1850-01-01 00:00:00+00:00", "1850-01-01 00:00:09+00:00"),  # fuzz/0029
+        ("2060-01-01 00:00:00+00:00", "2060-01-01 00:00:09+00:00"),  # fuzz/0030
+        ("9999-12-31 23:59:00+00:00", "9999-12-31 23:59:09+00:00"),  # fuzz/0032
+        ("0001-01-01 00:00:00+00:00", "0001-01-01 00:00:09+00:00"),  # fuzz/0033
+        ("2053-10-07 00:00:00+00:00", "2053-10-09 00:00:00+00:00"),  # ends past the span
+        ("1899-07-29 00:00:00+00:00", "1899-07-29 12:00:00+00:00"),  # starts in the margin
+    ],
+)
+def test_time_window_outside_the_ephemeris_is_refused_at_load(start: str, stop: str) -> None:
+    d = _set(_set(_example(), "time.start", start), "time.stop", stop)
+    d["time"]["step_s"] = 3600.0
+    msg = _refused(d)
+    assert "time: " in msg and "DE421" in msg
+    assert "1899-07-30" in msg and "2053-10-08" in msg  # the accepted span, named
+
+
+def test_time_window_at_the_edges_of_the_span_is_accepted() -> None:
+    d = _set(_example(), "time.start", "1899-07-30 00:00:00+00:00")
+    d = _set(d, "time.stop", "2053-10-08 00:00:00+00:00")
+    d["time"]["step_s"] = 86400.0 * 365
+    parse_scenario(yaml.safe_dump(d))
