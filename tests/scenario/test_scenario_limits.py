@@ -150,3 +150,43 @@ def test_time_window_at_the_edges_of_the_span_is_accepted() -> None:
     d = _set(d, "time.stop", "2053-10-08 00:00:00+00:00")
     d["time"]["step_s"] = 86400.0 * 365
     parse_scenario(yaml.safe_dump(d))
+
+
+# --- built-in shape sizes --------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("example", "path", "value", "radius"),
+    [
+        ("box-wing", "target.shape.wing_gap_m", 1e9, "1e+09"),  # fuzz/0533 (SIGABRT in Dr.Jit)
+        ("calsphere", "target.shape.radius_m", 1e7, "1e+07"),  # fuzz/0535
+        ("calsphere", "target.shape.radius_m", 1e-4, "0.0001"),
+    ],
+)
+def test_builtin_shape_out_of_scale_is_refused(
+    example: str, path: str, value: float, radius: str
+) -> None:
+    msg = _refused(_set(_example(example), path, value))
+    assert f"target.shape: builtin '{_builtin(example)}' has a bounding radius" in msg
+    assert f"bounding radius {radius} m" in msg and "accepted: 0.001 to 100000 m" in msg
+
+
+def _builtin(example: str) -> str:
+    return str(_example(example)["target"]["shape"]["builtin"])
+
+
+def test_tiny_cube_is_refused() -> None:
+    # fuzz/0536-cube-edge-1e-12 (SIGABRT in Dr.Jit): bounding radius edge * sqrt(3) / 2
+    d = _set(_example(), "target.shape", {"builtin": "cube", "edge_m": 1e-12})
+    d["target"]["materials"] = {"*": {"bsdf": "lambertian", "reflectance": 0.5}}
+    assert "builtin 'cube' has a bounding radius 8.66e-13 m" in _refused(d)
+
+
+def test_shape_scale_limits_are_the_mesh_readers() -> None:
+    from speclight.target.mesh_io import MAX_BOUNDING_RADIUS_M, MIN_BOUNDING_RADIUS_M
+
+    ok_small = _set(_example(), "target.shape.radius_m", MIN_BOUNDING_RADIUS_M)
+    ok_large = _set(_example(), "target.shape.radius_m", MAX_BOUNDING_RADIUS_M)
+    for d in (ok_small, ok_large):
+        parse_scenario(yaml.safe_dump(d))
+    _refused(_set(_example(), "target.shape.radius_m", MAX_BOUNDING_RADIUS_M * 1.01))

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
+import numpy as np
 from pydantic import (
     BaseModel,
     Discriminator,
@@ -209,7 +210,38 @@ class Shape(Strict):
                 f"builtin '{self.builtin}' takes {', '.join(_SHAPE_SIZES[self.builtin])}, "
                 f"not {', '.join(extra)}"
             )
+        _check_scale(self.builtin, {k: getattr(self, k) for k in sizes})
         return self
+
+
+def _check_scale(builtin: str, sizes: dict[str, Any]) -> None:
+    """Refuse a built-in shape whose bounding radius is out of any space object's scale.
+
+    The limits are the mesh reader's (:data:`~speclight.target.mesh_io.MIN_BOUNDING_RADIUS_M`
+    .. :data:`~speclight.target.mesh_io.MAX_BOUNDING_RADIUS_M`, 1 mm to 100 km): outside
+    them a size is in a wrong unit, and Dr.Jit's single-precision ray tracing aborts the
+    process (a 1e-12 m cube, a 1e9 m wing gap). The radius is that of the shape as built
+    (:meth:`~speclight.target.parts.Target.bounding_sphere`; the defaults filled in), so no
+    size formula is repeated here; building a built-in shape takes well under a millisecond.
+    """
+    from speclight.target import Material as TargetMaterial
+    from speclight.target import Reflectance as TargetReflectance
+    from speclight.target.from_values import BUILTIN_SHAPES
+    from speclight.target.mesh_io import MAX_BOUNDING_RADIUS_M, MIN_BOUNDING_RADIUS_M
+
+    builder, _ = BUILTIN_SHAPES[builtin]
+    white = TargetReflectance.constant(1.0)
+    probe = TargetMaterial(name="probe", bsdf="lambertian", reflectance=white)
+    kwargs = {k: tuple(v) if isinstance(v, list) else v for k, v in sizes.items()}
+    with np.errstate(all="ignore"):  # sizes near 1e308 overflow to inf: refused below
+        _, radius = builder(materials=probe, **kwargs).bounding_sphere()  # type: ignore[operator]
+    if not MIN_BOUNDING_RADIUS_M <= radius <= MAX_BOUNDING_RADIUS_M:
+        given = ", ".join(f"{k} = {v}" for k, v in sizes.items()) or "its default sizes"
+        raise ValueError(
+            f"builtin '{builtin}' has a bounding radius {radius:.3g} m ({given}); accepted: "
+            f"{MIN_BOUNDING_RADIUS_M:g} to {MAX_BOUNDING_RADIUS_M:g} m (a 1 mm fragment to "
+            "100 km): check the unit of the sizes (metres)"
+        )
 
 
 _SHAPE_FIELDS = sorted({k for sizes in _SHAPE_SIZES.values() for k in sizes})
