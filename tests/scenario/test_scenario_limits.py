@@ -190,3 +190,22 @@ def test_shape_scale_limits_are_the_mesh_readers() -> None:
     for d in (ok_small, ok_large):
         parse_scenario(yaml.safe_dump(d))
     _refused(_set(_example(), "target.shape.radius_m", MAX_BOUNDING_RADIUS_M * 1.01))
+
+
+# --- noise parameters --------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "bound"),
+    [
+        ("instrument.noise.dark_current_e_per_s", 1e300, "6241509074460.763"),  # fuzz/0246
+        ("instrument.noise.read_noise_e", 1e7, "1000000"),
+        ("instrument.noise.aperture_radius_arcsec", 1e6, "648000"),
+        ("instrument.exposure_s", 1e5, "86400"),
+    ],
+)
+def test_noise_parameters_above_their_physical_ceiling_are_refused(
+    path: str, value: float, bound: str
+) -> None:
+    msg = _refused(_set(_example(), path, value))
+    assert f"{path} = {value!r}: Input should be less than or equal to {bound}" in msg

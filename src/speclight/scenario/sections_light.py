@@ -395,18 +395,33 @@ class Band(Strict):
         return self
 
 
+#: The elementary charge [C] (exact, SI 2019; CODATA 2018).
+ELEMENTARY_CHARGE_C = 1.602176634e-19
+#: Largest dark current summed over the photometric aperture [e- s-1]: 1 uA, three decades
+#: above an uncooled large-area silicon or InGaAs photodiode (~1 nA) and far above any
+#: photon-counting sensor; a larger value is a unit mistake (A or e- per hour for e- s-1).
+MAX_DARK_CURRENT_E_PER_S = 1e-6 / ELEMENTARY_CHARGE_C
+#: Largest read noise of the whole aperture [e- rms]: the noisiest scientific sensors read
+#: ~100 e- rms per pixel, and 1e6 pixels summed (sqrt N) give 1e5; one decade of room.
+MAX_READ_NOISE_E = 1e6
+#: Largest photometric aperture radius [arcsec]: 180 deg, half a great circle.
+MAX_APERTURE_RADIUS_ARCSEC = 180 * 3600.0
+#: Longest exposure [s]: one day; a ground site cannot expose longer in one night.
+MAX_EXPOSURE_S = 86_400.0
+
+
 class Noise(Strict):
     enabled: bool = True
     seed: int = Field(default=0, ge=0, le=MAX_NOISE_SEED)
     sky_background_mag_arcsec2: float = Field(default=21.0, ge=10, le=30)
-    aperture_radius_arcsec: float = Field(default=3.0, gt=0)
-    dark_current_e_per_s: float = Field(default=0.0, ge=0)
-    read_noise_e: float = Field(default=0.0, ge=0)
+    aperture_radius_arcsec: float = Field(default=3.0, gt=0, le=MAX_APERTURE_RADIUS_ARCSEC)
+    dark_current_e_per_s: float = Field(default=0.0, ge=0, le=MAX_DARK_CURRENT_E_PER_S)
+    read_noise_e: float = Field(default=0.0, ge=0, le=MAX_READ_NOISE_E)
 
 
 class Instrument(Strict):
     optics_transmission: SpectralCurve = 1.0
     detector_qe: SpectralCurve = 1.0
-    exposure_s: float = Field(default=1.0, gt=0)
+    exposure_s: float = Field(default=1.0, gt=0, le=MAX_EXPOSURE_S)
     bands: list[Band] = Field(default_factory=list)
     noise: Noise | None = None
