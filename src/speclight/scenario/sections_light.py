@@ -355,15 +355,36 @@ class Spectrum(Strict):
         return self
 
 
+#: Most path-mode samples per pixel: the Monte Carlo noise falls as spp**-0.5 from 4.1 % per
+#: 5 nm bin and epoch at 16 spp (BENCHMARKS.md, "Rendering"), to 0.064 % at 65536, below any
+#: measurement's precision; more only costs time.
+MAX_SAMPLES_PER_PIXEL = 65_536
+#: Path-mode samples traced per second (box-wing, ``llvm_ad_spectral``, 128 px, 2 cores:
+#: BENCHMARKS.md "Rendering", 64 -> 256 spp adds 3.1e6 samples in 1.2 s per epoch).
+PATH_SAMPLES_PER_S = 2.5e6
+
+
 class Render(Strict):
     mode: Literal["single", "path"] = "single"
     resolution_px: int = Field(default=256, ge=8, le=8192)
-    samples_per_pixel: int = Field(default=16, ge=1, le=1_000_000)
+    samples_per_pixel: int = Field(default=16, ge=1)
     seed: int = Field(default=0, ge=0, le=MAX_RENDER_SEED)
     variant: str | None = Field(default=None, description="Force a Mitsuba variant")
     save_images_at: list[int] = Field(
         default_factory=list, description="Epoch indices whose images and depth maps are saved"
     )
+
+    @model_validator(mode="after")
+    def _samples(self) -> Render:
+        if self.samples_per_pixel > MAX_SAMPLES_PER_PIXEL:
+            per_epoch_s = self.resolution_px**2 * self.samples_per_pixel / PATH_SAMPLES_PER_S
+            raise ValueError(
+                f"samples_per_pixel = {self.samples_per_pixel} would take about "
+                f"{per_epoch_s:.3g} s per epoch at {self.resolution_px} px "
+                f"({PATH_SAMPLES_PER_S:.2g} samples/s); accepted: at most "
+                f"{MAX_SAMPLES_PER_PIXEL} (0.06 % Monte Carlo noise per bin and epoch)"
+            )
+        return self
 
 
 SpectralCurve = float | str | ReflectanceFile
