@@ -84,3 +84,29 @@ def test_sky_rate_from_surface_brightness_closed_form() -> None:
         sky_count_rate_per_s(
             mu, area, wl, np.ones(wl.size), np.ones(wl.size), band_response(["G-550/40"], wl)
         )
+
+
+def test_dark_current_1e300_does_not_overflow_the_poisson_draw() -> None:
+    # fuzz/0246-noise-dark-current-1e300: numpy's poisson refuses lam > ~9.2e18 (ValueError)
+    rates = np.array([[5.0, 5.0]])
+    m = simulate_measurement(rates, 1.0, dark_current_e_per_s=1e300, seed=2)
+    assert np.all(np.isfinite(m))
+    faint = simulate_measurement(np.full((N_SAMPLES, 1), 2.5), 1.0, seed=1)[:, 0]
+    assert np.all(faint == np.round(faint))  # below the threshold: still integer Poisson
+
+
+def test_normal_approximation_has_the_poisson_moments() -> None:
+    # Above POISSON_MAX_MEAN the count is N(lam, lam): mean lam and variance lam are those of
+    # Poisson(lam); the Z-tests as in test_sample_mean_and_variance_match_poisson_plus_read_noise
+    # (read noise 0, so the fourth central moment is lam + 3 lam^2).
+    from speclight.instrument.noise import POISSON_MAX_MEAN
+
+    t = 1.0
+    # just below (numpy's Poisson), above, above numpy's 9.2e18 limit
+    for lam in (POISSON_MAX_MEAN * 0.999, POISSON_MAX_MEAN * 1e4, 1e20):
+        m = simulate_measurement(np.full((N_SAMPLES, 1), lam), t, seed=11)[:, 0]
+        mean_se = np.sqrt(lam / N_SAMPLES)
+        assert abs(m.mean() - lam) < Z_MAX * mean_se
+        mu4 = lam + 3 * lam**2
+        var_se = np.sqrt((mu4 - lam**2 * (N_SAMPLES - 3) / (N_SAMPLES - 1)) / N_SAMPLES)
+        assert abs(m.var(ddof=1) - lam) < Z_MAX * var_se

@@ -7,18 +7,41 @@ validate and convert; the physics lives in the stage subpackages.
 
 from __future__ import annotations
 
-from datetime import UTC, datetime
+from datetime import UTC, datetime, timedelta
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 MAX_EPOCHS = 10_000_000
+#: Span of the JPL DE421 ephemeris shipped in skyfield-data (``de421.bsp``: every segment
+#: covers Julian dates 2414864.5 .. 2471184.5 TDB, 1899-07-29 .. 2053-10-09; Folkner et al.
+#: 2009, IPN Progress Report 42-178). The Sun's position, hence every run, needs it.
+EPHEMERIS_SPAN_TDB_JD = (2414864.5, 2471184.5)
+#: How far inside that span the time window must stay: the Sun and Earth-orientation grids
+#: reach 6 hourly steps beyond the window (``GRID_PAD_STEPS`` in :mod:`speclight.orbit.frames`
+#: and :mod:`speclight.orbit.sun`), the Sun is observed 8.3 min of light time earlier, and
+#: TDB - UTC stays within -3 .. +100 s over the span; one day covers all of them.
+EPHEMERIS_MARGIN = timedelta(days=1)
+
+
+def _utc_of_jd(jd: float) -> datetime:
+    """The UTC date of a Julian date, to the day (TDB - UTC is inside ``EPHEMERIS_MARGIN``)."""
+    return datetime(2000, 1, 1, 12, tzinfo=UTC) + timedelta(days=jd - 2451545.0)
+
+
+#: First and last accepted epoch of a time window (UTC).
+FIRST_EPOCH_UTC = _utc_of_jd(EPHEMERIS_SPAN_TDB_JD[0]) + EPHEMERIS_MARGIN
+LAST_EPOCH_UTC = _utc_of_jd(EPHEMERIS_SPAN_TDB_JD[1]) - EPHEMERIS_MARGIN
 
 
 class Strict(BaseModel):
-    """Base model: unknown keys are errors, values are validated on assignment."""
+    """Base model: unknown keys are errors, values are validated on assignment, and no
+    number may be infinite or NaN (YAML's ``.inf`` and ``.nan``: no field has a meaning for
+    them, and they would pass a bound such as ``gt=0`` or slip through a range check)."""
 
-    model_config = ConfigDict(extra="forbid", validate_assignment=True, frozen=False)
+    model_config = ConfigDict(
+        extra="forbid", validate_assignment=True, frozen=False, allow_inf_nan=False
+    )
 
 
 class TimeGrid(Strict):
@@ -42,6 +65,12 @@ class TimeGrid(Strict):
             raise ValueError(
                 f"stop ({self.stop.isoformat()}) is before start ({self.start.isoformat()}); "
                 "give a stop time after the start time"
+            )
+        if self.start < FIRST_EPOCH_UTC or self.stop > LAST_EPOCH_UTC:
+            raise ValueError(
+                f"the window {self.start.isoformat()} .. {self.stop.isoformat()} is outside "
+                f"what the shipped Sun ephemeris (JPL DE421) covers; accepted: "
+                f"{FIRST_EPOCH_UTC.date()} to {LAST_EPOCH_UTC.date()} UTC"
             )
         if span_s / self.step_s + 1 > MAX_EPOCHS:
             raise ValueError(
@@ -129,7 +158,7 @@ class AxesOrientation(Strict):
             if any(v is not None for v in radec):
                 raise ValueError("give either quaternion or the z/x axis RA/Dec, not both")
             norm = sum(c * c for c in self.quaternion) ** 0.5
-            if abs(norm - 1.0) > 1e-6:
+            if not abs(norm - 1.0) <= 1e-6:  # written so that a NaN norm fails too
                 raise ValueError(f"quaternion {self.quaternion} has norm {norm:.6g}; it must be 1")
         elif any(v is None for v in radec):
             raise ValueError(

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
+import numpy as np
 from pydantic import (
     BaseModel,
     Discriminator,
@@ -24,6 +25,14 @@ BsdfName = Literal["lambertian", "beckmann", "ggx", "plastic", "specular", "meas
 ConductorName = Literal["Al", "Ag", "Au"]
 DielectricName = Literal["SiO2", "Si", "GaAs", "Kapton"]
 BuiltinShape = Literal["sphere", "plate", "cube", "cylinder", "box_wing"]
+
+#: Largest ``render.seed``: Mitsuba's sampler seed is a 32-bit unsigned integer
+#: (``mi.render(seed=...)`` takes a ``UInt32``; :mod:`speclight.render.path` reduces its
+#: per-pass seeds modulo 2**32), so a larger seed would repeat the images of a smaller one.
+MAX_RENDER_SEED = 2**32 - 1
+#: Largest ``instrument.noise.seed``: numpy's ``SeedSequence`` takes any integer >= 0, the
+#: NetCDF writer (h5netcdf) stores integer attributes up to uint64; 2**64 failed at write time.
+MAX_NOISE_SEED = 2**64 - 1
 
 
 class ReflectanceFile(Strict):
@@ -201,7 +210,38 @@ class Shape(Strict):
                 f"builtin '{self.builtin}' takes {', '.join(_SHAPE_SIZES[self.builtin])}, "
                 f"not {', '.join(extra)}"
             )
+        _check_scale(self.builtin, {k: getattr(self, k) for k in sizes})
         return self
+
+
+def _check_scale(builtin: str, sizes: dict[str, Any]) -> None:
+    """Refuse a built-in shape whose bounding radius is out of any space object's scale.
+
+    The limits are the mesh reader's (:data:`~speclight.target.mesh_io.MIN_BOUNDING_RADIUS_M`
+    .. :data:`~speclight.target.mesh_io.MAX_BOUNDING_RADIUS_M`, 1 mm to 100 km): outside
+    them a size is in a wrong unit, and Dr.Jit's single-precision ray tracing aborts the
+    process (a 1e-12 m cube, a 1e9 m wing gap). The radius is that of the shape as built
+    (:meth:`~speclight.target.parts.Target.bounding_sphere`; the defaults filled in), so no
+    size formula is repeated here; building a built-in shape takes well under a millisecond.
+    """
+    from speclight.target import Material as TargetMaterial
+    from speclight.target import Reflectance as TargetReflectance
+    from speclight.target.from_values import BUILTIN_SHAPES
+    from speclight.target.mesh_io import MAX_BOUNDING_RADIUS_M, MIN_BOUNDING_RADIUS_M
+
+    builder, _ = BUILTIN_SHAPES[builtin]
+    white = TargetReflectance.constant(1.0)
+    probe = TargetMaterial(name="probe", bsdf="lambertian", reflectance=white)
+    kwargs = {k: tuple(v) if isinstance(v, list) else v for k, v in sizes.items()}
+    with np.errstate(all="ignore"):  # sizes near 1e308 overflow to inf: refused below
+        _, radius = builder(materials=probe, **kwargs).bounding_sphere()  # type: ignore[operator]
+    if not MIN_BOUNDING_RADIUS_M <= radius <= MAX_BOUNDING_RADIUS_M:
+        given = ", ".join(f"{k} = {v}" for k, v in sizes.items()) or "its default sizes"
+        raise ValueError(
+            f"builtin '{builtin}' has a bounding radius {radius:.3g} m ({given}); accepted: "
+            f"{MIN_BOUNDING_RADIUS_M:g} to {MAX_BOUNDING_RADIUS_M:g} m (a 1 mm fragment to "
+            "100 km): check the unit of the sizes (metres)"
+        )
 
 
 _SHAPE_FIELDS = sorted({k for sizes in _SHAPE_SIZES.values() for k in sizes})
@@ -315,15 +355,36 @@ class Spectrum(Strict):
         return self
 
 
+#: Most path-mode samples per pixel: the Monte Carlo noise falls as spp**-0.5 from 4.1 % per
+#: 5 nm bin and epoch at 16 spp (BENCHMARKS.md, "Rendering"), to 0.064 % at 65536, below any
+#: measurement's precision; more only costs time.
+MAX_SAMPLES_PER_PIXEL = 65_536
+#: Path-mode samples traced per second (box-wing, ``llvm_ad_spectral``, 128 px, 2 cores:
+#: BENCHMARKS.md "Rendering", 64 -> 256 spp adds 3.1e6 samples in 1.2 s per epoch).
+PATH_SAMPLES_PER_S = 2.5e6
+
+
 class Render(Strict):
     mode: Literal["single", "path"] = "single"
     resolution_px: int = Field(default=256, ge=8, le=8192)
-    samples_per_pixel: int = Field(default=16, ge=1, le=1_000_000)
-    seed: int = Field(default=0, ge=0)
+    samples_per_pixel: int = Field(default=16, ge=1)
+    seed: int = Field(default=0, ge=0, le=MAX_RENDER_SEED)
     variant: str | None = Field(default=None, description="Force a Mitsuba variant")
     save_images_at: list[int] = Field(
         default_factory=list, description="Epoch indices whose images and depth maps are saved"
     )
+
+    @model_validator(mode="after")
+    def _samples(self) -> Render:
+        if self.samples_per_pixel > MAX_SAMPLES_PER_PIXEL:
+            per_epoch_s = self.resolution_px**2 * self.samples_per_pixel / PATH_SAMPLES_PER_S
+            raise ValueError(
+                f"samples_per_pixel = {self.samples_per_pixel} would take about "
+                f"{per_epoch_s:.3g} s per epoch at {self.resolution_px} px "
+                f"({PATH_SAMPLES_PER_S:.2g} samples/s); accepted: at most "
+                f"{MAX_SAMPLES_PER_PIXEL} (0.06 % Monte Carlo noise per bin and epoch)"
+            )
+        return self
 
 
 SpectralCurve = float | str | ReflectanceFile
@@ -355,18 +416,33 @@ class Band(Strict):
         return self
 
 
+#: The elementary charge [C] (exact, SI 2019; CODATA 2018).
+ELEMENTARY_CHARGE_C = 1.602176634e-19
+#: Largest dark current summed over the photometric aperture [e- s-1]: 1 uA, three decades
+#: above an uncooled large-area silicon or InGaAs photodiode (~1 nA) and far above any
+#: photon-counting sensor; a larger value is a unit mistake (A or e- per hour for e- s-1).
+MAX_DARK_CURRENT_E_PER_S = 1e-6 / ELEMENTARY_CHARGE_C
+#: Largest read noise of the whole aperture [e- rms]: the noisiest scientific sensors read
+#: ~100 e- rms per pixel, and 1e6 pixels summed (sqrt N) give 1e5; one decade of room.
+MAX_READ_NOISE_E = 1e6
+#: Largest photometric aperture radius [arcsec]: 180 deg, half a great circle.
+MAX_APERTURE_RADIUS_ARCSEC = 180 * 3600.0
+#: Longest exposure [s]: one day; a ground site cannot expose longer in one night.
+MAX_EXPOSURE_S = 86_400.0
+
+
 class Noise(Strict):
     enabled: bool = True
-    seed: int = Field(default=0, ge=0)
+    seed: int = Field(default=0, ge=0, le=MAX_NOISE_SEED)
     sky_background_mag_arcsec2: float = Field(default=21.0, ge=10, le=30)
-    aperture_radius_arcsec: float = Field(default=3.0, gt=0)
-    dark_current_e_per_s: float = Field(default=0.0, ge=0)
-    read_noise_e: float = Field(default=0.0, ge=0)
+    aperture_radius_arcsec: float = Field(default=3.0, gt=0, le=MAX_APERTURE_RADIUS_ARCSEC)
+    dark_current_e_per_s: float = Field(default=0.0, ge=0, le=MAX_DARK_CURRENT_E_PER_S)
+    read_noise_e: float = Field(default=0.0, ge=0, le=MAX_READ_NOISE_E)
 
 
 class Instrument(Strict):
     optics_transmission: SpectralCurve = 1.0
     detector_qe: SpectralCurve = 1.0
-    exposure_s: float = Field(default=1.0, gt=0)
+    exposure_s: float = Field(default=1.0, gt=0, le=MAX_EXPOSURE_S)
     bands: list[Band] = Field(default_factory=list)
     noise: Noise | None = None

@@ -14,6 +14,7 @@ from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
 from speclight.simulate.dataset import geometry_dataset, global_attributes
 from speclight.simulate.geometry_stage import Geometry, scenario_geometry
+from speclight.simulate.memory import check_run_limits, grid_epochs
 from speclight.simulate.radiometry import (
     atmosphere_transmission,
     instrument_response,
@@ -99,6 +100,8 @@ def _simulate(
     geometry: Geometry | None,
 ) -> SimulationResult:
     sc = loaded.scenario
+    given = geometry.t_s if geometry is not None else time_utc
+    check_run_limits(loaded, grid_epochs(sc) if given is None else int(np.size(given)))
     target = build_target(loaded) if sc.target is not None else None  # once, and early
     # the one render variant of the run, handed to every render (Sun and lasers)
     session = (

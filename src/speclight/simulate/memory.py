@@ -1,0 +1,203 @@
+"""Up-front limits of a run: its peak memory and its path-mode render time, from the scenario.
+
+A run that cannot fit in memory is refused before any work, with the estimate, the limit and
+the fields to reduce (issue 9), instead of dying with ``MemoryError`` hours later. The model
+is linear in what the pipeline allocates (the coefficients measured as stated in
+BENCHMARKS.md, "Memory"):
+
+* a base: the process, Python, numpy, skyfield and Dr.Jit/LLVM loaded, :data:`BASE_BYTES`;
+* per epoch: the geometry and flags, :data:`BYTES_PER_EPOCH`, and per epoch and wavelength
+  bin the (N, L) arrays (solar irradiance, transmission; with a target also intensity, its
+  standard error and the spectral flux) with their copies in the dataset and the in-memory
+  file, :data:`BYTES_PER_EPOCH_BIN` and :data:`BYTES_PER_RENDERED_EPOCH_BIN`; per epoch and
+  band the count rates and magnitudes, :data:`BYTES_PER_EPOCH_BAND`;
+* per ray of one render batch (single mode: at least one epoch, up to
+  :data:`~speclight.render.material_channels.RAYS_PER_BATCH` rays), :data:`BYTES_PER_RAY`;
+  path mode renders one epoch at a time, on :data:`PATH_BASE_BYTES` more;
+* per saved image: its radiance (float64 in the render, float32 in the dataset), depth and
+  part maps, :data:`BYTES_PER_IMAGE_PIXEL_BIN` per pixel and bin;
+* with lasers: per epoch the range histograms (band x range bin, float64, accumulated and
+  stored) and each laser's spectral intensity.
+
+Every term is an upper bound in the count of rendered epochs (all epochs are assumed lit).
+The limit is :data:`MEMORY_FRACTION` of the machine's physical memory (``os.sysconf``), or
+the process's address-space limit (``RLIMIT_AS``) where that is lower.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import resource
+from dataclasses import dataclass
+
+from speclight.errors import InputError
+from speclight.scenario import LoadedScenario
+from speclight.scenario.scenario_model import Scenario
+from speclight.scenario.sections_light import PATH_SAMPLES_PER_S
+
+MIB = 1024**2
+#: Peak of a run of a few epochs at small resolution, above the pixel term (measured).
+BASE_BYTES = 230 * MIB
+#: Geometry, attitude and flags of one epoch (measured, geometry-only runs) [bytes].
+BYTES_PER_EPOCH = 700
+#: (N, L) arrays of every run, per epoch and bin (measured, geometry-only runs) [bytes].
+BYTES_PER_EPOCH_BIN = 21
+#: (N, L) arrays added by a target: intensity, intensity_std, spectral_flux, float64, each
+#: held twice (the stage's array and the dataset's, then the file) [bytes].
+BYTES_PER_RENDERED_EPOCH_BIN = 3 * 8 * 2
+#: (N, B) count_rate, count_rate_measured, ab_magnitude and their file copies [bytes].
+BYTES_PER_EPOCH_BAND = 3 * 8 * 2
+#: One primary ray of a single-mode batch with its hits, shadow rays and channel weights
+#: (measured: 1024 and 2048 px) [bytes].
+BYTES_PER_RAY = 341
+#: Path mode's extra base: Mitsuba's spectral variant and scene (measured: a first path run
+#: at 128 px peaked at 1137 MiB; its memory did not grow with spp, 64 to 1024) [bytes].
+PATH_BASE_BYTES = 900 * MIB
+#: A saved image per pixel and bin: float64 in the render, float32 in the dataset [bytes].
+BYTES_PER_IMAGE_PIXEL_BIN = 8 + 4
+#: Laser range histograms per epoch, band and range bin: accumulator and stored [bytes].
+BYTES_PER_EPOCH_BAND_RANGE_BIN = 8 * 2
+#: Fraction of the physical memory a run may plan to use: the rest stays for the system and
+#: for the transients the model does not count (allocator slack, Dr.Jit's arenas).
+MEMORY_FRACTION = 0.5
+#: Longest estimated path-mode render accepted [s]: one day. The output is written only at
+#: the end, so a longer run risks losing everything to one interruption: split the window.
+MAX_PATH_RENDER_S = 86_400.0
+
+
+@dataclass(frozen=True)
+class MemoryEstimate:
+    """A run's estimated peak memory [bytes] and its parts (name -> bytes)."""
+
+    total_bytes: int
+    parts: dict[str, int]
+
+
+def grid_epochs(scenario: Scenario) -> int:
+    """Epochs of the scenario's time grid (the count of
+    :func:`speclight.simulate.geometry_stage.time_grid`, without building it)."""
+    grid = scenario.time
+    span_s = (grid.stop - grid.start).total_seconds()
+    return math.floor(span_s / grid.step_s + 1e-9) + 1
+
+
+def _bins(scenario: Scenario) -> int:
+    sp = scenario.spectrum
+    return math.floor((sp.max_nm - sp.min_nm) / sp.step_nm + 1e-9) + 1
+
+
+def estimate_memory(scenario: Scenario, n_epochs: int) -> MemoryEstimate:
+    """The peak memory of a run of ``scenario`` at ``n_epochs`` epochs (model above)."""
+    from speclight.ranging.bins import RANGE_BINS
+    from speclight.render.material_channels import RAYS_PER_BATCH
+
+    n, n_bin = int(n_epochs), _bins(scenario)
+    n_band = len(scenario.instrument.bands)
+    parts = {
+        "base": BASE_BYTES,
+        "epochs": n * (BYTES_PER_EPOCH + n_bin * BYTES_PER_EPOCH_BIN),
+        "bins": n_bin * 8 * (8 + 3 * n_band),  # grids, solar spectrum, band curves
+    }
+    if scenario.target is not None:
+        render = scenario.render
+        pixels = render.resolution_px**2
+        per_epoch = n_bin * BYTES_PER_RENDERED_EPOCH_BIN + n_band * BYTES_PER_EPOCH_BAND
+        parts["spectra"] = n * per_epoch
+        if render.mode == "single":
+            epochs_per_batch = max(1, min(n, RAYS_PER_BATCH // pixels))
+            parts["render batch"] = epochs_per_batch * pixels * BYTES_PER_RAY
+        else:
+            parts["render batch"] = PATH_BASE_BYTES + pixels * BYTES_PER_RAY
+        images = len(set(render.save_images_at))
+        parts["images"] = images * pixels * (n_bin * BYTES_PER_IMAGE_PIXEL_BIN + 16)
+        lasers = len(scenario.illumination.lasers)
+        if lasers:
+            range_bins = RANGE_BINS * (2 if render.mode == "path" else 1)
+            parts["lasers"] = n * (
+                n_band * range_bins * BYTES_PER_EPOCH_BAND_RANGE_BIN + lasers * n_bin * 8 * 2
+            )
+    return MemoryEstimate(sum(parts.values()), parts)
+
+
+def memory_limit_bytes() -> int:
+    """The default limit: :data:`MEMORY_FRACTION` of the physical memory, or the process's
+    address-space limit (``RLIMIT_AS``) where lower."""
+    physical = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    limit = int(MEMORY_FRACTION * physical)
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    if soft != resource.RLIM_INFINITY:
+        limit = min(limit, int(soft))
+    return limit
+
+
+def path_render_seconds(scenario: Scenario, n_epochs: int) -> float:
+    """Estimated path-mode render time [s]: pixels x spp x epochs / :data:`PATH_SAMPLES_PER_S`."""
+    render = scenario.render
+    return render.resolution_px**2 * render.samples_per_pixel * n_epochs / PATH_SAMPLES_PER_S
+
+
+def _gib(n: float) -> str:
+    return f"{n / 1024**3:.3g} GiB"
+
+
+def check_run_limits(loaded: LoadedScenario, n_epochs: int, limit_bytes: int | None = None) -> None:
+    """Refuse a run whose estimated peak memory exceeds the limit, or whose path-mode render
+    would take longer than :data:`MAX_PATH_RENDER_S`, before any work.
+
+    Parameters
+    ----------
+    loaded
+        The validated scenario.
+    n_epochs
+        Epochs the run will compute (the time grid's, or those given).
+    limit_bytes
+        The limit [bytes]; default :func:`memory_limit_bytes`.
+
+    Raises
+    ------
+    InputError
+        With the estimate, its largest parts, the limit and the fields to reduce.
+    """
+    sc = loaded.scenario
+    if sc.target is not None and sc.render.mode == "path":
+        seconds = path_render_seconds(sc, n_epochs)
+        if seconds > MAX_PATH_RENDER_S:
+            raise InputError(
+                f"path mode at {sc.render.resolution_px} px x {sc.render.samples_per_pixel} spp "
+                f"x {n_epochs} epochs would render for about {seconds / 3600:.3g} h "
+                f"({PATH_SAMPLES_PER_S:.2g} samples/s); accepted: at most "
+                f"{MAX_PATH_RENDER_S / 3600:g} h per run: reduce render.samples_per_pixel or "
+                "render.resolution_px, or split the time window into several runs",
+                source=loaded.source,
+                field="render.samples_per_pixel",
+            )
+    limit = memory_limit_bytes() if limit_bytes is None else int(limit_bytes)
+    est = estimate_memory(loaded.scenario, n_epochs)
+    if est.total_bytes <= limit:
+        return
+    largest = sorted(est.parts.items(), key=lambda kv: -kv[1])[:3]
+    shown = ", ".join(f"{k} {_gib(v)}" for k, v in largest)
+    fields = ["time (fewer epochs: a larger step_s or a shorter window)", "spectrum.step_nm"]
+    if loaded.scenario.target is not None:
+        fields += ["render.resolution_px", "render.save_images_at"]
+        if loaded.scenario.render.mode == "path":
+            fields.append("render.samples_per_pixel")
+    raise InputError(
+        f"this run needs about {_gib(est.total_bytes)} of memory ({n_epochs} epochs x "
+        f"{_bins(loaded.scenario)} bins; largest parts: {shown}), more than the limit of "
+        f"{_gib(limit)} ({MEMORY_FRACTION:g} of the physical memory, or the process limit); "
+        f"reduce {', '.join(fields)}",
+        source=loaded.source,
+        field="time",
+    )
+
+
+__all__ = [
+    "MemoryEstimate",
+    "check_run_limits",
+    "estimate_memory",
+    "grid_epochs",
+    "memory_limit_bytes",
+    "path_render_seconds",
+]

@@ -1,0 +1,103 @@
+"""Up-front run limits (speclight.simulate.memory): a run that cannot fit in memory, or whose
+path-mode render would take days, is refused before any work with the estimate and the fields
+to reduce (issue 9, item 5). Reproducers: /work/shared/repro/fuzz/NNNN-*."""
+
+from __future__ import annotations
+
+import time
+from datetime import timedelta
+from typing import Any
+
+import pytest
+import yaml
+
+from speclight.errors import InputError
+from speclight.scenario import LoadedScenario, example_text, parse_scenario
+from speclight.simulate import memory
+from speclight.simulate.pipeline import simulate
+
+GIB = 1024**3
+
+
+def _loaded(name: str = "calsphere", **edits: Any) -> LoadedScenario:
+    d = yaml.safe_load(example_text(name))
+    if edits.pop("no_target", False):
+        d.pop("target")
+    if "window_s" in edits:
+        d["time"]["stop"] = d["time"]["start"] + timedelta(seconds=edits.pop("window_s"))
+    for path, value in edits.items():
+        section, key = path.split("__")
+        d[section][key] = value
+    return parse_scenario(yaml.safe_dump(d), source="test.yaml")
+
+
+def test_epoch_count_is_the_time_grids() -> None:
+    from speclight.simulate.geometry_stage import time_grid
+
+    loaded = _loaded(time__step_s=0.7)
+    assert memory.grid_epochs(loaded.scenario) == time_grid(loaded.scenario.time).size
+
+
+def test_two_million_geometry_epochs_are_refused_up_front() -> None:
+    # fuzz/0017, 0019: 2e6 and 9.9e6 epochs without a target passed the 1e7 epoch limit and
+    # died with MemoryError allocating the (N, 189) solar irradiance
+    loaded = _loaded(no_target=True, window_s=2_000_000, time__step_s=1.0)
+    n = memory.grid_epochs(loaded.scenario)
+    est = memory.estimate_memory(loaded.scenario, n)
+    # the model: 700 B per epoch + 21 B per epoch and bin (189 bins), plus the base
+    assert est.parts["epochs"] == n * (700 + 189 * 21)
+    with pytest.raises(InputError) as err:
+        memory.check_run_limits(loaded, n, limit_bytes=8 * GIB)
+    msg = str(err.value)
+    assert msg.startswith("test.yaml: time: this run needs about 8.92 GiB")
+    assert "2000001 epochs" in msg
+    assert "more than the limit of 8 GiB" in msg and "reduce time" in msg
+
+
+def test_a_run_that_fits_passes() -> None:
+    loaded = _loaded()
+    memory.check_run_limits(loaded, memory.grid_epochs(loaded.scenario), limit_bytes=2 * GIB)
+
+
+def test_resolution_8192_is_refused_for_its_render_batch() -> None:
+    # fuzz/0282: one 8192 px epoch is 67 million primary rays in one batch (~23 GB)
+    loaded = _loaded(render__resolution_px=8192)
+    est = memory.estimate_memory(loaded.scenario, 481)
+    assert est.parts["render batch"] == 8192**2 * memory.BYTES_PER_RAY
+    with pytest.raises(InputError, match=r"render\.resolution_px"):
+        memory.check_run_limits(loaded, 481, limit_bytes=16 * GIB)
+
+
+def test_billion_wavelength_bins_are_refused_before_any_work() -> None:
+    # fuzz/0298: spectrum.step_nm 1e-6 (9.4e8 bins) died allocating the wavelength grid
+    loaded = _loaded(spectrum__step_nm=1e-6)
+    t0 = time.perf_counter()
+    with pytest.raises(InputError, match=r"940000001 bins.*spectrum\.step_nm"):
+        simulate(loaded)  # the default limit: no machine has the ~0.5 TB this needs
+    assert time.perf_counter() - t0 < 1.0
+
+
+def test_day_long_path_render_is_refused_with_its_estimate() -> None:
+    # 256 px x 65536 spp x 481 epochs at 2.5e6 samples/s: about 230 h
+    loaded = _loaded(render__mode="path", render__samples_per_pixel=65536)
+    with pytest.raises(InputError) as err:
+        simulate(loaded)
+    msg = str(err.value)
+    assert "render.samples_per_pixel: path mode at 256 px x 65536 spp x 481 epochs" in msg
+    assert "about 230 h" in msg and "at most 24 h per run" in msg
+
+
+def test_million_spp_is_refused_at_load_with_its_estimate() -> None:
+    # fuzz/0285-path-mode-1e6-spp: ran until killed
+    with pytest.raises(InputError) as err:
+        _loaded(render__mode="path", render__resolution_px=32, render__samples_per_pixel=10**6)
+    msg = str(err.value)
+    assert "samples_per_pixel = 1000000 would take about 410 s per epoch at 32 px" in msg
+    assert "at most 65536" in msg
+
+
+def test_default_limit_is_a_fraction_of_physical_memory() -> None:
+    import os
+
+    physical = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    assert 0 < memory.memory_limit_bytes() <= memory.MEMORY_FRACTION * physical
