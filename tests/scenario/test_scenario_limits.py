@@ -209,3 +209,12 @@ def test_noise_parameters_above_their_physical_ceiling_are_refused(
 ) -> None:
     msg = _refused(_set(_example(), path, value))
     assert f"{path} = {value!r}: Input should be less than or equal to {bound}" in msg
+
+
+@pytest.mark.parametrize("key", ["sigma_nm", "center_nm"])
+def test_a_gaussian_band_wider_than_any_grid_is_refused(key):
+    # repro fuzz/0395, 0474: sigma_nm 1e308 overflowed to NaN count rates with exit 0
+    d = yaml.safe_load(example_text("calsphere"))
+    d["instrument"]["bands"][0]["gaussian"][key] = 1.0e308
+    with pytest.raises(InputError, match=key):
+        parse_scenario(yaml.safe_dump(d), source="test")

@@ -390,9 +390,14 @@ class Render(Strict):
 SpectralCurve = float | str | ReflectanceFile
 
 
+#: Widest Gaussian band [nm]: 100 um, a hundred times any optical grid (a wider one is flat
+#: across the grid, and its normalisation sqrt(2 pi) sigma overflows near 1e308).
+MAX_BAND_SIGMA_NM = 1.0e5
+
+
 class GaussianBand(Strict):
-    center_nm: float = Field(gt=0)
-    sigma_nm: float = Field(gt=0)
+    center_nm: float = Field(gt=0, le=MAX_BAND_SIGMA_NM)
+    sigma_nm: float = Field(gt=0, le=MAX_BAND_SIGMA_NM)
 
 
 class Band(Strict):
