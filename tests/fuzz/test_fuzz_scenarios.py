@@ -13,8 +13,8 @@ without a traceback.
 
 Bounded: fixed examples (``derandomize``), ``max_examples`` and ``deadline`` set, no example
 database; the file runs in about 25 s on 2 cores (``SPECLIGHT_FUZZ_EXAMPLES=2000`` to explore
-further). Internal errors it found that other parts of issue 9 fix are excluded by name, each
-in :func:`known_defect` with its reproducer in ``/work/shared/repro/fuzz``.
+further). The internal errors it found (``time.step_s: inf``, epochs outside DE421, unbounded
+noise parameters: repro fuzz/0022, 0029-0033, 0246) are fixed; nothing is excluded.
 """
 
 from __future__ import annotations
@@ -29,13 +29,13 @@ from typing import Any
 
 import numpy as np
 import yaml
-from hypothesis import HealthCheck, assume, event, given, settings
+from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from speclight.cli import app
 from speclight.errors import InputError
-from speclight.scenario import Scenario, example_names, example_text, load_scenario, parse_scenario
+from speclight.scenario import example_names, example_text, load_scenario
 from speclight.simulate.geometry_stage import scenario_geometry
 from speclight.simulate.radiometry import (
     atmosphere_transmission,
@@ -48,10 +48,6 @@ EXAMPLES = {name: yaml.safe_load(example_text(name)) for name in example_names()
 #: A scenario's own time grid is used up to this many epochs; beyond, three epochs 30 s apart.
 MAX_GRID_EPOCHS = 2000
 EPOCH_OFFSETS_S = np.array([0, 30, 60])
-#: Dates the JPL ephemeris DE421 covers, a day inside (see :func:`known_defect`).
-DE421_COVERS = (datetime(1899, 7, 30, tzinfo=UTC), datetime(2053, 10, 8, tzinfo=UTC))
-#: Noise parameters above this are a known defect (see :func:`known_defect`).
-NOISE_BOUND = 1e6
 FUZZ = settings(
     max_examples=int(os.environ.get("SPECLIGHT_FUZZ_EXAMPLES", "200")),  # more to explore
     deadline=timedelta(seconds=10),
@@ -245,36 +241,10 @@ def _text(data: dict[str, Any]) -> str:
     return yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
 
 
-def known_defect(sc: Scenario) -> str | None:
-    """A documented internal error that another part of issue 9 fixes, or None.
-
-    Each is excluded by name until its fix lands (then delete the line here).
-    """
-    if not math.isfinite(sc.time.step_s):  # repro fuzz/0022-step-s-inf: IndexError in skyfield
-        return "time.step_s = inf (fuzz/0022)"
-    lo, hi = DE421_COVERS
-    if sc.time.start < lo or sc.time.stop + timedelta(minutes=1) > hi:
-        # repro fuzz/0029, 0030, 0032, 0033 (years 1850, 2060, 9999, 1 AD): the time grid is
-        # not checked against the JPL ephemeris, skyfield raises EphemerisRangeError
-        return "epochs outside DE421, 1899-07-29..2053-10-09 (fuzz/0029)"
-    noise = sc.instrument.noise
-    if noise is not None and noise.enabled:
-        # repro fuzz/0246-noise-dark-current-1e300: the noise parameters have no upper bound;
-        # a huge aperture radius overflows (OverflowError), a huge mean count makes numpy's
-        # Poisson draw fail (ValueError: lam value too large)
-        values = (noise.aperture_radius_arcsec, noise.dark_current_e_per_s, noise.read_noise_e)
-        if max(values) > NOISE_BOUND:
-            return "instrument.noise parameter > 1e6 (fuzz/0246)"
-    return None
-
-
 def _cheap_stages(scenario_file: Path) -> None:
     """Load the scenario and run its stages but rendering on at most a short time grid."""
     loaded = load_scenario(scenario_file)
     sc = loaded.scenario
-    if (defect := known_defect(sc)) is not None:
-        event(f"excluded: {defect}")
-        return
     epochs = None
     if (sc.time.stop - sc.time.start).total_seconds() / sc.time.step_s + 1 > MAX_GRID_EPOCHS:
         start = np.datetime64(sc.time.start.replace(tzinfo=None), "ns")
@@ -364,10 +334,6 @@ def test_cli_exits_0_or_2_without_traceback(
     data, files = case
     with tempfile.TemporaryDirectory() as folder:
         scenario = _write(Path(folder), data, files)
-        try:
-            assume(known_defect(parse_scenario(scenario.read_text()).scenario) is None)
-        except InputError:
-            pass
         result = runner.invoke(app, ["simulate", str(scenario), "-o", f"{folder}/out.nc", "-q"])
     event(f"exit {result.exit_code}")
     assert result.exit_code in (0, 2), result.output

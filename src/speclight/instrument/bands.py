@@ -56,12 +56,18 @@ class Band:
     file: Path | None = None
 
 
+#: Largest Gaussian band centre and sigma [nm]: 100 um, a hundred times any optical grid (a
+#: wider band is flat across the grid; near 1e308 its normalisation overflows to NaN).
+MAX_GAUSSIAN_NM = 1.0e5
+
+
 def gaussian_band(center_nm: float, sigma_nm: float, name: str | None = None) -> Band:
     """A Gaussian band of peak 1; the default name is ``G-<centre>/<sigma>``."""
     c, s = float(center_nm), float(sigma_nm)
-    if not (np.isfinite(c) and c > 0 and np.isfinite(s) and s > 0):
+    if not (0 < c <= MAX_GAUSSIAN_NM and 0 < s <= MAX_GAUSSIAN_NM):  # False for NaN
         raise InputError(
-            f"Gaussian band centre {center_nm!r} nm and sigma {sigma_nm!r} nm must be > 0",
+            f"Gaussian band centre {center_nm!r} nm and sigma {sigma_nm!r} nm must be > 0 "
+            f"and at most {MAX_GAUSSIAN_NM:g} nm",
             field="instrument.bands",
         )
     return Band(name or f"G-{c:g}/{s:g}", "gaussian", center_nm=c, sigma_nm=s)
@@ -69,7 +75,7 @@ def gaussian_band(center_nm: float, sigma_nm: float, name: str | None = None) ->
 
 def _require_speclite(reason: str) -> None:
     """An :class:`InputError` saying how to install speclite, if it is missing."""
-    from speclight.scenario.engines import require_engine
+    from speclight.engine_packages import require_engine
 
     require_engine("speclite", "instrument.bands", reason)
 

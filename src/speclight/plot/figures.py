@@ -80,7 +80,7 @@ KINDS = tuple(f.name for f in FIGURES)
 
 def _require_matplotlib() -> None:
     """An :class:`InputError` saying how to install matplotlib, before any work, if missing."""
-    from speclight.scenario.engines import require_engine
+    from speclight.engine_packages import require_engine
 
     require_engine("matplotlib", "plot", "drawing figures")
 

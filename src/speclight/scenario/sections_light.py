@@ -19,6 +19,7 @@ from pydantic import (
     model_validator,
 )
 
+from speclight.instrument.bands import MAX_GAUSSIAN_NM
 from speclight.scenario.sections_geometry import Strict, Vector3
 
 BsdfName = Literal["lambertian", "beckmann", "ggx", "plastic", "specular", "measured"]
@@ -390,14 +391,10 @@ class Render(Strict):
 SpectralCurve = float | str | ReflectanceFile
 
 
-#: Widest Gaussian band [nm]: 100 um, a hundred times any optical grid (a wider one is flat
-#: across the grid, and its normalisation sqrt(2 pi) sigma overflows near 1e308).
-MAX_BAND_SIGMA_NM = 1.0e5
-
-
 class GaussianBand(Strict):
-    center_nm: float = Field(gt=0, le=MAX_BAND_SIGMA_NM)
-    sigma_nm: float = Field(gt=0, le=MAX_BAND_SIGMA_NM)
+    # the instrument stage's bound (a band wider than 100 um is flat across any grid)
+    center_nm: float = Field(gt=0, le=MAX_GAUSSIAN_NM)
+    sigma_nm: float = Field(gt=0, le=MAX_GAUSSIAN_NM)
 
 
 class Band(Strict):
