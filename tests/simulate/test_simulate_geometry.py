@@ -134,3 +134,14 @@ def test_light_time_range_solves_the_light_time_equation(tmp_path) -> None:
     )
     geometric = simulate(parse_scenario(no_delay)).dataset["range"].values
     assert np.all(np.abs(ds["range"].values - geometric) > 1.0)
+
+
+def test_geometry_only_run_allocates_no_spectra() -> None:
+    # issue 9 (fuzz/0019): a run without a target built (N, 189) solar irradiance and
+    # transmission arrays; 2e6 such epochs died with MemoryError
+    loaded = parse_scenario(_scenario(), source="test")
+    result = simulate(loaded)
+    ds = result.dataset
+    assert "wavelength" not in ds.dims and "solar_irradiance" not in ds and "transmission" not in ds
+    assert {"range", "elevation", "phase_angle", "sunlit", "flags"} <= set(ds.data_vars)
+    assert ds.sizes["time"] == result.geometry.t_s.size

@@ -6,11 +6,12 @@ is linear in what the pipeline allocates (the coefficients measured as stated in
 BENCHMARKS.md, "Memory"):
 
 * a base: the process, Python, numpy, skyfield and Dr.Jit/LLVM loaded, :data:`BASE_BYTES`;
-* per epoch: the geometry and flags, :data:`BYTES_PER_EPOCH`, and per epoch and wavelength
-  bin the (N, L) arrays (solar irradiance, transmission; with a target also intensity, its
-  standard error and the spectral flux) with their copies in the dataset and the in-memory
-  file, :data:`BYTES_PER_EPOCH_BIN` and :data:`BYTES_PER_RENDERED_EPOCH_BIN`; per epoch and
-  band the count rates and magnitudes, :data:`BYTES_PER_EPOCH_BAND`;
+* per epoch: the geometry and flags, :data:`BYTES_PER_EPOCH` (a geometry-only run, without a
+  target, allocates nothing per wavelength bin); with a target, per epoch and wavelength bin
+  the (N, L) arrays (solar irradiance, transmission, intensity, its standard error and the
+  spectral flux) with their copies in the dataset and the in-memory file,
+  :data:`BYTES_PER_EPOCH_BIN` and :data:`BYTES_PER_RENDERED_EPOCH_BIN`; per epoch and band the
+  count rates and magnitudes, :data:`BYTES_PER_EPOCH_BAND`;
 * per ray of one render batch (single mode: at least one epoch, up to
   :data:`~speclight.render.material_channels.RAYS_PER_BATCH` rays), :data:`BYTES_PER_RAY`;
   path mode renders one epoch at a time, on :data:`PATH_BASE_BYTES` more;
@@ -39,9 +40,11 @@ from speclight.scenario.sections_light import PATH_SAMPLES_PER_S
 MIB = 1024**2
 #: Peak of a run of a few epochs at small resolution, above the pixel term (measured).
 BASE_BYTES = 230 * MIB
-#: Geometry, attitude and flags of one epoch (measured, geometry-only runs) [bytes].
-BYTES_PER_EPOCH = 700
-#: (N, L) arrays of every run, per epoch and bin (measured, geometry-only runs) [bytes].
+#: Geometry, attitude and flags of one epoch, dataset and file copies included (measured:
+#: geometry-only runs of 2e4, 2e5 and 2e6 epochs, 1.13-1.19 KB per epoch) [bytes].
+BYTES_PER_EPOCH = 1200
+#: Solar irradiance and transmission (N, L) of a run with a target, per epoch and bin
+#: (measured before geometry-only runs stopped writing them: 941 vs 189 bins) [bytes].
 BYTES_PER_EPOCH_BIN = 21
 #: (N, L) arrays added by a target: intensity, intensity_std, spectral_flux, float64, each
 #: held twice (the stage's array and the dataset's, then the file) [bytes].
@@ -96,13 +99,14 @@ def estimate_memory(scenario: Scenario, n_epochs: int) -> MemoryEstimate:
     n_band = len(scenario.instrument.bands)
     parts = {
         "base": BASE_BYTES,
-        "epochs": n * (BYTES_PER_EPOCH + n_bin * BYTES_PER_EPOCH_BIN),
+        "epochs": n * BYTES_PER_EPOCH,
         "bins": n_bin * 8 * (8 + 3 * n_band),  # grids, solar spectrum, band curves
     }
     if scenario.target is not None:
         render = scenario.render
         pixels = render.resolution_px**2
-        per_epoch = n_bin * BYTES_PER_RENDERED_EPOCH_BIN + n_band * BYTES_PER_EPOCH_BAND
+        per_epoch = n_bin * (BYTES_PER_EPOCH_BIN + BYTES_PER_RENDERED_EPOCH_BIN)
+        per_epoch += n_band * BYTES_PER_EPOCH_BAND
         parts["spectra"] = n * per_epoch
         if render.mode == "single":
             epochs_per_batch = max(1, min(n, RAYS_PER_BATCH // pixels))

@@ -112,6 +112,12 @@ def _simulate(
     geo = geometry if geometry is not None else scenario_geometry(loaded, time_utc)
     wavelength_nm = wavelength_grid_nm(sc.spectrum)
     setup = prepare_ranging(loaded, geo, wavelength_nm, target, session)  # None without lasers
+    flags = geo.flags.copy()  # every stage's flag bits: geometry, render, lasers
+    if target is None:  # geometry only: nothing is rendered, so no (N, L) spectra at all
+        ds = geometry_dataset(geo, flags)
+        modes = {"render_mode": sc.render.mode, "atmosphere_model": sc.atmosphere.model}
+        ds.attrs.update(global_attributes(loaded, modes))
+        return SimulationResult(dataset=ds, geometry=geo, notes=_visibility_notes(geo))
     reflection = render_reflection(
         loaded,
         geo,
@@ -131,8 +137,6 @@ def _simulate(
     ranging = None
     if setup is not None:
         ranging = laser_ranging(loaded, geo, setup, transmission, radiometry)
-    # every stage's flag bits: geometry, render, lasers
-    flags = geo.flags.copy()
     if reflection.flags is not None:
         flags |= reflection.flags
     if setup is not None:
