@@ -13,6 +13,7 @@ every reproducer of the audit is covered.
 from __future__ import annotations
 
 import argparse
+import os
 import shutil
 import subprocess
 import sys
@@ -24,8 +25,12 @@ from pathlib import Path
 def run_case(folder: Path, scenario: Path, timeout_s: float) -> tuple[str, float, str]:
     with tempfile.TemporaryDirectory(prefix="speclight-repro-") as tmp:
         for f in folder.iterdir():
-            if f.is_file() and f.suffix not in (".log", ".txt"):
+            if f.suffix == ".IS_A_FIFO":  # the audit's marker: "mkfifo this name to reproduce"
+                os.mkfifo(Path(tmp) / f.stem)
+            elif f.is_file() and f.suffix not in (".log", ".txt"):
                 shutil.copy(f, Path(tmp) / f.name)
+        if "adir" in scenario.read_text():  # the audit's "file is a directory" cases
+            (Path(tmp) / "adir").mkdir()
         cmd = [sys.executable, "-m", "speclight.cli", "simulate", scenario.name, "-o", "out.nc"]
         t0 = time.perf_counter()
         try:
