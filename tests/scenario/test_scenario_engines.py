@@ -209,8 +209,10 @@ def test_sixs_missing_falls_back_to_spectrl2_instead_of_crashing(tmp_path: Path)
 
 
 def test_cli_sixs_missing_with_fallback_is_one_notice(tmp_path: Path) -> None:
-    scenario = _scenario(  # without a target: geometry and atmosphere only, quick
-        tmp_path, drop=("target",), atmosphere={"model": "6s", "fallback_to_spectrl2": True}
+    scenario = _scenario(  # 3 epochs at 32 px: quick, and the atmosphere stage runs
+        tmp_path,
+        atmosphere={"model": "6s", "fallback_to_spectrl2": True},
+        render={"resolution_px": 32},
     )
     out = tmp_path / "out.nc"
     run = _cli(["simulate", str(scenario), "-o", str(out), "-q"], **_SIXS_HIDDEN)
