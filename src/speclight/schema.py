@@ -68,6 +68,12 @@ VARIABLES: dict[str, VariableInfo] = {
     "count_rate_measured": V(
         TB, "s-1", "simulated background-subtracted measurement of the count rate (noisy)"
     ),
+    "reflectance_factor": V(
+        TB,
+        "m2 sr-1",
+        "band count rate x range^2 over the aperture area x the band-weighted solar photon "
+        "irradiance at the aperture (Nussbaum et al. 2022, eq. 5)",
+    ),
     "band_response": V(("band", "wavelength"), "1", "relative spectral response of each band"),
     "optics_transmission": V(("wavelength",), "1", "transmission of the telescope optics"),
     "detector_qe": V(("band", "wavelength"), "1", "detector quantum efficiency"),

@@ -21,6 +21,7 @@ from speclight.instrument.photometry import (
     ab_magnitude,
     ab_reference_W_m2_nm,
     count_rate_per_s,
+    reflectance_factor_m2_sr,
 )
 from speclight.instrument.telescope import aperture_area_m2, spectral_flux_W_nm
 from speclight.wavelength_grid import bin_average, bin_edges_nm, bin_widths_nm
@@ -41,6 +42,7 @@ __all__ = [
     "gaussian_band",
     "load_preset",
     "parse_band",
+    "reflectance_factor_m2_sr",
     "simulate_measurement",
     "sky_count_rate_per_s",
     "speclite_filter_names",

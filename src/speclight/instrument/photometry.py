@@ -83,6 +83,54 @@ def count_rate_per_s(
     return flux @ kernel.T
 
 
+def reflectance_factor_m2_sr(
+    count_rate_per_s: ArrayLike,
+    range_m: ArrayLike,
+    aperture_area_m2: float,
+    illumination_W_m2_nm: ArrayLike,
+    wavelength_nm: ArrayLike,
+    optics: ArrayLike,
+    qe: ArrayLike,
+    band_response: ArrayLike,
+) -> NDArray[np.float64]:
+    """Band signals made free of geometry and source: the reflectance factor per band.
+
+    .. math:: F_j = \\dot N_j R^2 \\Big/ \\Big(A \\int E(\\lambda)\\,\tau_{opt}\\,\\eta\\,R_j
+              \\,\frac{\\lambda}{hc}\\,d\\lambda\\Big)\\quad [\\mathrm{m^2\\,sr^{-1}}]
+
+    (Nussbaum et al. 2022, eq. 5), with ``E`` the irradiance on the target times the
+    transmission to the observer (the solar irradiance x sunlit fraction x T for the Sun).
+    A target whose intensity is ``I = F E`` with a grey ``F`` (a constant spectral
+    reflectance) has the same factor in every band: ``F`` itself.
+
+    Parameters
+    ----------
+    count_rate_per_s
+        (N, B) detected rates [s-1].
+    range_m
+        (N,) observer-target distance [m].
+    aperture_area_m2
+        Collecting area [m2].
+    illumination_W_m2_nm
+        (N, L) irradiance at the target times the transmission to the observer [W m-2 nm-1].
+    wavelength_nm, optics, qe, band_response
+        As for :func:`count_rate_per_s`.
+
+    Returns
+    -------
+    numpy.ndarray
+        (N, B) [m2 sr-1]; NaN where the band receives no light (shadow, below the horizon).
+    """
+    rate = np.asarray(count_rate_per_s, dtype=np.float64)
+    illum = np.asarray(illumination_W_m2_nm, dtype=np.float64)
+    kernel = photon_kernel(wavelength_nm, optics, qe, band_response)
+    _check(illum, np.asarray(wavelength_nm), kernel)
+    photons = aperture_area_m2 * (illum @ kernel.T)  # per unit reflectance factor [s-1 m2]
+    r2 = np.asarray(range_m, dtype=np.float64)[:, None] ** 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.asarray(np.where(photons > 0, rate * r2 / photons, np.nan))
+
+
 def ab_magnitude(
     spectral_flux_W_nm: ArrayLike,
     aperture_area_m2: float,

@@ -131,8 +131,15 @@ def _simulate(
     transmission = atmosphere_transmission(loaded, wavelength_nm, elevation)
     radiometry = None
     if reflection.intensity_W_sr_nm is not None:
+        sunlit = geo.sunlit_fraction if sc.illumination.sun else np.zeros(geo.t_s.size)
+        illumination = reflection.solar_irradiance_W_m2_nm * sunlit[:, None] * transmission
         radiometry = instrument_response(
-            loaded, wavelength_nm, reflection.intensity_W_sr_nm, transmission, geo.range_m
+            loaded,
+            wavelength_nm,
+            reflection.intensity_W_sr_nm,
+            transmission,
+            geo.range_m,
+            illumination_W_m2_nm=illumination,
         )
     ranging = None
     if setup is not None:

@@ -79,6 +79,7 @@ class Radiometry:
     band_response: F64
     optics: F64
     qe: F64
+    reflectance_factor_m2_sr: F64 | None = None
 
 
 def instrument_response(
@@ -87,8 +88,14 @@ def instrument_response(
     intensity_W_sr_nm: F64,
     transmission: F64,
     range_m: F64,
+    illumination_W_m2_nm: F64 | None = None,
 ) -> Radiometry:
-    """Spectral flux at the aperture, band count rates, AB magnitudes and noisy rates."""
+    """Spectral flux at the aperture, band count rates, AB magnitudes and noisy rates.
+
+    ``illumination_W_m2_nm`` (N, L): the irradiance on the target (the Sun's, after the
+    Earth's shadow) times the transmission to the observer; with it the band reflectance
+    factors are computed too (:func:`speclight.instrument.reflectance_factor_m2_sr`).
+    """
     sc = loaded.scenario
     area = instrument.aperture_area_m2(
         sc.telescope.aperture_diameter_m, sc.telescope.obstruction_diameter_m
@@ -149,6 +156,11 @@ def instrument_response(
             read_noise_e=noise.read_noise_e,
             seed=noise.seed,
         )
+    factor = None
+    if illumination_W_m2_nm is not None and bands:
+        factor = instrument.reflectance_factor_m2_sr(
+            rate, range_m, area, illumination_W_m2_nm, wavelength_nm, optics, ones, response * qe
+        )
     return Radiometry(
         band_names=[b.name for b in bands],
         spectral_flux_W_nm=flux,
@@ -158,6 +170,7 @@ def instrument_response(
         band_response=response,
         optics=optics,
         qe=qe,
+        reflectance_factor_m2_sr=factor,
     )
 
 

@@ -40,6 +40,10 @@ def add_spectral(
         ds["count_rate_measured"] = schema.variable(
             "count_rate_measured", radiometry.count_rate_measured_per_s
         )
+    if radiometry.reflectance_factor_m2_sr is not None:
+        ds["reflectance_factor"] = schema.variable(
+            "reflectance_factor", radiometry.reflectance_factor_m2_sr
+        )
     ds["band_response"] = schema.variable("band_response", radiometry.band_response)
     ds["optics_transmission"] = schema.variable("optics_transmission", radiometry.optics)
     ds["detector_qe"] = schema.variable("detector_qe", radiometry.qe)
