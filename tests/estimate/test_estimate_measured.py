@@ -1,0 +1,103 @@
+"""Measured light curves in (issue 10, item 1): CSV and speclight NetCDF, checks, binning.
+
+References: files written here with known values; the binning against sums worked by hand
+(the mean of n rates, the standard error sqrt(sum sigma^2) / n of their mean).
+"""
+
+import numpy as np
+import pytest
+import yaml
+
+from speclight.errors import InputError
+from speclight.estimate.measured import bin_light_curve, read_measured
+from speclight.io.netcdf import write_dataset
+from speclight.scenario import example_text, parse_scenario
+from speclight.simulate import simulate
+
+CSV = """# a camera and a SPAD
+time,B,R,R_sigma
+2020-02-29T21:16:00Z,100.5,20.0,1.5
+2020-02-29T21:16:01+00:00,101.0,,2.0
+2020-02-29T21:16:02,-3.0,nan,0.5
+"""
+
+
+def _write(tmp_path, text, name="lc.csv"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_csv_is_read_with_nan_cells_and_negative_rates_kept(tmp_path):
+    lc = read_measured(_write(tmp_path, CSV))
+    assert lc.band_names == ["B", "R"]
+    expected = np.array(
+        ["2020-02-29T21:16:00", "2020-02-29T21:16:01", "2020-02-29T21:16:02"], "datetime64[ns]"
+    )
+    np.testing.assert_array_equal(lc.time_utc, expected)
+    np.testing.assert_array_equal(lc.rate_per_s, [[100.5, 20.0], [101.0, np.nan], [-3.0, np.nan]])
+    assert lc.sigma_per_s is not None
+    np.testing.assert_array_equal(lc.sigma_per_s[:, 1], [1.5, 2.0, 0.5])
+    assert np.all(np.isnan(lc.sigma_per_s[:, 0]))  # B has no sigma column
+
+
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ("t,B\n2020-01-01T00:00:00Z,1\n", "first column must be 'time'"),
+        ("time,B\n2020-01-01T00:00:01Z,1\n2020-01-01T00:00:00Z,2\n", "line 3: .*comes before"),
+        ("time,B\n2020-01-01T00:00:00Z,1\n2020-01-01T00:00:00Z,2\n", "line 3: .*repeats"),
+        ("time,B\n2020-01-01T00:00:00+02:00,1\n", "UTC offset \\+02:00"),
+        ("time,B\nyesterday,1\n", "line 2: 'yesterday' is not an ISO 8601 time"),
+        ("time,B\n2020-01-01T00:00:00Z,lots\n", "line 2: 'lots' in column 'B' is not a number"),
+        ("time,B\n2020-01-01T00:00:00Z,1,2\n", "line 2: 3 cells, the header names 2"),
+        ("time,B,G_sigma\n2020-01-01T00:00:00Z,1,2\n", "'G_sigma' is the sigma of no band"),
+        ("time,B,B_sigma\n2020-01-01T00:00:00Z,1,-2\n", "sigma -2 is negative"),
+        ("time,B\n", "a header but no rows"),
+        ("# only a comment\n", "no header and no rows"),
+    ],
+)
+def test_bad_csv_is_refused_with_the_line(tmp_path, text, match):
+    with pytest.raises(InputError, match=match) as err:
+        read_measured(_write(tmp_path, text))
+    assert err.value.source == str(tmp_path / "lc.csv")
+
+
+def test_bands_are_checked_against_the_scenario(tmp_path):
+    lc = read_measured(_write(tmp_path, CSV))
+    assert lc.select_bands(["R", "B"]).band_names == ["R", "B"]
+    np.testing.assert_array_equal(lc.select_bands(["R", "B"]).rate_per_s[:, 1], lc.rate_per_s[:, 0])
+    with pytest.raises(InputError, match=r"band 'RR' .*did you mean 'R'"):
+        lc.select_bands(["B", "RR"])
+
+
+def test_a_speclight_dataset_gives_its_noisy_rates(tmp_path):
+    d = yaml.safe_load(example_text("calsphere"))
+    d["time"] = {"start": "2020-02-29T21:16:00Z", "stop": "2020-02-29T21:16:10Z", "step_s": 2.0}
+    d["render"]["resolution_px"] = 32
+    ds = simulate(parse_scenario(yaml.safe_dump(d), source="test")).dataset
+    path = write_dataset(ds, tmp_path / "pass.nc")
+    lc = read_measured(path)
+    assert lc.band_names == [str(b) for b in ds["band"].values]
+    np.testing.assert_array_equal(lc.time_utc, ds["time"].values)
+    np.testing.assert_array_equal(lc.rate_per_s, ds["count_rate_measured"].values)
+    assert lc.sigma_per_s is None
+
+
+def test_binning_averages_rates_and_combines_sigmas(tmp_path):
+    rows = ["time,A,A_sigma"]
+    rates = [1.0, 3.0, 5.0, np.nan, 11.0]
+    sig = [1.0, 2.0, 2.0, 1.0, 4.0]
+    for k, (r, s) in enumerate(zip(rates, sig, strict=True)):
+        rows.append(f"2020-01-01T00:00:0{k}.5Z,{r},{s}")
+    lc = read_measured(_write(tmp_path, "\n".join(rows) + "\n"))
+    binned = bin_light_curve(lc, 2.0)  # bins [0, 2), [2, 4), [4, 6) s from the first epoch
+    np.testing.assert_array_equal(binned.n_samples, [2, 2, 1])
+    np.testing.assert_allclose(binned.rate_per_s[:, 0], [2.0, 5.0, 11.0])  # the NaN is skipped
+    np.testing.assert_allclose(binned.sigma_per_s[:, 0], [np.sqrt(5) / 2, 2.0, 4.0])
+    expected = np.array(
+        ["2020-01-01T00:00:01", "2020-01-01T00:00:03", "2020-01-01T00:00:04.5"], "datetime64[ns]"
+    )
+    np.testing.assert_array_equal(binned.time_utc, expected)
+    with pytest.raises(InputError, match="--bin-s"):
+        bin_light_curve(lc, 0.0)
