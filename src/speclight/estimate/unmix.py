@@ -60,7 +60,7 @@ UNMIX_METHODS: tuple[str, ...] = get_args(UnmixMethod)
 #: against 0.19 s at K = 8).
 MAX_ENUMERATED_ENDMEMBERS = 7
 #: Weight of the sum-to-one row of ``fcls`` in the per-epoch solver, relative to the largest
-#: signature norm (Heinz & Chang 2001, eq. 12, use its inverse ``delta`` on the data rows).
+#: signature norm (Heinz & Chang 2001 put its inverse, ``delta``, on the data rows instead).
 FCLS_SUM_WEIGHT = 1.0e4
 
 
