@@ -1,7 +1,7 @@
 """Unmixing benchmark: run ``python bench/bench_unmix.py [--epochs N]`` and read the printout.
 
 Synthetic mixtures of 4 random endmember signatures over 10 bands with Gaussian noise
-(10,000 epochs by default): the time of :func:`speclight.estimate.unmix.unmix` for every
+(10,000 epochs by default): the time of :func:`speclight.estimate.unmixing.unmix` for every
 method and of :func:`speclight.estimate.endmembers.extract_endmembers` for every method
 (best of three runs each). The issue's target: every unmixing method under 1 s.
 """
@@ -18,7 +18,7 @@ from functools import partial
 import numpy as np
 
 from speclight.estimate.endmembers import extract_endmembers
-from speclight.estimate.unmix import unmix
+from speclight.estimate.unmixing import unmix
 
 TARGET_S = 1.0
 

@@ -4,13 +4,13 @@ Plain-array cores first (numpy in, numpy out; see ``docs/design.md``); the comma
 command line are built on them:
 
 * :mod:`.measured`: measured light curves in (CSV, speclight NetCDF), binning;
-* :mod:`.unmix`: the linear mixing model x = S a (LS, NNLS, NNLS + normalisation, FCLS);
+* :mod:`.unmixing`: the linear mixing model x = S a (LS, NNLS, NNLS + normalisation, FCLS);
 * :mod:`.endmembers`: endmember extraction (ATGP, PCA, N-FINDR).
 """
 
 from speclight.estimate.endmembers import EndmemberResult, extract_endmembers
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
-from speclight.estimate.unmix import UNMIX_METHODS, UnmixResult, unmix
+from speclight.estimate.unmixing import UNMIX_METHODS, UnmixResult, unmix
 
 __all__ = [
     "UNMIX_METHODS",

@@ -43,7 +43,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError, did_you_mean
-from speclight.estimate.unmix import _validated_samples
+from speclight.estimate.unmixing import _validated_samples
 
 F64 = NDArray[np.float64]
 EndmemberMethod = Literal["atgp", "pca", "nfindr"]
