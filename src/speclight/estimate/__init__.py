@@ -5,20 +5,24 @@ command line are built on them:
 
 * :mod:`.measured`: measured light curves in (CSV, speclight NetCDF), binning;
 * :mod:`.unmixing`: the linear mixing model x = S a (LS, NNLS, NNLS + normalisation, FCLS);
-* :mod:`.endmembers`: endmember extraction (ATGP, PCA, N-FINDR).
+* :mod:`.endmembers`: endmember extraction (ATGP, PCA, N-FINDR);
+* :mod:`.upsampling`: spectra from n band albedos (sigmoid polynomial, eq. 3-4).
 """
 
 from speclight.estimate.endmembers import EndmemberResult, extract_endmembers
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
 from speclight.estimate.unmixing import UNMIX_METHODS, UnmixResult, unmix
+from speclight.estimate.upsampling import UpsampledSpectrum, upsample
 
 __all__ = [
     "UNMIX_METHODS",
     "EndmemberResult",
     "MeasuredLightCurve",
     "UnmixResult",
+    "UpsampledSpectrum",
     "bin_light_curve",
     "extract_endmembers",
     "read_measured",
     "unmix",
+    "upsample",
 ]
