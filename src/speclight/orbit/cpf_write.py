@@ -16,7 +16,8 @@ MJD0 = np.datetime64("1858-11-17T00:00:00", "ns")
 
 
 def _ymdhms(t: np.datetime64) -> tuple[int, int, int, int, int, int]:
-    s = str(np.asarray(t).astype("datetime64[s]"))
+    # datetime_as_string: str() follows numpy print options, which other libraries change
+    s = str(np.datetime_as_string(np.asarray(t).astype("datetime64[s]"), unit="s"))
     d, hms = s.split("T")
     y, mo, da = (int(v) for v in d.split("-"))
     h, mi, se = (int(v) for v in hms.split(":"))
