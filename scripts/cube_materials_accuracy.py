@@ -56,12 +56,16 @@ def run(name: str, resolution_px: int | None) -> tuple[Any, Any]:
 def case(loaded: Any, ds: Any, laser: bool, seed: int = 7) -> dict[str, Any]:
     """Signatures, factors (noise-free and noisy) and true fractions of one run."""
     wl = ds["wavelength"].values
-    response = ds["band_response"].values * ds["detector_qe"].values * ds["optics_transmission"].values
+    response = (
+        ds["band_response"].values * ds["detector_qe"].values * ds["optics_transmission"].values
+    )
     tables = np.stack([Reflectance.table_file(material_table_path(n)).evaluate(wl) for n in NAMES])
     transmission = ds["transmission"].values
     if laser:
         lasers = loaded.scenario.illumination.lasers
-        lines = np.stack([gaussian_line_per_nm(wl, la.wavelength_nm, la.linewidth_nm) for la in lasers])
+        lines = np.stack(
+            [gaussian_line_per_nm(wl, la.wavelength_nm, la.linewidth_nm) for la in lasers]
+        )
         irradiance = ds["laser_irradiance"].values @ lines  # (N, L) at the target
         source = mean_source_W_m2_nm(irradiance, transmission)
         x = ds["laser_reflectance_factor"].values
@@ -70,19 +74,28 @@ def case(loaded: Any, ds: Any, laser: bool, seed: int = 7) -> dict[str, Any]:
         noise = loaded.scenario.instrument.noise
         area = instrument.aperture_area_m2(0.43, 0.0)
         sky = instrument.sky_count_rate_per_s(
-            noise.sky_background_mag_arcsec2, area, wl, np.ones(wl.size), np.ones(wl.size),
-            response, background_aperture_radius_arcsec=noise.aperture_radius_arcsec,
+            noise.sky_background_mag_arcsec2,
+            area,
+            wl,
+            np.ones(wl.size),
+            np.ones(wl.size),
+            response,
+            background_aperture_radius_arcsec=noise.aperture_radius_arcsec,
         )
         finite = np.isfinite(rate)
         measured = np.full_like(rate, np.nan)
         measured[finite] = instrument.simulate_measurement(
-            rate[finite], loaded.scenario.instrument.exposure_s,
+            rate[finite],
+            loaded.scenario.instrument.exposure_s,
             sky_count_rate_per_s=np.broadcast_to(sky, rate.shape)[finite],
-            dark_current_e_per_s=noise.dark_current_e_per_s, read_noise_e=noise.read_noise_e,
+            dark_current_e_per_s=noise.dark_current_e_per_s,
+            read_noise_e=noise.read_noise_e,
             seed=seed,
         )
     else:
-        source = mean_source_W_m2_nm(ds["solar_irradiance"].values, transmission, ds["sunlit"].values)
+        source = mean_source_W_m2_nm(
+            ds["solar_irradiance"].values, transmission, ds["sunlit"].values
+        )
         x = ds["reflectance_factor"].values
         per_material = ds["reflectance_factor_material"].values
         rate, measured = ds["count_rate"].values, ds["count_rate_measured"].values
@@ -97,7 +110,8 @@ def case(loaded: Any, ds: Any, laser: bool, seed: int = 7) -> dict[str, Any]:
 
 def report(title: str, c: dict[str, Any]) -> None:
     print(f"\n## {title}")
-    print(f"condition number of the signature matrix (10 x 4): {np.linalg.cond(c['signatures'].T):.1f}")
+    cond = np.linalg.cond(c["signatures"].T)
+    print(f"condition number of the signature matrix (10 x 4): {cond:.1f}")
     for data in ("x", "noisy"):
         for method in ("nnls-norm", "fcls"):
             for sig in ("signatures", "plain"):
@@ -115,7 +129,7 @@ def report(title: str, c: dict[str, Any]) -> None:
                         print(f"{n:>17}: " + " ".join(f"{v:>11d}" for v in row))
     for data in ("x", "noisy"):
         ext = extract_endmembers(c[data], 4, method="atgp")
-        angle, partner = matched_angles_deg(c["signatures"], ext.signatures)
+        angle, _ = matched_angles_deg(c["signatures"], ext.signatures)
         kind = "noise-free" if data == "x" else "noisy"
         pairs = ", ".join(f"{n} {a:.2f} deg" for n, a in zip(NAMES, angle, strict=True))
         print(f"\nATGP ({kind}): spectral angle to the true signature: {pairs}")

@@ -88,7 +88,9 @@ def fractions(contributions: ArrayLike) -> F64:
         return np.asarray(np.where(total > 0, a / total, np.nan))
 
 
-def dominant_confusion(true_fraction: ArrayLike, estimated_fraction: ArrayLike) -> NDArray[np.int64]:
+def dominant_confusion(
+    true_fraction: ArrayLike, estimated_fraction: ArrayLike
+) -> NDArray[np.int64]:
     """Confusion matrix (K, K) of the dominant endmember per epoch: rows true, columns
     estimated; epochs with a NaN in either are left out."""
     t = np.asarray(true_fraction, dtype=np.float64)
