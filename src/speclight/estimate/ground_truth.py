@@ -154,10 +154,12 @@ def unmix_accuracy(
 
 
 def spectral_angle_deg(a: ArrayLike, b: ArrayLike) -> F64:
-    """Spectral angle [deg] between the rows of ``a`` (K, B) and ``b`` (K, B) (or (B,))."""
+    """Spectral angle [deg] between the rows of ``a`` (K, B) and ``b`` (K, B) (or (B,));
+    NaN where a row is zero (no direction)."""
     u = np.atleast_2d(np.asarray(a, dtype=np.float64))
     v = np.atleast_2d(np.asarray(b, dtype=np.float64))
-    cos = np.sum(u * v, axis=1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cos = np.sum(u * v, axis=1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
     return np.asarray(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
 
 
@@ -166,11 +168,12 @@ def matched_angles_deg(true_signatures: ArrayLike, extracted: ArrayLike) -> tupl
 
     Returns the angle [deg] of each true signature to its partner (K,) and the index of the
     partner in ``extracted`` (K,) (Hungarian assignment, scipy ``linear_sum_assignment``).
+    An extracted signature of zeros (a dark epoch) pairs at NaN, as if at 180 deg.
     """
     s = np.atleast_2d(np.asarray(true_signatures, dtype=np.float64))
     e = np.atleast_2d(np.asarray(extracted, dtype=np.float64))
     cost = np.array([[spectral_angle_deg(si, ej)[0] for ej in e] for si in s])
-    rows, cols = linear_sum_assignment(cost)
+    rows, cols = linear_sum_assignment(np.nan_to_num(cost, nan=180.0))
     angle = np.full(len(s), np.nan)
     partner = np.full(len(s), -1.0)
     angle[rows] = cost[rows, cols]
@@ -196,3 +199,27 @@ def mean_source_W_m2_nm(
     if not np.any(ok):
         raise InputError("no epoch with a finite, lit source spectrum", field="irradiance")
     return np.asarray(e[ok].mean(axis=0))
+
+
+def coaxial_laser_source_W_m2_nm(
+    laser_irradiance_W_m2: ArrayLike, line_per_nm: ArrayLike, transmission: ArrayLike
+) -> F64:
+    """Lasers' spectrum at the aperture (N, L) for transmitters at the observer's site.
+
+    ``laser_irradiance_W_m2`` (N, K) is the simulate output's ``laser_irradiance`` (each
+    line's irradiance at the target, after the uplink), ``line_per_nm`` (K, L) the line
+    shapes on the grid (on their support, as the pipeline keeps them) and ``transmission``
+    (N, L) the observer's. From the observer's own site the uplink has the downlink's
+    transmission T, so a line at the target is ``beam x shape x T`` (``laser_irradiance`` its
+    bin sum on a uniform grid) and at the aperture ``beam x shape x T^2``.
+    """
+    irr = np.asarray(laser_irradiance_W_m2, dtype=np.float64)
+    lines = np.atleast_2d(np.asarray(line_per_nm, dtype=np.float64))
+    t = np.asarray(transmission, dtype=np.float64)
+    out = np.zeros_like(t)
+    for k in range(len(lines)):
+        shaped = lines[k] * t
+        with np.errstate(invalid="ignore", divide="ignore"):
+            beam = np.where(irr[:, k] > 0, irr[:, k] / shaped.sum(axis=1), 0.0)
+        out += beam[:, None] * shaped
+    return np.asarray(out * t)
