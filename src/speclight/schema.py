@@ -74,6 +74,17 @@ VARIABLES: dict[str, VariableInfo] = {
         "band count rate x range^2 over the aperture area x the band-weighted solar photon "
         "irradiance at the aperture (Nussbaum et al. 2022, eq. 5)",
     ),
+    "reflectance_factor_material": V(
+        ("time", "material", "band"),
+        "m2 sr-1",
+        "each material's share of reflectance_factor, from rendering the material alone "
+        "(render.per_material; sums to reflectance_factor over material)",
+    ),
+    "material_reflectance": V(
+        ("material",),
+        "",
+        "the material's reflectance spectrum: shipped table name, file stem, number or n,k",
+    ),
     "band_response": V(("band", "wavelength"), "1", "relative spectral response of each band"),
     "optics_transmission": V(("wavelength",), "1", "transmission of the telescope optics"),
     "detector_qe": V(("band", "wavelength"), "1", "detector quantum efficiency"),
@@ -109,6 +120,18 @@ VARIABLES: dict[str, VariableInfo] = {
         "detected laser return photo-electrons per second per range bin",
     ),
     "range_offset": V(TB, "m", "mean return range minus range to the centre of mass (one-way)"),
+    "laser_reflectance_factor": V(
+        TB,
+        "m2 sr-1",
+        "laser return rate x range^2 over the aperture area x the band-weighted laser photon "
+        "irradiance at the aperture, all lasers (Nussbaum et al. 2022, eq. 5)",
+    ),
+    "laser_reflectance_factor_material": V(
+        ("time", "material", "band"),
+        "m2 sr-1",
+        "each material's share of laser_reflectance_factor, from rendering the material alone "
+        "(render.per_material)",
+    ),
 }
 
 #: Attributes of the coordinates.
@@ -122,6 +145,7 @@ COORDINATES: dict[str, dict[str, str]] = {
     "band": {"long_name": "photometric band"},
     "image_time": {"long_name": "epochs whose images are saved"},
     "laser": {"long_name": "laser transmitter"},
+    "material": {"long_name": "target material (scenario target.materials key)"},
     "range_bin": {
         "units": "m",
         "long_name": "one-way range offset from the centre of mass (bin centre), "

@@ -40,7 +40,8 @@ def _short_scenario(tmp_path: Path, name: str = "calsphere", **time: str) -> Pat
 def test_example_lists_and_prints() -> None:
     listed = runner.invoke(app, ["example"])
     assert listed.exit_code == 0
-    assert {"box-wing", "calsphere", "lcs1"} <= set(listed.stdout.split())
+    names = {"box-wing", "calsphere", "cube-materials", "cube-materials-laser", "lcs1"}
+    assert names <= set(listed.stdout.split())
     printed = runner.invoke(app, ["example", "lcs1"])
     assert printed.exit_code == 0
     assert yaml.safe_load(printed.stdout)["name"] == "lcs1-pass"

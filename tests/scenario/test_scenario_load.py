@@ -20,7 +20,10 @@ def _edited(old: str, new: str, name: str = "lcs1") -> str:
     return text.replace(old, new)
 
 
-@pytest.mark.parametrize("name", ["box-wing", "box-wing-laser", "calsphere", "lcs1"])
+@pytest.mark.parametrize(
+    "name",
+    ["box-wing", "box-wing-laser", "calsphere", "cube-materials", "cube-materials-laser", "lcs1"],
+)
 def test_builtin_examples_validate(name: str) -> None:
     assert name in example_names()
     loaded = parse_scenario(example_text(name), source=name)

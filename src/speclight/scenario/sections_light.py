@@ -25,6 +25,8 @@ from speclight.scenario.sections_geometry import Strict, Vector3
 BsdfName = Literal["lambertian", "beckmann", "ggx", "plastic", "specular", "measured"]
 ConductorName = Literal["Al", "Ag", "Au"]
 DielectricName = Literal["SiO2", "Si", "GaAs", "Kapton"]
+#: Shipped reflectance tables (``data/materials``, :mod:`speclight.target.material_tables`).
+MaterialTableName = Literal["aluminium", "kapton_mli", "solar_cell", "white_paint"]
 BuiltinShape = Literal["sphere", "plate", "cube", "cylinder", "box_wing"]
 
 #: Largest ``render.seed``: Mitsuba's sampler seed is a 32-bit unsigned integer
@@ -66,9 +68,14 @@ class Dielectric(Strict):
     dielectric: DielectricName
 
 
+class ShippedTable(Strict):
+    table: MaterialTableName = Field(description="A shipped reflectance table (data/materials)")
+
+
 REFLECTANCE_FORMS = (
     "a number in [0, 1], {file: table.csv}, {wavelength_nm: [...], value: [...]}, "
-    "{conductor: Al|Ag|Au} or {dielectric: SiO2|Si|GaAs|Kapton}"
+    "{conductor: Al|Ag|Au}, {dielectric: SiO2|Si|GaAs|Kapton} or "
+    "{table: aluminium|kapton_mli|solar_cell|white_paint}"
 )
 
 
@@ -82,6 +89,7 @@ def _reflectance_form(value: Any) -> str | None:
             ("value", "pairs"),
             ("conductor", "conductor"),
             ("dielectric", "dielectric"),
+            ("table", "table"),
         ):
             if key in value:
                 return tag
@@ -91,6 +99,7 @@ def _reflectance_form(value: Any) -> str | None:
             ReflectancePairs: "pairs",
             Conductor: "conductor",
             Dielectric: "dielectric",
+            ShippedTable: "table",
         }.get(type(value))
     return None
 
@@ -100,7 +109,8 @@ Reflectance = Annotated[
     | Annotated[ReflectanceFile, Tag("file")]
     | Annotated[ReflectancePairs, Tag("pairs")]
     | Annotated[Conductor, Tag("conductor")]
-    | Annotated[Dielectric, Tag("dielectric")],
+    | Annotated[Dielectric, Tag("dielectric")]
+    | Annotated[ShippedTable, Tag("table")],
     Discriminator(
         _reflectance_form,
         custom_error_type="reflectance_form",
@@ -374,9 +384,19 @@ class Render(Strict):
     save_images_at: list[int] = Field(
         default_factory=list, description="Epoch indices whose images and depth maps are saved"
     )
+    per_material: bool = Field(
+        default=False,
+        description="Also write reflectance_factor_material(time, material, band): each "
+        "material's share of the band reflectance factors (single mode only)",
+    )
 
     @model_validator(mode="after")
     def _samples(self) -> Render:
+        if self.per_material and self.mode != "single":
+            raise ValueError(
+                f"per_material: true needs mode: single (got mode: {self.mode}); the shares "
+                "come from single-scattering renders of each material alone"
+            )
         if self.samples_per_pixel > MAX_SAMPLES_PER_PIXEL:
             per_epoch_s = self.resolution_px**2 * self.samples_per_pixel / PATH_SAMPLES_PER_S
             raise ValueError(

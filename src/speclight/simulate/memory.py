@@ -18,7 +18,12 @@ BENCHMARKS.md, "Memory"):
 * per saved image: its radiance (float64 in the render, float32 in the dataset), depth and
   part maps, :data:`BYTES_PER_IMAGE_PIXEL_BIN` per pixel and bin;
 * with lasers: per epoch the range histograms (band x range bin, float64, accumulated and
-  stored) and each laser's spectral intensity.
+  stored) and each laser's spectral intensity;
+* with ``render.per_material``: per epoch, material and bin the shares (N, M, L) of
+  :mod:`speclight.simulate.per_material` (the render's output and the accumulated shares,
+  float64), and per epoch, material and band the factors and their file copy,
+  :data:`BYTES_PER_EPOCH_MATERIAL_BIN` and :data:`BYTES_PER_EPOCH_MATERIAL_BAND` (counted
+  from the allocations, not measured).
 
 Every term is an upper bound in the count of rendered epochs (all epochs are assumed lit).
 The limit is :data:`MEMORY_FRACTION` of the machine's physical memory (``os.sysconf``), or
@@ -61,6 +66,10 @@ PATH_BASE_BYTES = 900 * MIB
 BYTES_PER_IMAGE_PIXEL_BIN = 8 + 4
 #: Laser range histograms per epoch, band and range bin: accumulator and stored [bytes].
 BYTES_PER_EPOCH_BAND_RANGE_BIN = 8 * 2
+#: render.per_material: the (N, M, L) render output and accumulated shares, float64 [bytes].
+BYTES_PER_EPOCH_MATERIAL_BIN = 2 * 8
+#: render.per_material: the (N, M, B) factors, Sun and lasers, and their file copies [bytes].
+BYTES_PER_EPOCH_MATERIAL_BAND = 2 * 8 * 2
 #: Fraction of the physical memory a run may plan to use: the rest stays for the system and
 #: for the transients the model does not count (allocator slack, Dr.Jit's arenas).
 MEMORY_FRACTION = 0.5
@@ -115,6 +124,13 @@ def estimate_memory(scenario: Scenario, n_epochs: int) -> MemoryEstimate:
             parts["render batch"] = PATH_BASE_BYTES + pixels * BYTES_PER_RAY
         images = len(set(render.save_images_at))
         parts["images"] = images * pixels * (n_bin * BYTES_PER_IMAGE_PIXEL_BIN + 16)
+        if render.per_material:
+            n_mat = len(scenario.target.materials)
+            parts["per material"] = (
+                n
+                * n_mat
+                * (n_bin * BYTES_PER_EPOCH_MATERIAL_BIN + n_band * BYTES_PER_EPOCH_MATERIAL_BAND)
+            )
         lasers = len(scenario.illumination.lasers)
         if lasers:
             range_bins = RANGE_BINS * (2 if render.mode == "path" else 1)

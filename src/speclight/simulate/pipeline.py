@@ -15,6 +15,12 @@ from speclight.scenario import LoadedScenario
 from speclight.simulate.dataset import geometry_dataset, global_attributes
 from speclight.simulate.geometry_stage import Geometry, scenario_geometry
 from speclight.simulate.memory import check_run_limits, grid_epochs
+from speclight.simulate.per_material import (
+    add_per_material,
+    laser_material_factors,
+    material_labels,
+    solar_material_factors,
+)
 from speclight.simulate.radiometry import (
     atmosphere_transmission,
     instrument_response,
@@ -151,6 +157,27 @@ def _simulate(
     ds = geometry_dataset(geo, flags)
     ds = add_spectral(ds, wavelength_nm, reflection, transmission, radiometry)
     ds = add_images(ds, reflection.images, reflection.part_names)
+    if sc.render.per_material and radiometry is not None and radiometry.band_names:
+        assert session is not None  # a target is rendered, so the run has a session
+        solar = None
+        if sc.illumination.sun:
+            solar = solar_material_factors(
+                loaded,
+                geo,
+                wavelength_nm,
+                target,
+                session,
+                reflection.solar_irradiance_W_m2_nm,
+                transmission,
+                radiometry,
+            )
+        laser = None
+        if setup is not None:
+            laser = laser_material_factors(
+                loaded, geo, wavelength_nm, target, session, setup, transmission, radiometry
+            )
+        names = [m.name for m in target.materials]
+        ds = add_per_material(ds, names, material_labels(loaded, target), solar, laser)
     extra: dict[str, str] = {"render_mode": sc.render.mode, "atmosphere_model": sc.atmosphere.model}
     if reflection.variant:
         extra["render_variant"] = reflection.variant

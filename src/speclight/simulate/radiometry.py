@@ -174,9 +174,40 @@ def instrument_response(
     )
 
 
+def band_reflectance_factor(
+    loaded: LoadedScenario,
+    radiometry: Radiometry,
+    wavelength_nm: F64,
+    intensity_W_sr_nm: F64,
+    transmission: F64,
+    range_m: F64,
+    illumination_W_m2_nm: F64,
+) -> F64:
+    """Band reflectance factors (N, B) [m2 sr-1] of an intensity (N, L), e.g. one material's.
+
+    The chain of :func:`instrument_response` with its curves (``radiometry``): spectral flux
+    at the aperture, band count rates, then
+    :func:`speclight.instrument.reflectance_factor_m2_sr` for the illumination
+    ``illumination_W_m2_nm`` (N, L) (irradiance at the target x transmission). Linear in the
+    intensity, so the factors of intensities that sum to the total sum to the total's.
+    """
+    sc = loaded.scenario
+    area = instrument.aperture_area_m2(
+        sc.telescope.aperture_diameter_m, sc.telescope.obstruction_diameter_m
+    )
+    ones = np.ones(wavelength_nm.size)
+    kernel = radiometry.band_response * radiometry.qe
+    flux = instrument.spectral_flux_W_nm(intensity_W_sr_nm, transmission, area, range_m)
+    rate = instrument.count_rate_per_s(flux, wavelength_nm, radiometry.optics, ones, kernel)
+    return instrument.reflectance_factor_m2_sr(
+        rate, range_m, area, illumination_W_m2_nm, wavelength_nm, radiometry.optics, ones, kernel
+    )
+
+
 __all__ = [
     "Radiometry",
     "atmosphere_transmission",
+    "band_reflectance_factor",
     "instrument_response",
     "wavelength_grid_nm",
 ]

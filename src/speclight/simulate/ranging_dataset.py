@@ -28,6 +28,7 @@ class RangingResult:
     return_rate_per_s: F64  # (N, B)
     range_histogram_per_s: F64  # (N, B, bins)
     range_offset_m: F64  # (N, B)
+    reflectance_factor_m2_sr: F64  # (N, B) from the returns and the lasers' irradiance
     notes: list[str] = field(default_factory=list)
 
     def add_to(self, ds: xr.Dataset) -> xr.Dataset:
@@ -52,4 +53,7 @@ class RangingResult:
             ds["return_rate"] = schema.variable("return_rate", self.return_rate_per_s)
             ds["range_histogram"] = schema.variable("range_histogram", self.range_histogram_per_s)
             ds["range_offset"] = schema.variable("range_offset", self.range_offset_m)
+            ds["laser_reflectance_factor"] = schema.variable(
+                "laser_reflectance_factor", self.reflectance_factor_m2_sr
+            )
         return ds

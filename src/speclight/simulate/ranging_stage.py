@@ -188,6 +188,16 @@ def prepare_ranging(
     return RangingSetup(lasers, acc, session, flags)
 
 
+def laser_irradiance_W_m2_nm(setup: RangingSetup, n_wavelengths: int) -> F64:
+    """Spectral irradiance of all lasers at the target on the full grid (N, L) [W m-2 nm-1]
+    (after the uplink; 0 off the lines and where a laser is below its horizon)."""
+    n = setup.lasers[0].light.irradiance_W_m2_nm.shape[0] if setup.lasers else 0
+    out = np.zeros((n, n_wavelengths))
+    for laser in setup.lasers:
+        out[:, laser.light.support] += laser.light.irradiance_W_m2_nm
+    return out
+
+
 def laser_ranging(
     loaded: LoadedScenario,
     geo: Geometry,
@@ -248,15 +258,30 @@ def laser_ranging(
         )
         per_pulse, total = returns.per_pulse, returns.rate_per_s
         hist, offset = returns.histogram_per_s, returns.offset_m
+        # eq. 5 with the lasers' line instead of the Sun (SPEC section 5): the same
+        # reflectance factor as the Sun's, from the return rates and the lasers' irradiance
+        illumination = laser_irradiance_W_m2_nm(setup, n_wl) * np.nan_to_num(transmission)
+        factor = instrument.reflectance_factor_m2_sr(
+            total,
+            geo.range_m,
+            area,
+            illumination,
+            wavelength_nm,
+            radiometry.optics,
+            np.ones(n_wl),
+            radiometry.band_response * radiometry.qe,
+        )
     else:
         per_pulse, total = np.zeros((n, k_las, 0)), np.zeros((n, 0))
         hist, offset = np.zeros((n, 0, n_bins)), np.zeros((n, 0))
+        factor = np.zeros((n, 0))
     nan_rows = ~obs
     intensity[nan_rows] = np.nan
     per_pulse[nan_rows] = np.nan
     hist[nan_rows] = np.nan
     total[nan_rows] = np.nan
     offset[nan_rows] = np.nan
+    factor[nan_rows] = np.nan
     notes = []
     below = [la.name for la in setup.lasers if np.any(obs & geo.orbit_ok & ~la.above_horizon)]
     if below:
@@ -284,5 +309,6 @@ def laser_ranging(
         return_rate_per_s=total,
         range_histogram_per_s=hist,
         range_offset_m=offset,
+        reflectance_factor_m2_sr=factor,
         notes=notes,
     )

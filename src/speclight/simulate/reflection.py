@@ -23,12 +23,14 @@ from speclight.scenario.sections_light import (
     Dielectric,
     ReflectanceFile,
     ReflectancePairs,
+    ShippedTable,
 )
 from speclight.scenario.sections_light import Material as MaterialModel
 from speclight.simulate.geometry_stage import Geometry
 from speclight.target import Material, Reflectance, Target
 from speclight.target.brdf_table import load_brdf_table
 from speclight.target.from_values import BUILTIN_SHAPES
+from speclight.target.material_tables import material_table_path
 from speclight.target.mesh_io import load_mesh
 from speclight.target.rgl_file import is_rgl_path
 
@@ -60,6 +62,8 @@ def _reflectance(loaded: LoadedScenario, spec: Any, field: str) -> Reflectance:
     """A :class:`Reflectance` from a validated scenario reflectance (number or model)."""
     if isinstance(spec, ReflectanceFile):
         return Reflectance.table_file(loaded.resolve(spec.file), field=field)
+    if isinstance(spec, ShippedTable):
+        return Reflectance.table_file(material_table_path(spec.table), field=field)
     if isinstance(spec, ReflectancePairs):
         return Reflectance.pairs(spec.wavelength_nm, spec.value, field=field)
     if isinstance(spec, Conductor):

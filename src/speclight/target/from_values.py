@@ -15,6 +15,7 @@ from typing import Any
 
 from speclight.errors import InputError, did_you_mean
 from speclight.target import shapes
+from speclight.target.material_tables import material_table_path
 from speclight.target.materials import Material
 from speclight.target.mesh_io import load_mesh
 from speclight.target.parts import Target
@@ -65,10 +66,12 @@ def reflectance_from_spec(
             return Reflectance.conductor(str(spec["conductor"]))
         if keys == {"dielectric"}:
             return Reflectance.dielectric(str(spec["dielectric"]))
+        if keys == {"table"}:
+            return Reflectance.table_file(material_table_path(str(spec["table"])), field=field)
     raise InputError(
         f"reflectance {spec!r} is not understood; give a number in [0, 1], {{file: x.csv}}, "
         "{wavelength_nm: [...], value: [...]}, {conductor: Al|Ag|Au} or "
-        "{dielectric: SiO2|Si|GaAs|Kapton}",
+        "{dielectric: SiO2|Si|GaAs|Kapton} or {table: aluminium|kapton_mli|solar_cell|white_paint}",
         field=field,
     )
 
