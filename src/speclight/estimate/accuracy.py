@@ -127,7 +127,8 @@ def _paired(true_shares: ArrayLike, estimated_shares: ArrayLike) -> tuple[F64, F
 def spectral_angle_rad(a: ArrayLike, b: ArrayLike) -> F64:
     """Spectral angles [rad] (K, M) between the rows of ``a`` (K, B) and ``b`` (M, B).
 
-    ``arccos(a.b / (|a| |b|))``: 0 for proportional signatures (Kruse et al. 1993, "The
+    ``arccos(a.b / (|a| |b|))`` (evaluated as ``2 atan2(|u - v|, |u + v|)`` of the unit
+    vectors, exact to rounding also near 0): 0 for proportional signatures (Kruse et al. 1993, "The
     spectral image processing system (SIPS)", Remote Sens. Environ. 44, 145-163,
     doi:10.1016/0034-4257(93)90013-N).
     """
@@ -138,11 +139,13 @@ def spectral_angle_rad(a: ArrayLike, b: ArrayLike) -> F64:
             f"signatures of {x.shape[1]} and {y.shape[1]} bands cannot be compared",
             field="signatures",
         )
-    nx = np.linalg.norm(x, axis=1)[:, None]
-    ny = np.linalg.norm(y, axis=1)[None, :]
     with np.errstate(invalid="ignore", divide="ignore"):
-        cos = (x @ y.T) / (nx * ny)
-    return np.asarray(np.arccos(np.clip(cos, -1.0, 1.0)))
+        u = x / np.linalg.norm(x, axis=1, keepdims=True)
+        v = y / np.linalg.norm(y, axis=1, keepdims=True)
+    # 2 atan2(|u - v|, |u + v|) for unit vectors: accurate near 0 and pi, where arccos is not
+    diff = np.linalg.norm(u[:, None, :] - v[None, :, :], axis=2)
+    total = np.linalg.norm(u[:, None, :] + v[None, :, :], axis=2)
+    return np.asarray(2.0 * np.arctan2(diff, total))
 
 
 def match_by_angle(signatures: ArrayLike, references: ArrayLike) -> NDArray[np.intp]:
