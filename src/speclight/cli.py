@@ -333,11 +333,12 @@ def unmix(
     force: Annotated[bool, typer.Option("--force", help="Overwrite existing outputs.")] = False,
 ) -> None:
     """Per-epoch material contributions from band reflectance factors: the linear mixing
-    model x = S a (paper eq. 6) with known endmember spectra or extracted endmembers.
+    model x = S a (paper eq. 6) with endmember spectra (-e FILE ..., or -e scenario for the
+    scenario's materials) or endmembers extracted from the data (--extract, --n). Writes
+    ABUND.nc: abundance(time, endmember), residual(time), endmember_signature(endmember, band)
+    and reflectance_factor(time, band); with ground truth in MEASURED, the confusion matrix.
 
-    Writes ABUND.nc: abundance(time, endmember), residual(time), endmember_signature
-    (endmember, band), reflectance_factor(time, band); with ground truth in MEASURED, the
-    confusion matrix too.
+    Example: speclight unmix out.nc -e gold.csv cell.csv paint.csv -o abund.nc --plot abund.png
     """
 
     def run() -> None:

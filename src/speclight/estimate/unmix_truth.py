@@ -89,7 +89,7 @@ def compare_with_truth(
                 "the endmember and its matched material's signature",
             },
         )
-        matching = "each endmember to the material of smallest spectral angle"
+        matching = "by spectral angle"
     norm = reference / np.where(
         reference.mean(axis=1, keepdims=True) > 0, reference.mean(axis=1, keepdims=True), 1.0
     )

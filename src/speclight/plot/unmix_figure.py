@@ -42,7 +42,7 @@ def abundance_panel(ds: xr.Dataset, ax: Any) -> None:
     ax.set_xlabel("time (UTC)")
     ax.set_title(f"contributions ({ds.attrs.get('method', '')})", loc="left", fontsize="medium")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize="small", frameon=False)
+    ax.legend(fontsize="small", framealpha=0.8)
     ax.tick_params(axis="x", labelrotation=20)
 
 
@@ -79,7 +79,7 @@ def signature_panel(ds: xr.Dataset, ax: Any) -> None:
     what = "extracted signatures" if extracted else "endmember signatures"
     ax.set_title(what, loc="left", fontsize="medium")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize="small", frameon=False)
+    ax.legend(fontsize="small", framealpha=0.8)
 
 
 def share_panel(ds: xr.Dataset, ax: Any) -> None:
@@ -98,7 +98,7 @@ def share_panel(ds: xr.Dataset, ax: Any) -> None:
         f"true (lines) and estimated shares; mean |error| {err:.3f}", loc="left", fontsize="medium"
     )
     ax.grid(alpha=0.3)
-    ax.legend(fontsize="small", frameon=False)
+    ax.legend(fontsize="small", framealpha=0.8)
     ax.tick_params(axis="x", labelrotation=20)
 
 
