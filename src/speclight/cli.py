@@ -345,7 +345,6 @@ def unmix(
         from speclight.estimate.unmix_io import check_unmix_options, unmix_measured
         from speclight.io.netcdf import dataset_bytes
         from speclight.plot.figure_output import claim_outputs
-        from speclight.scenario import load_scenario
 
         members = _endmember_files(measured, endmembers)
         check_unmix_options(members, extract, n, method)
@@ -355,7 +354,11 @@ def unmix(
         for i, path in enumerate(members or []):
             inputs[f"endmember file {i + 1}"] = path
         with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
-            loaded = load_scenario(scenario) if scenario is not None else None
+            loaded = None
+            if scenario is not None:
+                from speclight.scenario import load_scenario
+
+                loaded = load_scenario(scenario)
             ds = unmix_measured(
                 measured[0],
                 endmembers=members,

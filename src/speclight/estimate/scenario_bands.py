@@ -11,13 +11,16 @@ never rebuilt here.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
-from speclight.scenario import LoadedScenario
+
+if TYPE_CHECKING:
+    from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
 

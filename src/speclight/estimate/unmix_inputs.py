@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import xarray as xr
@@ -31,9 +32,10 @@ from speclight.errors import InputError
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
 from speclight.estimate.scenario_bands import BandResponses, dataset_band_responses
 from speclight.estimate.upsampling import photon_weights
-from speclight.scenario import LoadedScenario
-from speclight.target.materials import Material
-from speclight.target.reflectance import Reflectance
+
+if TYPE_CHECKING:
+    from speclight.scenario import LoadedScenario
+    from speclight.target.materials import Material
 
 F64 = NDArray[np.float64]
 FIELD = "MEASURED"
@@ -215,6 +217,8 @@ def endmembers_from_files(paths: list[str | Path], bands: BandResponses) -> Endm
             f"endmember name(s) {', '.join(twice)} given twice (names are the file stems)",
             field="--endmembers",
         )
+    from speclight.target.reflectance import Reflectance
+
     spectra = [
         Reflectance.table_file(p, field="--endmembers").evaluate(bands.wavelength_nm) for p in paths
     ]

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import xarray as xr
@@ -39,7 +40,9 @@ from speclight.estimate.unmix_inputs import (
 )
 from speclight.estimate.unmix_truth import compare_with_truth
 from speclight.estimate.unmixing import UNMIX_METHODS, unmix
-from speclight.scenario import LoadedScenario
+
+if TYPE_CHECKING:
+    from speclight.scenario import LoadedScenario
 
 #: ``--endmembers`` value that takes the scenario's materials.
 SCENARIO_ENDMEMBERS = "scenario"

@@ -12,6 +12,7 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,7 +20,9 @@ from speclight.errors import InputError, did_you_mean
 from speclight.estimate.scenario_bands import BandResponses, scenario_band_responses
 from speclight.estimate.upsampling import UpsampledSpectrum, photon_weights, upsample
 from speclight.input_files import read_user_text
-from speclight.scenario import LoadedScenario
+
+if TYPE_CHECKING:
+    from speclight.scenario import LoadedScenario
 
 FIELD = "FIT.json"
 
