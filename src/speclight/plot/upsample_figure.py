@@ -55,7 +55,7 @@ def upsample_figure(result: ScenarioSpectrum, title: str = "") -> Any:
             capsize=3,
             label=f"{name}: {s.albedo[j]:.3f}",
         )
-        top.plot(centre[j], s.albedo_fit[j], "x", color="k", ms=5)
+        top.plot(centre[j], s.albedo_fit[j], "x", color="k", ms=6, mew=1.5, zorder=10)
     top.plot([], [], "x", color="k", label="band averages of the spectrum")
     state = "" if s.converged else " (fit NOT converged)"
     top.set_title(
