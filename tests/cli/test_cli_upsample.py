@@ -156,3 +156,25 @@ def test_bad_input_exits_2_and_writes_nothing(
     elif case != "output-is-fit":
         assert not out.exists()
     assert not list(tmp_path.glob(".spectrum*"))
+
+
+def test_unreachable_albedos_are_written_with_a_notice(tmp_path: Path) -> None:
+    # Two Gaussian bands on one centre, sigma 20 and 120 nm, albedos 0.9 and 0.1: with two
+    # bands p is a line, S(p) is monotonic, and the wide band's average cannot fall that far
+    # below the narrow one's (it would need the spectrum far below 0.1 on both sides of the
+    # centre). The spectrum is still written, said to be unconverged.
+    data = yaml.safe_load(example_text("calsphere"))
+    data["instrument"]["bands"] = [
+        {"name": "narrow", "gaussian": {"center_nm": 700.0, "sigma_nm": 20.0}},
+        {"name": "wide", "gaussian": {"center_nm": 700.0, "sigma_nm": 120.0}},
+    ]
+    scenario = tmp_path / "two.yaml"
+    scenario.write_text(yaml.safe_dump(data, sort_keys=False))
+    out = tmp_path / "s.csv"
+    fit = _fit(tmp_path, {"narrow": 0.9, "wide": 0.1})
+    result = runner.invoke(app, ["upsample", str(scenario), str(fit), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "notice: the fit did not converge" in result.stdout
+    comments, table = _read_csv(out)
+    assert any("NOT converged" in c for c in comments)
+    assert np.all((table[:, 1] >= 0) & (table[:, 1] <= 1))
