@@ -367,6 +367,7 @@ def unmix(
                 method=method,
                 loaded=loaded,
                 bin_s=bin_s,
+                progress=sys.stderr.isatty(),
             )
             _raise_if_signalled()
             claim.write(dataset_bytes(ds))

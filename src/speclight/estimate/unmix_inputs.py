@@ -80,7 +80,10 @@ def _bin(time: NDArray[np.datetime64], values: F64, bin_s: float, src: str) -> t
 
 
 def read_reflectance_factors(
-    path: str | Path, loaded: LoadedScenario | None = None, bin_s: float | None = None
+    path: str | Path,
+    loaded: LoadedScenario | None = None,
+    bin_s: float | None = None,
+    progress: bool = False,
 ) -> ReflectanceFactors:
     """Band reflectance factors from a speclight NetCDF or a CSV of rates (module doc).
 
@@ -94,6 +97,8 @@ def read_reflectance_factors(
     bin_s
         Average the epochs into bins of this many seconds (rates for a CSV, factors for a
         NetCDF), or None.
+    progress
+        Show the simulation's progress bar (CSV input).
 
     Raises
     ------
@@ -111,7 +116,7 @@ def read_reflectance_factors(
                 field="--scenario",
             )
         lc = read_measured(p)
-        return _factors_from_rates(lc, loaded, bin_s)
+        return _factors_from_rates(lc, loaded, bin_s, progress)
     read_measured(p)  # the file checks of every MEASURED reader (times, rates, sigmas)
     with xr.open_dataset(p, engine="h5netcdf") as ds:
         if "reflectance_factor" not in ds:
@@ -145,7 +150,7 @@ def read_reflectance_factors(
 
 
 def _factors_from_rates(
-    lc: MeasuredLightCurve, loaded: LoadedScenario, bin_s: float | None
+    lc: MeasuredLightCurve, loaded: LoadedScenario, bin_s: float | None, progress: bool
 ) -> ReflectanceFactors:
     from speclight import instrument
     from speclight.simulate import simulate
@@ -154,7 +159,7 @@ def _factors_from_rates(
     lc = lc.select_bands(names)
     if bin_s is not None:
         lc = bin_light_curve(lc, bin_s)
-    ds = simulate(loaded, time_utc=lc.time_utc).dataset
+    ds = simulate(loaded, progress=progress, time_utc=lc.time_utc).dataset
     bands = dataset_band_responses(ds, loaded.source)
     tel = loaded.scenario.telescope
     area = instrument.aperture_area_m2(tel.aperture_diameter_m, tel.obstruction_diameter_m)

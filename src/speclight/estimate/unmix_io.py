@@ -92,6 +92,7 @@ def unmix_measured(
     method: str = "nnls-norm",
     loaded: LoadedScenario | None = None,
     bin_s: float | None = None,
+    progress: bool = False,
 ) -> xr.Dataset:
     """Unmix measured light curves into endmember contributions (module doc: the dataset).
 
@@ -111,6 +112,8 @@ def unmix_measured(
         The scenario (for a CSV input or scenario endmembers).
     bin_s
         Average epochs into bins of this many seconds first.
+    progress
+        Show the progress bar of the simulation a CSV input needs.
 
     Raises
     ------
@@ -121,7 +124,7 @@ def unmix_measured(
     check_unmix_options(endmembers, extract, n, method)
     if endmembers == [SCENARIO_ENDMEMBERS] and loaded is None:
         raise InputError("--endmembers scenario needs --scenario SCENARIO.yaml", field="--scenario")
-    data = read_reflectance_factors(measured, loaded, bin_s)
+    data = read_reflectance_factors(measured, loaded, bin_s, progress)
     n_bands = len(data.bands.band_names)
     if extract is not None:
         assert n is not None
