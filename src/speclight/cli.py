@@ -235,6 +235,157 @@ def plot(
 
 
 @app.command()
+def upsample(
+    scenario: Annotated[Path, typer.Argument(help="Scenario YAML file: bands, optics, QE, grid.")],
+    fit: Annotated[Path, typer.Argument(help="JSON with bands.BAND.albedo (`speclight fit`).")],
+    output: Annotated[
+        str, typer.Option("--output", "-o", metavar="FILE", help="Output CSV spectrum.")
+    ] = "spectrum.csv",
+    plot_file: Annotated[
+        str | None, typer.Option("--plot", metavar="FIG", help="Figure (.png, .pdf, .svg).")
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite existing outputs.")] = False,
+) -> None:
+    """Reflectance spectrum from band albedos: a sigmoid of a polynomial of order n-1 whose
+    photon-weighted band averages (band x optics x QE) equal the albedos (paper eq. 3-4).
+
+    Writes CSV wavelength_nm,reflectance on the scenario's wavelength grid.
+    """
+
+    def run() -> None:
+        from speclight.estimate.upsample_io import read_fit_albedos, spectrum_csv
+        from speclight.estimate.upsample_io import upsample_scenario as upsample_from
+        from speclight.plot.figure_output import claim_outputs
+        from speclight.scenario import load_scenario
+
+        inputs = {"scenario file": scenario, "fit file": fit}
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+            result = upsample_from(load_scenario(scenario), read_fit_albedos(fit), str(fit))
+            claim.write(spectrum_csv(result, str(scenario), str(fit)).encode())
+            if figure is not None:
+                from speclight.plot.upsample_figure import upsample_figure
+
+                figure.write(upsample_figure(result, scenario.stem))
+        if not result.spectrum.converged:
+            typer.echo(
+                "notice: the fit did not converge: the spectrum reproduces the albedos only to "
+                f"{result.spectrum.max_band_error:.3g} (said in the CSV header)"
+            )
+        typer.echo(f"wrote {output}" + (f" and {plot_file}" if plot_file else ""))
+
+    _guarded(run)
+
+
+def _endmember_files(arguments: list[Path], endmembers: list[str] | None) -> list[str] | None:
+    """``--endmembers E1.csv E2.csv ...`` (SPEC): the files after the first arrive as
+    positional arguments after MEASURED; ``-e`` may also be repeated."""
+    extra = [str(p) for p in arguments[1:]]
+    if extra and not endmembers:
+        raise InputError(
+            f"unexpected argument(s) {' '.join(extra)}: give one MEASURED file (endmember "
+            "files follow --endmembers)",
+            field="MEASURED",
+        )
+    return None if not endmembers else [*endmembers, *extra]
+
+
+@app.command()
+def unmix(
+    measured: Annotated[
+        list[Path],
+        typer.Argument(
+            help="MEASURED first: a speclight NetCDF, or a CSV of count rates (with "
+            "--scenario); any further arguments are more --endmembers files.",
+            metavar="MEASURED [E2.csv ...]",
+        ),
+    ],
+    endmembers: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--endmembers",
+            "-e",
+            metavar="FILE",
+            help="Endmember spectrum CSV (wavelength_nm,reflectance; name = file stem); "
+            "repeat for each, or 'scenario' for the scenario's materials.",
+        ),
+    ] = None,
+    extract: Annotated[
+        str | None,
+        typer.Option("--extract", help="Extract endmembers from the data: atgp, pca or nfindr."),
+    ] = None,
+    n: Annotated[int | None, typer.Option("--n", help="Number of endmembers to extract.")] = None,
+    method: Annotated[
+        str, typer.Option("--method", help="ls, nnls, nnls-norm (default) or fcls.")
+    ] = "nnls-norm",
+    scenario: Annotated[
+        Path | None,
+        typer.Option("--scenario", help="Scenario YAML (needed for a CSV or -e scenario)."),
+    ] = None,
+    bin_s: Annotated[
+        float | None, typer.Option("--bin-s", help="Average epochs into bins of S seconds.")
+    ] = None,
+    output: Annotated[
+        str, typer.Option("--output", "-o", metavar="FILE", help="Output NetCDF (ABUND.nc).")
+    ] = "abundance.nc",
+    plot_file: Annotated[
+        str | None, typer.Option("--plot", metavar="FIG", help="Figure (.png, .pdf, .svg).")
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite existing outputs.")] = False,
+) -> None:
+    """Per-epoch material contributions from band reflectance factors: the linear mixing
+    model x = S a (paper eq. 6) with endmember spectra (-e FILE ..., or -e scenario for the
+    scenario's materials) or endmembers extracted from the data (--extract, --n). Writes
+    ABUND.nc: abundance(time, endmember), residual(time), endmember_signature(endmember, band)
+    and reflectance_factor(time, band); with ground truth in MEASURED, the confusion matrix.
+
+    Example: speclight unmix out.nc -e gold.csv cell.csv paint.csv -o abund.nc --plot abund.png
+    """
+
+    def run() -> None:
+        from speclight.estimate.unmix_io import check_unmix_options, unmix_measured
+        from speclight.io.netcdf import dataset_bytes
+        from speclight.plot.figure_output import claim_outputs
+
+        members = _endmember_files(measured, endmembers)
+        check_unmix_options(members, extract, n, method)
+        inputs: dict[str, Path | str] = {"measured file": measured[0]}
+        if scenario is not None:
+            inputs["scenario file"] = scenario
+        for i, path in enumerate(members or []):
+            inputs[f"endmember file {i + 1}"] = path
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+            loaded = None
+            if scenario is not None:
+                from speclight.scenario import load_scenario
+
+                loaded = load_scenario(scenario)
+            ds = unmix_measured(
+                measured[0],
+                endmembers=members,
+                extract=extract,
+                n=n,
+                method=method,
+                loaded=loaded,
+                bin_s=bin_s,
+                progress=sys.stderr.isatty(),
+            )
+            _raise_if_signalled()
+            claim.write(dataset_bytes(ds))
+            if figure is not None:
+                from speclight.plot.unmix_figure import unmix_figure
+
+                figure.write(unmix_figure(ds))
+        if "mean_absolute_share_error" in ds.attrs:
+            typer.echo(
+                f"against the ground truth: mean absolute share error "
+                f"{ds.attrs['mean_absolute_share_error']:.3f} (matched {ds.attrs['matching']})"
+            )
+        typer.echo(f"wrote {output}" + (f" and {plot_file}" if plot_file else ""))
+
+    _guarded(run)
+
+
+@app.command()
 def info() -> None:
     """Versions of speclight and its engines, render variants, and data coverage."""
 

@@ -47,7 +47,6 @@ from typing import Literal, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import nnls as scipy_nnls
 
 from speclight.errors import InputError, did_you_mean
 
@@ -180,6 +179,8 @@ def _enumerated(x: F64, s: F64, sum_to_one: bool) -> F64:
 
 def _per_row(x: F64, s: F64, sum_to_one: bool) -> F64:
     """NNLS (or Heinz & Chang's augmented FCLS) of each row with :func:`scipy.optimize.nnls`."""
+    from scipy.optimize import nnls as scipy_nnls  # here: importing scipy.optimize costs ~0.3 s
+
     n, k = x.shape[0], s.shape[0]
     a = np.zeros((n, k))
     mat = s.T

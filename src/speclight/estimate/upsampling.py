@@ -40,7 +40,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.polynomial import legendre
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import least_squares
 
 from speclight.constants import HC_J_M
 from speclight.errors import InputError
@@ -316,6 +315,8 @@ def upsample(
         reflectance = np.full(wl.size, rho[0])
         fit = weights @ reflectance
         return _result(wl, reflectance, coefficients, centre, half_span, rho, rho.copy(), fit, tol)
+
+    from scipy.optimize import least_squares  # here: importing scipy.optimize costs ~0.3 s
 
     target = np.clip(rho, clip, 1.0 - clip)
     vander = legendre.legvander(scaled_wavelength(wl, centre, half_span), n - 1)
