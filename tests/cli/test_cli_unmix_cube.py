@@ -146,3 +146,23 @@ def test_extracted_laser_signatures_against_the_truth(tmp_path: Path, simulated:
             assert ab["endmember_angle"].values[k] == pytest.approx(expected, abs=1e-6)
     assert pure >= 1
     assert fig.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize(
+    ("name", "source", "needle"),
+    [
+        ("cube-materials-laser", "sun", "NaN at every epoch (no Sun light); try --source laser"),
+        ("cube-materials", "laser", "has no laser_reflectance_factor(time, band)"),
+        ("cube-materials", "lazer", "unknown source 'lazer' (choices: sun, laser)"),
+    ],
+)
+def test_a_source_the_data_lack_is_refused(
+    tmp_path: Path, simulated: dict, name: str, source: str, needle: str
+) -> None:
+    out = tmp_path / "ab.nc"
+    measured, _ = simulated[name]
+    args = [str(measured), "-e", "scenario", "--source", source, "-o", str(out)]
+    result = runner.invoke(app, ["unmix", *args])
+    assert result.exit_code == 2
+    assert needle in result.stderr and len(result.stderr.strip().splitlines()) == 1
+    assert not out.exists()

@@ -156,6 +156,14 @@ def read_reflectance_factors(
             )
         bands = dataset_band_responses(ds, src)
         factor = ds[var].transpose("time", "band").values.astype(float)
+        if not np.any(np.isfinite(factor)):
+            other = "sun" if chosen == "laser" else "laser"
+            raise InputError(
+                f"{var} is NaN at every epoch (no {'laser' if chosen == 'laser' else 'Sun'} "
+                f"light); try --source {other}",
+                source=src,
+                field="--source",
+            )
         what = var
         if chosen == "sun":
             source = sun_source_W_m2_nm(ds)
