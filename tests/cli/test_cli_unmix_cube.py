@@ -69,7 +69,7 @@ def _truth(ds: xr.Dataset, laser: bool) -> tuple[np.ndarray, np.ndarray]:
     if laser:
         loaded = parse_scenario(ds.attrs["scenario_yaml"], source="laser")
         lines = laser_lines_per_nm(loaded, wl)
-        source = coaxial_laser_source_W_m2_nm(ds["laser_irradiance"].values, lines, t)
+        source = coaxial_laser_source_W_m2_nm(ds["laser_irradiance"].values, lines, t, wl)
         shares = ds["laser_reflectance_factor_material"].values
     else:
         source = ds["solar_irradiance"].values * ds["sunlit"].values[:, None] * t
@@ -166,3 +166,28 @@ def test_a_source_the_data_lack_is_refused(
     assert result.exit_code == 2
     assert needle in result.stderr and len(result.stderr.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_laser_rates_as_csv_give_simulates_laser_factors(tmp_path: Path, simulated: dict) -> None:
+    # eq. 5 with the lasers' lines (SPEC section 5): the laser return rates written as a
+    # MEASURED CSV, with the scenario, must come back as simulate's own
+    # laser_reflectance_factor (the same range, lines, transmission and bands), to rounding
+    measured, ds = simulated["cube-materials-laser"]
+    bands = [str(b) for b in ds["band"].values]
+    rows = ["time," + ",".join(bands)]
+    for t, rate in zip(ds["time"].values, ds["return_rate"].values, strict=True):
+        rows.append(
+            np.datetime_as_string(t, unit="ms") + "Z," + ",".join(repr(float(r)) for r in rate)
+        )
+    rates = tmp_path / "returns.csv"
+    rates.write_text("\n".join(rows) + "\n")
+    out = tmp_path / "ab.nc"
+    scenario = str(measured.with_suffix(".yaml"))
+    args = [str(rates), "--scenario", scenario, "-e", "scenario", "-o", str(out)]
+    result = runner.invoke(app, ["unmix", *args])
+    assert result.exit_code == 0, result.output
+    ab = xr.open_dataset(out)
+    assert ab.attrs["light"] == "laser"
+    np.testing.assert_allclose(
+        ab["reflectance_factor"].values, ds["laser_reflectance_factor"].values, rtol=1e-9
+    )

@@ -11,11 +11,15 @@ microfacet models with the reflectance given as numbers), its share is
     s_kj = sum_l rho_k(l) E(l) R_j(l) l dl / sum_l E(l) R_j(l) l dl,
 
 with ``E`` the source spectrum at the aperture (the Sun or the lasers' lines, times the
-atmosphere's transmission) and ``R_j`` the band response x optics x QE (the weights of eq. 5,
-Nussbaum et al. 2022, doi:10.3390/aerospace9040214; :func:`band_albedo` with ``E R_j`` as
-the response). The true contribution is then the projection ``g_k = F_k . s_k / |s_k|^2``
-(exact for such materials), and the true fractions ``g_k / sum g`` are what ``nnls-norm``
-and ``fcls`` estimate (:func:`speclight.estimate.unmix`).
+atmosphere's transmission: :mod:`speclight.estimate.source_spectrum`; per epoch, since the
+transmission changes along a pass) and ``R_j`` the band response x optics x QE (the weights
+of eq. 5, Nussbaum et al. 2022, doi:10.3390/aerospace9040214; :func:`band_albedo` with
+``E R_j`` as the response). The true contribution is then the projection
+``g_k = F_k . s_k / |s_k|^2`` (exact for such materials), and the true fractions
+``g_k / sum g`` are what ``nnls-norm`` estimates (:func:`speclight.estimate.unmix`,
+:func:`.unmix_per_epoch`); the comparison of ``speclight unmix`` is
+:mod:`speclight.estimate.unmix_truth`, with the confusion matrix and spectral angle of
+:mod:`speclight.estimate.accuracy`.
 """
 
 from __future__ import annotations

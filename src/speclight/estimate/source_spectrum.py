@@ -26,6 +26,7 @@ import xarray as xr
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError
+from speclight.wavelength_grid import grid_bin_bounds_nm
 
 if TYPE_CHECKING:
     from speclight.scenario import LoadedScenario
@@ -56,25 +57,30 @@ def mean_source_W_m2_nm(
 
 
 def coaxial_laser_source_W_m2_nm(
-    laser_irradiance_W_m2: ArrayLike, line_per_nm: ArrayLike, transmission: ArrayLike
+    laser_irradiance_W_m2: ArrayLike,
+    line_per_nm: ArrayLike,
+    transmission: ArrayLike,
+    wavelength_nm: ArrayLike,
 ) -> F64:
     """Lasers' spectrum at the aperture (N, L) for transmitters at the observer's site.
 
     ``laser_irradiance_W_m2`` (N, K) is the simulate output's ``laser_irradiance`` (each
     line's irradiance at the target, after the uplink), ``line_per_nm`` (K, L) the line
-    shapes on the grid (on their support, as the pipeline keeps them) and ``transmission``
-    (N, L) the observer's. From the observer's own site the uplink has the downlink's
-    transmission T, so a line at the target is ``beam x shape x T`` (``laser_irradiance`` its
-    bin sum on a uniform grid) and at the aperture ``beam x shape x T^2``.
+    shapes on the grid ``wavelength_nm`` (on their support, as the pipeline keeps them) and
+    ``transmission`` (N, L) the observer's. From the observer's own site the uplink has the
+    downlink's transmission T, so a line at the target is ``beam x shape x T``
+    [W m-2 nm-1] (``laser_irradiance`` its integral over the grid's bins, as the pipeline
+    sums it) and at the aperture ``beam x shape x T^2``.
     """
     irr = np.asarray(laser_irradiance_W_m2, dtype=np.float64)
     lines = np.atleast_2d(np.asarray(line_per_nm, dtype=np.float64))
     t = np.asarray(transmission, dtype=np.float64)
+    lo, hi = grid_bin_bounds_nm(np.asarray(wavelength_nm, dtype=np.float64))
     out = np.zeros_like(t)
     for k in range(len(lines)):
         shaped = lines[k] * t
         with np.errstate(invalid="ignore", divide="ignore"):
-            beam = np.where(irr[:, k] > 0, irr[:, k] / shaped.sum(axis=1), 0.0)
+            beam = np.where(irr[:, k] > 0, irr[:, k] / (shaped @ (hi - lo)), 0.0)
         out += beam[:, None] * shaped
     return np.asarray(out * t)
 
@@ -127,11 +133,12 @@ def laser_source_W_m2_nm(ds: xr.Dataset, loaded: LoadedScenario) -> F64:
             "simulated with lasers",
             field="--source",
         )
-    lines = laser_lines_per_nm(loaded, ds["wavelength"].values)
+    wl = ds["wavelength"].values
     return coaxial_laser_source_W_m2_nm(
         ds["laser_irradiance"].transpose("time", "laser").values,
-        lines,
+        laser_lines_per_nm(loaded, wl),
         ds["transmission"].transpose("time", "wavelength").values,
+        wl,
     )
 
 
