@@ -9,7 +9,7 @@ material_signatures`), with ``E T`` the spectrum returned here, per epoch (N, L)
 
 * the Sun: ``solar_irradiance x sunlit x transmission`` of a ``speclight simulate`` dataset;
 * lasers transmitted from the observer's site (coaxial): each line ``beam x shape x T`` at
-  the target (``laser_irradiance`` its bin sum) and ``x T`` again at the aperture
+  the target (``laser_irradiance`` its integral over the bins) and ``x T`` again at the aperture
   (:func:`coaxial_laser_source_W_m2_nm`), the line shapes from the scenario.
 
 A transmitter elsewhere has an uplink transmission of its own, not in the dataset; the
