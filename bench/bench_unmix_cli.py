@@ -57,10 +57,16 @@ def write_inputs(folder: Path, epochs: int, bands: int, k: int) -> tuple[Path, l
         path.write_text("wavelength_nm,reflectance\n" + "\n".join(rows) + "\n")
         files.append(path)
         spectra.append(np.interp(WL, nodes, np.round(values, 4)))
-    w = response * WL
-    s = np.array(spectra) @ (w / w.sum(axis=1, keepdims=True)).T
+    # a Sun-like source and a transmission that changes with the epoch: the signatures are
+    # weighted by each epoch's source at the aperture (SPEC section 5, eq. 5)
+    solar = 1.9 * np.exp(-(((WL - 480.0) / 380.0) ** 2))
+    transmission = (0.35 + 0.6 * (WL - WL[0]) / (WL[-1] - WL[0]))[None, :] ** np.linspace(
+        1.0, 1.5, epochs
+    )[:, None]
+    w = response[None, :, :] * (solar * transmission)[:, None, :] * WL
+    s = np.einsum("kl,nbl->nkb", np.array(spectra), w / w.sum(axis=2, keepdims=True))
     a = rng.dirichlet(np.ones(k), size=epochs) * 0.1
-    x = a @ s + rng.normal(0.0, 0.001, size=(epochs, bands))
+    x = np.einsum("nk,nkb->nb", a, s) + rng.normal(0.0, 0.001, size=(epochs, bands))
     time_utc = np.datetime64("2020-01-01T00:00:00", "ns") + np.arange(epochs) * np.timedelta64(
         1, "s"
     )
@@ -68,6 +74,8 @@ def write_inputs(folder: Path, epochs: int, bands: int, k: int) -> tuple[Path, l
         coords={"time": time_utc, "wavelength": WL, "band": [f"G-{c:.0f}/26" for c in centres]}
     )
     ds["band_response"] = (("band", "wavelength"), response)
+    ds["solar_irradiance"] = (("time", "wavelength"), np.tile(solar, (epochs, 1)))
+    ds["transmission"] = (("time", "wavelength"), transmission)
     ds["reflectance_factor"] = (("time", "band"), x)
     ds["count_rate"] = (("time", "band"), x * 1e4)
     measured = folder / "measured.nc"

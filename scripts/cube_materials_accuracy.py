@@ -1,46 +1,50 @@
 """Unmixing accuracy of the cube-materials examples (reference paper section 5.2, Figure 13).
 
 Runs ``cube-materials`` (Sun) and ``cube-materials-laser`` (seven coaxial laser lines),
-unmixes the band reflectance factors against the four shipped material tables
-(``nnls-norm`` and ``fcls``), compares with the ground truth of
-``render: {per_material: true}`` and prints, for noise-free and noisy data, the
-dominant-material confusion matrix (rows true, columns estimated) and the mean absolute error
-of the fractions; then the ATGP signatures' spectral angles to the true ones and the
+reads them back as ``speclight unmix`` does (:func:`speclight.estimate.
+read_reflectance_factors`: the factors and the source spectrum at the aperture), makes the
+four shipped material tables endmembers as ``speclight unmix -e TABLE.csv ...`` does
+(:func:`speclight.estimate.endmembers_from_files`: signatures weighted by each epoch's
+source, and by the mean source of the pass), unmixes (``nnls-norm`` and ``fcls``), compares
+with the ground truth of ``render: {per_material: true}`` and prints, for noise-free and
+noisy data, the dominant-material confusion matrix (rows true, columns estimated) and the
+mean absolute error of the fractions, for per-epoch signatures (what ``speclight unmix``
+uses), one matrix of the mean source spectrum, and plain ``band_albedo`` signatures without
+the source; then the ATGP and N-FINDR signatures' spectral angles to the true ones and the
 condition number of the band signature matrix. ``docs/cube-materials.md`` quotes its output::
 
     python scripts/cube_materials_accuracy.py [--resolution PX]
 
 Noisy data. Under the Sun: the simulate output's ``count_rate_measured`` (the example's
 noise block: Poisson, sky, dark current, read noise, 1 s exposures), as reflectance factors
-(the factor is proportional to the rate). Under lasers the pipeline draws no noise for the
-returns, so the same noise model (:func:`speclight.instrument.simulate_measurement`, the
-example's noise block and sky) is applied here to ``return_rate``.
+(the factor is proportional to the rate; what ``speclight unmix`` reads). Under lasers the
+pipeline draws no noise for the returns, so the same noise model
+(:func:`speclight.instrument.simulate_measurement`, the example's noise block and sky) is
+applied here to ``return_rate``.
 """
 
 from __future__ import annotations
 
 import argparse
+import tempfile
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import yaml
 
 from speclight import instrument
-from speclight.estimate import extract_endmembers
-from speclight.estimate.ground_truth import (
-    coaxial_laser_source_W_m2_nm,
+from speclight.estimate import (
+    endmembers_from_files,
+    extract_endmembers,
     fractions,
-    matched_angles_deg,
     material_signatures,
-    mean_source_W_m2_nm,
+    read_reflectance_factors,
     true_contributions,
-    unmix_accuracy,
 )
-from speclight.illumination.laser import gaussian_line_per_nm
+from speclight.estimate.ground_truth import matched_angles_deg, unmix_accuracy
 from speclight.scenario import example_text, parse_scenario
 from speclight.simulate import simulate
-from speclight.simulate.ranging_stage import SUPPORT_THRESHOLD
-from speclight.target import Reflectance
 from speclight.target.material_tables import MATERIAL_TABLES, material_table_path
 
 NAMES = list(MATERIAL_TABLES)  # aluminium, kapton_mli, solar_cell, white_paint
@@ -57,35 +61,24 @@ def run(name: str, resolution_px: int | None) -> tuple[Any, Any]:
 
 def case(loaded: Any, ds: Any, laser: bool, seed: int = 7) -> dict[str, Any]:
     """Signatures, factors (noise-free and noisy) and true fractions of one run."""
-    wl = ds["wavelength"].values
-    response = (
-        ds["band_response"].values * ds["detector_qe"].values * ds["optics_transmission"].values
-    )
-    tables = np.stack([Reflectance.table_file(material_table_path(n)).evaluate(wl) for n in NAMES])
-    transmission = ds["transmission"].values
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "run.nc"
+        ds.to_netcdf(path, engine="h5netcdf")
+        data = read_reflectance_factors(path, loaded, light="laser" if laser else "sun")
+    tables = [material_table_path(n) for n in NAMES]
+    members = endmembers_from_files(tables, data.bands, data.source_W_m2_nm)
     if laser:
-        lasers = loaded.scenario.illumination.lasers
-        lines = np.stack(
-            [gaussian_line_per_nm(wl, la.wavelength_nm, la.linewidth_nm) for la in lasers]
-        )
-        keep = lines > SUPPORT_THRESHOLD * lines.max(axis=1, keepdims=True)
-        lines = np.where(keep, lines, 0.0)  # on their support, as the pipeline keeps them
-        at_aperture = coaxial_laser_source_W_m2_nm(
-            ds["laser_irradiance"].values, lines, transmission
-        )
-        source = mean_source_W_m2_nm(at_aperture, 1.0)
         x = ds["laser_reflectance_factor"].values
-        per_material = ds["laser_reflectance_factor_material"].values
         rate = ds["return_rate"].values
         noise = loaded.scenario.instrument.noise
-        area = instrument.aperture_area_m2(0.43, 0.0)
+        wl = data.bands.wavelength_nm
         sky = instrument.sky_count_rate_per_s(
             noise.sky_background_mag_arcsec2,
-            area,
+            instrument.aperture_area_m2(0.43, 0.0),
             wl,
             np.ones(wl.size),
             np.ones(wl.size),
-            response,
+            data.bands.response,
             background_aperture_radius_arcsec=noise.aperture_radius_arcsec,
         )
         finite = np.isfinite(rate)
@@ -98,25 +91,39 @@ def case(loaded: Any, ds: Any, laser: bool, seed: int = 7) -> dict[str, Any]:
             read_noise_e=noise.read_noise_e,
             seed=seed,
         )
+        with np.errstate(invalid="ignore", divide="ignore"):
+            noisy = np.where(rate > 0, x * measured / rate, np.nan)
     else:
-        source = mean_source_W_m2_nm(
-            ds["solar_irradiance"].values, transmission, ds["sunlit"].values
-        )
         x = ds["reflectance_factor"].values
-        per_material = ds["reflectance_factor_material"].values
-        rate, measured = ds["count_rate"].values, ds["count_rate_measured"].values
-    with np.errstate(invalid="ignore", divide="ignore"):
-        noisy = np.where(rate > 0, x * measured / rate, np.nan)
-    signatures = material_signatures(tables, response, wl, source)
-    labels = [str(v) for v in ds["material_reflectance"].values]
-    truth = fractions(true_contributions(per_material, labels, NAMES, signatures))
-    plain = material_signatures(tables, response, wl)  # band_albedo: no source weighting
-    return {"x": x, "noisy": noisy, "truth": truth, "signatures": signatures, "plain": plain}
+        noisy = data.factor  # from count_rate_measured, as speclight unmix reads it
+    assert data.material_contribution is not None and data.material_labels is not None
+    truth = fractions(
+        true_contributions(
+            data.material_contribution, data.material_labels, NAMES, members.signatures_epoch
+        )
+    )
+    tables_on_grid = members.spectra
+    plain = material_signatures(tables_on_grid, data.bands.response, data.bands.wavelength_nm)
+    return {
+        "x": x,
+        "noisy": noisy,
+        "truth": truth,
+        "per-epoch": members.signatures_epoch,
+        "mean": members.signatures,
+        "plain": plain,
+    }
+
+
+SIGNATURES = {
+    "per-epoch": "per-epoch source-weighted (speclight unmix)",
+    "mean": "mean-source-weighted",
+    "plain": "band_albedo (no source)",
+}
 
 
 def report(title: str, c: dict[str, Any]) -> None:
     print(f"\n## {title}")
-    cond = np.linalg.cond(c["signatures"].T)
+    cond = np.linalg.cond(c["mean"].T)
     purest = np.nanmax(c["truth"], axis=0)
     print(
         "purest epoch per material: "
@@ -125,23 +132,22 @@ def report(title: str, c: dict[str, Any]) -> None:
     print(f"condition number of the signature matrix (10 x 4): {cond:.1f}")
     for data in ("x", "noisy"):
         for method in ("nnls-norm", "fcls"):
-            for sig in ("signatures", "plain"):
+            for sig, what in SIGNATURES.items():
                 acc = unmix_accuracy(c[data], c["truth"], c[sig], method)  # type: ignore[arg-type]
                 kind = "noise-free" if data == "x" else "noisy"
-                weights = "source-weighted" if sig == "signatures" else "band_albedo"
                 print(
-                    f"\n{kind}, {method}, {weights} signatures: {acc.n_epochs} epochs, "
+                    f"\n{kind}, {method}, {what} signatures: {acc.n_epochs} epochs, "
                     f"dominant material right {100 * acc.dominant_accuracy:.1f} %, "
                     f"mean |error| {acc.mean_abs_error:.2e}, max {acc.max_abs_error:.2e}"
                 )
-                if sig == "signatures" and method == "nnls-norm":
+                if sig == "per-epoch" and method == "nnls-norm":
                     print("true \\ estimated: " + " ".join(f"{n:>11}" for n in NAMES))
                     for n, row in zip(NAMES, acc.confusion, strict=True):
                         print(f"{n:>17}: " + " ".join(f"{v:>11d}" for v in row))
     for data in ("x", "noisy"):
         for method in ("atgp", "nfindr"):
             ext = extract_endmembers(c[data], 4, method=method)  # type: ignore[arg-type]
-            angle, _ = matched_angles_deg(c["signatures"], ext.signatures)
+            angle, _ = matched_angles_deg(c["mean"], ext.signatures)
             kind = "noise-free" if data == "x" else "noisy"
             pairs = ", ".join(f"{n} {a:.2f}" for n, a in zip(NAMES, angle, strict=True))
             print(f"\n{method} ({kind}): spectral angle to the true signature [deg]: {pairs}")

@@ -319,10 +319,21 @@ def unmix(
     ] = "nnls-norm",
     scenario: Annotated[
         Path | None,
-        typer.Option("--scenario", help="Scenario YAML (needed for a CSV or -e scenario)."),
+        typer.Option(
+            "--scenario",
+            help="Scenario YAML (needed for a CSV; for a NetCDF default: the one it carries).",
+        ),
     ] = None,
     bin_s: Annotated[
         float | None, typer.Option("--bin-s", help="Average epochs into bins of S seconds.")
+    ] = None,
+    source: Annotated[
+        str | None,
+        typer.Option(
+            "--source",
+            help="sun or laser: unmix the solar or the laser reflectance factors (default: "
+            "the lasers' where the data have no solar ones).",
+        ),
     ] = None,
     output: Annotated[
         str, typer.Option("--output", "-o", metavar="FILE", help="Output NetCDF (ABUND.nc).")
@@ -334,9 +345,11 @@ def unmix(
 ) -> None:
     """Per-epoch material contributions from band reflectance factors: the linear mixing
     model x = S a (paper eq. 6) with endmember spectra (-e FILE ..., or -e scenario for the
-    scenario's materials) or endmembers extracted from the data (--extract, --n). Writes
-    ABUND.nc: abundance(time, endmember), residual(time), endmember_signature(endmember, band)
-    and reflectance_factor(time, band); with ground truth in MEASURED, the confusion matrix.
+    scenario's materials) or endmembers extracted from the data (--extract, --n). Spectra
+    enter through band signatures weighted by the source at the aperture (Sun or lasers),
+    per epoch. Writes ABUND.nc: abundance(time, endmember), residual(time),
+    endmember_signature(endmember, band) and reflectance_factor(time, band); with ground
+    truth in MEASURED, the confusion matrix.
 
     Example: speclight unmix out.nc -e gold.csv cell.csv paint.csv -o abund.nc --plot abund.png
     """
@@ -347,7 +360,7 @@ def unmix(
         from speclight.plot.figure_output import claim_outputs
 
         members = _endmember_files(measured, endmembers)
-        check_unmix_options(members, extract, n, method)
+        check_unmix_options(members, extract, n, method, source)
         inputs: dict[str, Path | str] = {"measured file": measured[0]}
         if scenario is not None:
             inputs["scenario file"] = scenario
@@ -368,6 +381,7 @@ def unmix(
                 loaded=loaded,
                 bin_s=bin_s,
                 progress=sys.stderr.isatty(),
+                light=source,
             )
             _raise_if_signalled()
             claim.write(dataset_bytes(ds))

@@ -4,7 +4,11 @@ Everything is computed here from closed forms, independently of speclight: Gauss
 bin-averaged with the normal CDF over bins half-way between grid points (a uniform grid,
 so every bin is STEP_NM wide), optics and QE constants, and the photon-weighted band
 average of eq. 3 of the reference paper (Nussbaum et al. 2022): the weight of a wavelength
-is R_j(lambda) lambda d(lambda) (h c cancels in the ratio).
+is R_j(lambda) lambda d(lambda) (h c cancels in the ratio), times the source spectrum at the
+aperture E T: the band reflectance factor of eq. 5 divides by the band-weighted source photon
+flux, so a material of reflectance rho enters it as sum rho E T R_j l / sum E T R_j l (SPEC
+section 5). The dataset's Sun and transmission are smooth non-flat closed forms, so that
+signatures without the source weighting would not fit.
 """
 
 from __future__ import annotations
@@ -21,6 +25,10 @@ CENTRES_NM = [430.0, 520.0, 600.0, 680.0, 780.0, 900.0]
 SIGMA_NM = 25.0
 OPTICS = 0.8
 QE = 0.9
+#: Solar irradiance [W m-2 nm-1] and transmission of the synthetic dataset (closed forms).
+SOLAR = 1.9 * np.exp(-(((WL - 480.0) / 380.0) ** 2))
+TRANSMISSION = 0.35 + 0.6 * (WL - WL[0]) / (WL[-1] - WL[0])
+SOURCE = SOLAR * TRANSMISSION
 
 # endmember spectra: (wavelength_nm, reflectance) nodes, linearly interpolated
 SPECTRA = {
@@ -40,9 +48,16 @@ def gaussian_responses() -> np.ndarray:
     return np.array(rows)
 
 
-def band_average(spectrum: np.ndarray, response: np.ndarray, wl: np.ndarray = WL) -> np.ndarray:
-    """Photon-weighted band averages (eq. 3) on a uniform grid: sum g R l / sum R l."""
-    w = response * wl
+def band_average(
+    spectrum: np.ndarray,
+    response: np.ndarray,
+    wl: np.ndarray = WL,
+    source: np.ndarray | float = 1.0,
+) -> np.ndarray:
+    """Photon-weighted band averages on a uniform grid, ``sum g E R l / sum E R l``: with a
+    flat source those of eq. 3 (upsampling), with the source at the aperture those of the
+    band reflectance factor (unmixing)."""
+    w = response * source * wl
     return np.asarray((w @ spectrum) / w.sum(axis=1))
 
 
@@ -52,9 +67,10 @@ def spectrum(name: str, wl: np.ndarray = WL) -> np.ndarray:
 
 
 def signatures(names: list[str]) -> np.ndarray:
-    """(K, B) band signatures of the named spectra through the bands x optics x QE."""
+    """(K, B) band signatures of the named spectra through the bands x optics x QE,
+    weighted by the dataset's source at the aperture."""
     response = gaussian_responses() * OPTICS * QE
-    return np.array([band_average(spectrum(n), response) for n in names])
+    return np.array([band_average(spectrum(n), response, source=SOURCE) for n in names])
 
 
 def write_spectra(folder: Path) -> dict[str, Path]:
@@ -82,6 +98,13 @@ def mixture_dataset(abundance: np.ndarray, names: list[str]) -> xr.Dataset:
     ds["band_response"] = (("band", "wavelength"), gaussian_responses(), {"units": "1"})
     ds["optics_transmission"] = (("wavelength",), np.full(WL.size, OPTICS), {"units": "1"})
     ds["detector_qe"] = (("band", "wavelength"), np.full((len(bands), WL.size), QE), {"units": "1"})
+    ds["solar_irradiance"] = (
+        ("time", "wavelength"),
+        np.tile(SOLAR, (n, 1)),
+        {"units": "W m-2 nm-1"},
+    )
+    ds["transmission"] = (("time", "wavelength"), np.tile(TRANSMISSION, (n, 1)), {"units": "1"})
+    ds["sunlit"] = (("time",), np.ones(n), {"units": "1"})
     ds["reflectance_factor"] = (("time", "band"), factor, {"units": "m2 sr-1"})
     ds["count_rate"] = (("time", "band"), np.nan_to_num(factor) * 1e4, {"units": "s-1"})
     ds["reflectance_factor_material"] = (

@@ -1,4 +1,4 @@
-"""Signal shares, confusion matrix and spectral angle (speclight.estimate.accuracy).
+"""Confusion matrix, errors, spectral angle, reference units (speclight.estimate.accuracy).
 
 References: hand-worked cases (the numbers are derived in the comments), and the spectral
 angle's definition (Kruse et al. 1993, doi:10.1016/0034-4257(93)90013-N).
@@ -12,12 +12,14 @@ import pytest
 from speclight.errors import InputError
 from speclight.estimate import (
     confusion_matrix,
-    material_shares,
+    fractions,
+    in_reference_units,
     mean_absolute_share_error,
-    signal_shares,
     spectral_angle_rad,
+    true_contributions,
 )
 from speclight.estimate.accuracy import match_by_angle, merge_columns
+from speclight.estimate.ground_truth import matched_angles_deg
 
 ROUNDING = 1e-12
 
@@ -47,9 +49,17 @@ def test_nan_epochs_are_left_out_and_empty_classes_are_nan_rows() -> None:
     assert mean_absolute_share_error(true, est) == pytest.approx(1.6 / 15, abs=ROUNDING)
 
 
-def test_material_shares_from_contributions() -> None:
-    # epoch 0: material sums 0.3 + 0.1 and 0.2 + 0.4 -> 0.4 / 1.0 and 0.6 / 1.0;
-    # epoch 1 is dark (all 0) and epoch 2 has a NaN: both NaN rows
+def test_confusion_counts_the_dominant_endmember() -> None:
+    # true dominant 0, 1, 0 (and a NaN epoch, left out); estimated 0, 0, 0
+    truth = np.array([[0.9, 0.1], [0.2, 0.8], [0.6, 0.4], [np.nan, 1.0]])
+    est = np.array([[0.7, 0.3], [0.6, 0.4], [0.9, 0.1], [0.5, 0.5]])
+    np.testing.assert_array_equal(confusion_matrix(truth, est, normalise=False), [[2, 0], [1, 0]])
+
+
+def test_fractions_of_per_material_contributions() -> None:
+    # epoch 0: material parts (0.3, 0.1) and (0.2, 0.4) on unit signatures (1, 0), (0, 1):
+    # contributions 0.3 and 0.4 -> fractions 3/7, 4/7; epoch 1 is dark (all 0) and epoch 2
+    # has a NaN: both NaN rows
     c = np.array(
         [
             [[0.3, 0.1], [0.2, 0.4]],
@@ -57,17 +67,23 @@ def test_material_shares_from_contributions() -> None:
             [[np.nan, 0.1], [0.2, 0.4]],
         ]
     )
-    shares = material_shares(c)
-    np.testing.assert_allclose(shares[0], [0.4, 0.6], atol=ROUNDING)
-    assert np.all(np.isnan(shares[1:]))
+    g = true_contributions(c, ["a", "b"], ["a", "b"], np.eye(2))
+    f = fractions(g)
+    np.testing.assert_allclose(f[0], [3 / 7, 4 / 7], atol=ROUNDING)
+    assert np.all(np.isnan(f[1:]))
 
 
-def test_signal_shares_weigh_abundance_by_signature_sum() -> None:
-    # a = (2, 1), S rows summing to 0.2 and 0.8 -> parts 0.4 and 0.8 -> shares 1/3, 2/3;
-    # scaling a (as nnls-norm does) leaves them unchanged
+def test_abundance_in_reference_units() -> None:
+    # a = (2, 1), S rows (0.1, 0.1) and (0.5, 0.3), references (1, 1): projections
+    # 0.2 / 2 = 0.1 and 0.8 / 2 = 0.4 -> (0.2, 0.4) -> fractions 1/3, 2/3; scaling a (as
+    # nnls-norm does) leaves the fractions unchanged
     s = np.array([[0.1, 0.1], [0.5, 0.3]])
-    np.testing.assert_allclose(signal_shares([[2.0, 1.0]], s), [[1 / 3, 2 / 3]], atol=ROUNDING)
-    np.testing.assert_allclose(signal_shares([[2 / 3, 1 / 3]], s), [[1 / 3, 2 / 3]], atol=ROUNDING)
+    ref = np.ones((2, 2))
+    np.testing.assert_allclose(
+        in_reference_units([[2.0, 1.0]], s, ref), [[0.2, 0.4]], atol=ROUNDING
+    )
+    scaled = fractions(in_reference_units([[2 / 3, 1 / 3]], s, ref))
+    np.testing.assert_allclose(scaled, [[1 / 3, 2 / 3]], atol=ROUNDING)
 
 
 def test_merge_columns_sums_into_classes() -> None:
@@ -86,8 +102,17 @@ def test_spectral_angle_and_matching() -> None:
     )
 
 
+def test_hungarian_matching_leaves_a_dark_signature_out() -> None:
+    true = np.array([[1.0, 0.0], [0.0, 1.0]])
+    found = np.array([[0.0, 0.0], [0.0, 3.0], [2.0, 0.1]])  # a dark row pairs with nothing
+    angle, partner = matched_angles_deg(true, found)
+    np.testing.assert_allclose(angle, [np.degrees(np.arctan(0.05)), 0.0], atol=1e-12)
+    np.testing.assert_array_equal(partner, [2, 1])
+    assert np.isnan(spectral_angle_rad(found[:1], true)).all()
+
+
 def test_shapes_are_checked() -> None:
     with pytest.raises(InputError, match=r"\(N, C\)"):
         confusion_matrix(np.zeros((3, 2)), np.zeros((3, 3)))
-    with pytest.raises(InputError, match="contribution"):
-        material_shares(np.zeros((3, 2)))
+    with pytest.raises(InputError, match="references"):
+        in_reference_units(np.zeros((3, 2)), np.zeros((2, 4)), np.zeros((2, 3)))

@@ -14,6 +14,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "cli"))
 from synthetic_mixture import (
+    SOURCE,
     WL,
     gaussian_responses,
     mixture_dataset,
@@ -49,11 +50,13 @@ def test_unmix_measured_returns_abund_dataset(tmp_path: Path) -> None:
 def test_endmember_files_signatures_and_duplicate_names(tmp_path: Path) -> None:
     files = write_spectra(tmp_path)
     bands = BandResponses(["a"] * 6, WL, gaussian_responses() * 0.8 * 0.9)
-    members = endmembers_from_files([files["gold"], files["paint"]], bands)
+    # weighted by the source at the aperture (SPEC section 5, eq. 5), here one for 3 epochs
+    members = endmembers_from_files([files["gold"], files["paint"]], bands, np.tile(SOURCE, (3, 1)))
     np.testing.assert_allclose(members.signatures, signatures(["gold", "paint"]), rtol=1e-12)
     other = tmp_path / "sub"
     other.mkdir()
     (other / "gold.csv").write_text(files["gold"].read_text())
+    np.testing.assert_allclose(members.signatures_epoch[1], members.signatures, rtol=1e-12)
     with pytest.raises(InputError, match="gold given twice"):
         endmembers_from_files([files["gold"], other / "gold.csv"], bands)
 

@@ -7,28 +7,30 @@ command line are built on them:
 * :mod:`.unmixing`: the linear mixing model x = S a (LS, NNLS, NNLS + normalisation, FCLS);
 * :mod:`.endmembers`: endmember extraction (ATGP, PCA, N-FINDR);
 * :mod:`.upsampling`: spectra from n band albedos (sigmoid polynomial, eq. 3-4);
-* :mod:`.accuracy`: signal shares, confusion matrix, spectral angle (unmixing against truth);
-* :mod:`.upsample_io`, :mod:`.unmix_io` (with :mod:`.unmix_inputs`, :mod:`.unmix_truth`,
-  :mod:`.scenario_bands`): the ``speclight upsample`` and ``speclight unmix`` commands.
+* :mod:`.accuracy`: confusion matrix, errors, spectral angle (unmixing against truth);
+* :mod:`.ground_truth`: source-weighted material signatures, true contributions and
+  fractions from per-material ground truth; :mod:`.source_spectrum`: the source at the
+  aperture (Sun, coaxial lasers);
+* :mod:`.upsample_io`, :mod:`.unmix_io` (with :mod:`.unmix_inputs`,
+  :mod:`.endmember_spectra`, :mod:`.unmix_truth`, :mod:`.scenario_bands`): the
+  ``speclight upsample`` and ``speclight unmix`` commands.
 """
 
 from speclight.estimate.accuracy import (
     confusion_matrix,
-    material_shares,
+    in_reference_units,
     mean_absolute_share_error,
-    signal_shares,
     spectral_angle_rad,
 )
+from speclight.estimate.endmember_spectra import endmembers_from_files, endmembers_from_scenario
 from speclight.estimate.endmembers import EndmemberResult, extract_endmembers
+from speclight.estimate.ground_truth import fractions, material_signatures, true_contributions
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
 from speclight.estimate.scenario_bands import BandResponses, scenario_band_responses
-from speclight.estimate.unmix_inputs import (
-    endmembers_from_files,
-    endmembers_from_scenario,
-    read_reflectance_factors,
-)
+from speclight.estimate.unmix_inputs import read_reflectance_factors
 from speclight.estimate.unmix_io import unmix_measured
 from speclight.estimate.unmixing import UNMIX_METHODS, UnmixResult, unmix
+from speclight.estimate.unmixing_epochs import unmix_per_epoch
 from speclight.estimate.upsample_io import read_fit_albedos, upsample_scenario
 from speclight.estimate.upsampling import UpsampledSpectrum, upsample
 
@@ -44,16 +46,19 @@ __all__ = [
     "endmembers_from_files",
     "endmembers_from_scenario",
     "extract_endmembers",
-    "material_shares",
+    "fractions",
+    "in_reference_units",
+    "material_signatures",
     "mean_absolute_share_error",
     "read_fit_albedos",
     "read_measured",
     "read_reflectance_factors",
     "scenario_band_responses",
-    "signal_shares",
     "spectral_angle_rad",
+    "true_contributions",
     "unmix",
     "unmix_measured",
+    "unmix_per_epoch",
     "upsample",
     "upsample_scenario",
 ]

@@ -1,22 +1,17 @@
-"""How well unmixing recovered the materials: shares, confusion matrix, spectral angle.
+"""Comparing estimated with true contributions: confusion matrix, errors, spectral angle.
 
-Plain arrays in, plain arrays out. The comparison is made on **signal shares**: the fraction
-of an epoch's band-summed reflectance factor that each material (or endmember) contributes.
-
-* True shares from ground truth ``contribution[n, m, b]``, each material's part of the band
-  reflectance factor (``reflectance_factor_material`` of a simulation): ``sum_b c[n, m, b]``
-  over ``sum_{m, b} c[n, m, b]``.
-* Estimated shares from the contributions ``a`` and signatures ``S`` of eq. 6: endmember k
-  contributes ``a[n, k] S[k, :]`` to the model of epoch n, so its share is
-  ``a[n, k] sum_b S[k, b]`` over the sum of these. This is invariant to a scaling of ``a``
-  (``nnls-norm``'s normalisation does not change it) and compares a dark material's large
-  coefficient with its small signal, as the truth does (the reference paper, section 5.2,
-  warns that the contribution is not an area fraction).
+Plain arrays in, plain arrays out. The compared quantities are **shares**: the fractions
+``g_k / sum(g)`` of an epoch's contributions (N, C), true ones from the ground truth
+(:func:`speclight.estimate.ground_truth.true_contributions` and ``fractions``), estimated
+ones from the unmixing (``nnls-norm`` returns them; other methods' contributions divided by
+their sum). Extracted endmembers, whose signatures are reflectance factors of arbitrary
+scale, are first put in the units of reference signatures (:func:`in_reference_units`) and
+summed into the classes they are matched to (:func:`merge_columns`, :func:`match_by_angle`).
 
 The class of an epoch is its dominant material (largest share). The confusion matrix has
-one row per true class and one column per estimated class, each row divided by the number of
-epochs of that true class (the reference paper's Figure 13); a class no epoch has gives a
-NaN row.
+one row per true class and one column per estimated class: counts, or each row divided by
+the number of epochs of that true class (the reference paper's Figure 13); a class no
+epoch has gives a NaN row.
 """
 
 from __future__ import annotations
@@ -29,40 +24,25 @@ from speclight.errors import InputError
 F64 = NDArray[np.float64]
 
 
-def material_shares(contribution: ArrayLike) -> F64:
-    """True signal shares (N, M) from per-material contributions (N, M, B) [any unit].
+def in_reference_units(abundance: ArrayLike, signatures: ArrayLike, references: ArrayLike) -> F64:
+    """Contributions (N, K) re-expressed in units of reference signatures.
 
-    Rows with a non-finite contribution or a zero total are NaN.
+    Endmember k contributes ``a[n, k] S[k]`` to epoch n; in units of the reference
+    ``R[k]`` (B,) that is ``a[n, k] S[k] . R[k] / |R[k]|^2`` (the projection, exact when
+    ``S[k]`` is proportional to ``R[k]``). Extracted signatures (reflectance factors of an
+    epoch, of arbitrary scale) become comparable with the true contributions computed with
+    the same references (:func:`speclight.estimate.ground_truth.true_contributions`).
     """
-    c = np.asarray(contribution, dtype=np.float64)
-    if c.ndim != 3:
-        raise InputError(
-            f"contribution must be (N epochs, M materials, B bands), got shape {c.shape}",
-            field="contribution",
-        )
-    per_material = c.sum(axis=2)
-    return _normalised(per_material)
-
-
-def signal_shares(abundance: ArrayLike, signatures: ArrayLike) -> F64:
-    """Estimated signal shares (N, K): ``a[n, k] sum_b S[k, b]`` normalised per epoch."""
     a = np.asarray(abundance, dtype=np.float64)
     s = np.asarray(signatures, dtype=np.float64)
-    if a.ndim != 2 or s.ndim != 2 or a.shape[1] != s.shape[0]:
+    r = np.asarray(references, dtype=np.float64)
+    if a.ndim != 2 or s.shape != r.shape or s.ndim != 2 or a.shape[1] != s.shape[0]:
         raise InputError(
-            f"abundance {a.shape} and signatures {s.shape} must be (N, K) and (K, B)",
+            f"abundance {a.shape}, signatures {s.shape} and references {r.shape} must be "
+            "(N, K), (K, B) and (K, B)",
             field="abundance",
         )
-    return _normalised(a * s.sum(axis=1)[None, :])
-
-
-def _normalised(parts: F64) -> F64:
-    total = parts.sum(axis=1, keepdims=True)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        out = parts / total
-    bad = ~np.all(np.isfinite(parts), axis=1) | ~(np.abs(total[:, 0]) > 0)
-    out[bad] = np.nan
-    return np.asarray(out, dtype=np.float64)
+    return np.asarray(a * (np.sum(s * r, axis=1) / np.sum(r * r, axis=1))[None, :])
 
 
 def merge_columns(shares: ArrayLike, classes: ArrayLike, n_classes: int) -> F64:
@@ -82,25 +62,32 @@ def merge_columns(shares: ArrayLike, classes: ArrayLike, n_classes: int) -> F64:
     return out
 
 
-def confusion_matrix(true_shares: ArrayLike, estimated_shares: ArrayLike) -> F64:
-    """Row-normalised confusion matrix (C, C) of the dominant class per epoch.
+def confusion_matrix(
+    true_shares: ArrayLike, estimated_shares: ArrayLike, normalise: bool = True
+) -> F64:
+    """Confusion matrix (C, C) of the dominant class per epoch, rows true, columns estimated.
 
     Parameters
     ----------
     true_shares, estimated_shares
         (N, C) shares of the same C classes, in the same order. Epochs with a NaN in either
         are left out.
+    normalise
+        Divide each row by its count (the reference paper's Figure 13), else the counts.
 
     Returns
     -------
     numpy.ndarray
-        ``m[i, j]``: the fraction of the epochs whose true dominant class is i that were
-        estimated as dominated by class j; NaN rows for classes that dominate no epoch.
+        ``m[i, j]``: the number of the epochs whose true dominant class is i that were
+        estimated as dominated by class j, or (``normalise``) their fraction of the row,
+        with NaN rows for classes that dominate no epoch.
     """
     t, e = _paired(true_shares, estimated_shares)
     c = t.shape[1]
     counts = np.zeros((c, c))
     np.add.at(counts, (np.argmax(t, axis=1), np.argmax(e, axis=1)), 1.0)
+    if not normalise:
+        return counts
     rows = counts.sum(axis=1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(rows > 0, counts / rows, np.nan)

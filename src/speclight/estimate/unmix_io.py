@@ -11,12 +11,15 @@ every epoch (:func:`.unmix`, eq. 6) and returns the dataset:
 ``reflectance_factor(time, band)`` [m2 sr-1]
     as SPEC says; epochs with a NaN factor keep their row, with NaN abundances.
 
-With ground truth in the input (``reflectance_factor_material``), also the comparison of
-:mod:`.accuracy`: ``true_share`` and ``estimated_share(time, class)``, ``confusion_matrix
-(true_class, estimated_class)`` and the attribute ``mean_absolute_share_error``. Endmembers
-are matched to the materials by name (a scenario endmember ``a,b`` stands for materials a
-and b), otherwise (extracted endmembers, foreign names) each endmember to the material
-whose ground-truth signature is nearest in spectral angle.
+Endmember spectra enter through their band signatures weighted by the source spectrum at
+the aperture (the Sun's or the lasers', :mod:`.endmember_spectra`), and every epoch is
+unmixed with its own epoch's signatures (:func:`.unmix_per_epoch`); ``endmember_signature``
+holds those of the mean source spectrum.
+
+With ground truth in the input (``reflectance_factor_material`` or
+``laser_reflectance_factor_material``), also the comparison of :mod:`.unmix_truth`:
+``true_share`` and ``estimated_share(time, class)``, ``confusion_matrix(true_class,
+estimated_class)``, ``confusion_count`` and the attribute ``mean_absolute_share_error``.
 """
 
 from __future__ import annotations
@@ -30,16 +33,21 @@ import xarray as xr
 
 from speclight.errors import InputError, did_you_mean
 from speclight.estimate import accuracy
-from speclight.estimate.endmembers import ENDMEMBER_METHODS, extract_endmembers
-from speclight.estimate.unmix_inputs import (
+from speclight.estimate.endmember_spectra import (
     Endmembers,
-    ReflectanceFactors,
     endmembers_from_files,
     endmembers_from_scenario,
+)
+from speclight.estimate.endmembers import ENDMEMBER_METHODS, extract_endmembers
+from speclight.estimate.source_spectrum import check_light
+from speclight.estimate.unmix_inputs import (
+    ReflectanceFactors,
+    dataset_scenario,
     read_reflectance_factors,
 )
 from speclight.estimate.unmix_truth import compare_with_truth
-from speclight.estimate.unmixing import UNMIX_METHODS, unmix
+from speclight.estimate.unmixing import UNMIX_METHODS
+from speclight.estimate.unmixing_epochs import unmix_per_epoch
 
 if TYPE_CHECKING:
     from speclight.scenario import LoadedScenario
@@ -49,9 +57,14 @@ SCENARIO_ENDMEMBERS = "scenario"
 
 
 def check_unmix_options(
-    endmembers: list[str] | None, extract: str | None, n: int | None, method: str
+    endmembers: list[str] | None,
+    extract: str | None,
+    n: int | None,
+    method: str,
+    light: str | None = None,
 ) -> None:
     """Refuse inconsistent options before any work (one-line :class:`InputError`)."""
+    check_light(light)
     if method not in UNMIX_METHODS:
         raise InputError(
             f"unknown method '{method}'{did_you_mean(method, UNMIX_METHODS)} "
@@ -93,6 +106,7 @@ def unmix_measured(
     loaded: LoadedScenario | None = None,
     bin_s: float | None = None,
     progress: bool = False,
+    light: str | None = None,
 ) -> xr.Dataset:
     """Unmix measured light curves into endmember contributions (module doc: the dataset).
 
@@ -109,11 +123,15 @@ def unmix_measured(
     method
         ``ls``, ``nnls``, ``nnls-norm`` (default, the reference paper's best) or ``fcls``.
     loaded
-        The scenario (for a CSV input or scenario endmembers).
+        The scenario (for a CSV input or scenario endmembers; for a NetCDF, default: the
+        scenario it was simulated from, its ``scenario_yaml`` attribute).
     bin_s
         Average epochs into bins of this many seconds first.
     progress
         Show the progress bar of the simulation a CSV input needs.
+    light
+        ``"sun"`` or ``"laser"``: unmix the solar or the laser reflectance factors (None:
+        the lasers' where the dataset has no finite solar ones, else the Sun's).
 
     Raises
     ------
@@ -121,10 +139,21 @@ def unmix_measured(
         Inconsistent options, a bad file, more endmembers than bands, signatures that
         cannot be told apart.
     """
-    check_unmix_options(endmembers, extract, n, method)
+    check_unmix_options(endmembers, extract, n, method, light)
     if endmembers == [SCENARIO_ENDMEMBERS] and loaded is None:
-        raise InputError("--endmembers scenario needs --scenario SCENARIO.yaml", field="--scenario")
-    data = read_reflectance_factors(measured, loaded, bin_s, progress)
+        if Path(measured).suffix.lower() not in (".nc", ".nc4", ".netcdf", ".h5"):
+            raise InputError(
+                "--endmembers scenario needs --scenario SCENARIO.yaml", field="--scenario"
+            )
+        with xr.open_dataset(measured, engine="h5netcdf") as head:
+            if "scenario_yaml" not in head.attrs:
+                raise InputError(
+                    "--endmembers scenario needs --scenario SCENARIO.yaml (the dataset does "
+                    "not carry the scenario it was simulated from)",
+                    field="--scenario",
+                )
+            loaded = dataset_scenario(head, str(measured))
+    data = read_reflectance_factors(measured, loaded, bin_s, progress, light)
     n_bands = len(data.bands.band_names)
     if extract is not None:
         assert n is not None
@@ -141,10 +170,10 @@ def unmix_measured(
         assert endmembers
         if endmembers == [SCENARIO_ENDMEMBERS]:
             assert loaded is not None
-            members = endmembers_from_scenario(loaded, data.bands)
+            members = endmembers_from_scenario(loaded, data.bands, data.source_W_m2_nm)
             origin = f"materials of scenario {loaded.source}"
         else:
-            members = endmembers_from_files(list(endmembers), data.bands)
+            members = endmembers_from_files(list(endmembers), data.bands, data.source_W_m2_nm)
             origin = "spectra " + ", ".join(str(p) for p in endmembers)
         _check_distinct(members)
         if len(members.names) > n_bands:
@@ -153,7 +182,8 @@ def unmix_measured(
                 f"contributions are not determined; give at most {n_bands}",
                 field="--endmembers",
             )
-    result = unmix(data.factor, members.signatures, method)  # type: ignore[arg-type]
+    sig = members.signatures if members.signatures_epoch is None else members.signatures_epoch
+    result = unmix_per_epoch(data.factor, sig, method)  # type: ignore[arg-type]
     ds = _dataset(data, members, result.abundance, result.residual, method, extract, origin)
     if data.material_contribution is not None and data.material_names is not None:
         ds = compare_with_truth(ds, data, members, result.abundance, by_name=extract is None)
@@ -215,8 +245,9 @@ def _dataset(
         members.signatures,
         {
             "units": unit_s,
-            "long_name": "band signature of each endmember (photon-weighted band "
-            "average of its spectrum, or the extracted reflectance factors)",
+            "long_name": "band signature of each endmember (band average of its spectrum "
+            "weighted by the detected photons of the mean source spectrum, or the extracted "
+            "reflectance factors)",
         },
     )
     ds["reflectance_factor"] = (
@@ -248,6 +279,7 @@ def _dataset(
             "title": "speclight unmix: endmember contributions per epoch",
             "method": method,
             "source": data.source,
+            "light": data.light,
             "endmembers": origin,
             "speclight_version": __version__,
             "history": f"{datetime.now(UTC).isoformat(timespec='seconds')} speclight unmix",

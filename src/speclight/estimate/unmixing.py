@@ -236,13 +236,18 @@ def unmix(x: ArrayLike, signatures: ArrayLike, method: UnmixMethod = "fcls") -> 
         a = _enumerated(xg, s, sum_to_one=method == "fcls")
     else:
         a = _per_row(xg, s, sum_to_one=method == "fcls")
-    r = _residual_norm(xg, a, s)
+    return result_rows(a, _residual_norm(xg, a, s), good, method)
+
+
+def result_rows(a: F64, residual: F64, good: NDArray[np.bool_], method: str) -> UnmixResult:
+    """The result of the ``good`` rows' contributions ``a`` and residuals (NaN elsewhere),
+    normalised to sum to one for ``nnls-norm``."""
     if method == "nnls-norm":
         total = a.sum(axis=1, keepdims=True)
         with np.errstate(invalid="ignore", divide="ignore"):
             a = np.where(total > 0.0, a / total, np.nan)
-    abundance = np.full((xs.shape[0], s.shape[0]), np.nan)
-    residual = np.full(xs.shape[0], np.nan)
+    abundance = np.full((good.size, a.shape[1]), np.nan)
+    res = np.full(good.size, np.nan)
     abundance[good] = a
-    residual[good] = r
-    return UnmixResult(abundance=abundance, residual=residual, method=method)
+    res[good] = residual
+    return UnmixResult(abundance=abundance, residual=res, method=method)

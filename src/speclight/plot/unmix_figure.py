@@ -3,8 +3,9 @@
 Panels: the contributions per endmember against time; the endmember signatures per band
 (at the bands' photon-weighted centres; extracted signatures, which are reflectance
 factors, divided by their band mean, beside the ground-truth signatures when the input had
-them). With ground truth, also the true and estimated signal shares against time and the
-confusion matrix of the dominant material (the reference paper's Figure 13).
+them: the reference paper's Figure 14). With ground truth, also the true and estimated
+fractions of the contributions against time and the confusion matrix of the dominant
+material (the reference paper's Figure 13).
 """
 
 from __future__ import annotations
@@ -61,9 +62,9 @@ def signature_panel(ds: xr.Dataset, ax: Any) -> None:
             label += f" ~ {ds['endmember_material'].values[k]}"
             label += f" ({float(ds['endmember_angle'].values[k]):.1f} deg)"
         ax.plot(x[order], s[k, order], "o-", color=c, ms=4, lw=1.2, label=label)
-    if extracted and "material_signature" in ds:
-        for m, name in enumerate(ds["material"].values):
-            sig = ds["material_signature"].values[m]
+    if extracted and "true_signature" in ds:
+        for m, name in enumerate(ds["class"].values):
+            sig = ds["true_signature"].transpose("class", "band").values[m]
             ax.plot(x[order], sig[order], "--", color="0.4", lw=1.0)
             ax.annotate(
                 str(name),
@@ -83,7 +84,7 @@ def signature_panel(ds: xr.Dataset, ax: Any) -> None:
 
 
 def share_panel(ds: xr.Dataset, ax: Any) -> None:
-    """True (solid) and estimated (dots) signal shares of each class against time."""
+    """True (solid) and estimated (dots) fractions of each class against time."""
     t = ds["time"].values
     true = ds["true_share"].transpose("time", "class").values
     est = ds["estimated_share"].transpose("time", "class").values
@@ -91,7 +92,7 @@ def share_panel(ds: xr.Dataset, ax: Any) -> None:
         ax.plot(t, true[:, c], "-", color=col, lw=1.4, label=f"{name}")
         ax.plot(t, est[:, c], ".", color=col, ms=2.5)
     ax.plot([], [], ".", color="0.3", label="estimated (dots)")
-    ax.set_ylabel("share of the signal [1]")
+    ax.set_ylabel("fraction of the contributions [1]")
     ax.set_xlabel("time (UTC)")
     err = ds.attrs.get("mean_absolute_share_error", float("nan"))
     ax.set_title(
@@ -105,11 +106,14 @@ def share_panel(ds: xr.Dataset, ax: Any) -> None:
 def confusion_panel(ds: xr.Dataset, ax: Any) -> None:
     """Row-normalised confusion matrix of the dominant class (paper Figure 13)."""
     cm = ds["confusion_matrix"].values
+    count = ds["confusion_count"].values if "confusion_count" in ds else None
     names = [str(c) for c in ds["class"].values]
     ax.imshow(np.nan_to_num(cm, nan=0.0), cmap="Blues", vmin=0.0, vmax=1.0)
     for i in range(cm.shape[0]):
         for j in range(cm.shape[1]):
             text = "-" if not np.isfinite(cm[i, j]) else f"{cm[i, j]:.2f}"
+            if count is not None and np.isfinite(cm[i, j]):
+                text += f"\n({count[i, j]})"
             dark = np.isfinite(cm[i, j]) and cm[i, j] > 0.6
             ax.text(
                 j,

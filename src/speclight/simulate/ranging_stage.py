@@ -92,7 +92,9 @@ class RangingSetup:
         return call
 
 
-def _line_shape(loaded: LoadedScenario, cfg: Any, wl: F64, where: str) -> F64:
+def line_shape_per_nm(loaded: LoadedScenario, cfg: Any, wl: F64, where: str) -> F64:
+    """A laser's unit-area line shape on the grid [nm-1] (its spectrum file or a Gaussian);
+    the support the pipeline keeps is where it exceeds ``SUPPORT_THRESHOLD`` x its peak."""
     if cfg.spectrum_file:
         x, y = lz.read_laser_spectrum(loaded.resolve(cfg.spectrum_file))
         shape = lz.table_line_per_nm(wl, x, y)
@@ -123,7 +125,7 @@ def _laser(loaded: LoadedScenario, geo: Geometry, wl: F64, k: int, t: Any) -> La
         up = geo.orbit_ok & (tx.elevation_deg > min_el)
     offset = cfg.pointing_offset_arcsec * lz.ARCSEC_RAD
     beam = lz.beam_irradiance_W_m2(power, theta, tx.range_m, offset, cfg.beam_profile)
-    shape = _line_shape(loaded, cfg, wl, where)
+    shape = line_shape_per_nm(loaded, cfg, wl, where)
     support = np.flatnonzero(shape > SUPPORT_THRESHOLD * shape.max())
     elev = np.where(up, tx.elevation_deg, np.nan)
     t_up = np.zeros((len(elev), support.size))
