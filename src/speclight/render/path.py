@@ -1,17 +1,18 @@
 """Path-traced render: multi-bounce Monte Carlo with Mitsuba 3's spectral ``path`` integrator.
 
-The scene (:mod:`.path_scene`) is built once per run: the target's parts and BSDFs, a Sun of
-unit spectral irradiance and an orthographic sensor along the line of sight, whose
-``specfilm`` has one box response per wavelength bin. Per epoch only the Sun's and the
-sensor's transforms change (:func:`.path_scene.set_epoch`; no scene rebuild, and the kernel
-is reused: Dr.Jit's cache hits). Each pixel of channel k holds the radiance integrated over
-bin k; dividing by the bin width gives the bin-averaged radiance, which is scaled by the
-epoch's solar spectrum (bin averages) afterwards.
+The scene (:mod:`.path_scene`) is built once per run: the target's parts and BSDFs and a
+Sun of unit spectral irradiance. Per epoch only the Sun and the rays change
+(:func:`.path_scene.set_epoch`: no scene rebuild, and the kernel is reused). The rays are
+those of an orthographic view along the line of sight (the single mode's pixels); each
+sample's radiance is added to the wavelength bins, giving per pixel the radiance integrated
+over each bin; dividing by the bin width gives the bin-averaged radiance, which is scaled
+by the epoch's solar spectrum (bin averages) afterwards.
 
 The sample budget is split in ``K`` passes with independent samples; their spread gives the
-standard error of the mean per bin. The passes of an epoch are the ``K`` views of one batch
-sensor, rendered in one launch (one ``mi.render`` per epoch, whatever the materials: plastic
-coats are the spectral BSDF of :mod:`.path_coat`). Measured lab BRDF tables are not
+standard error of the mean per bin. All passes of an epoch are sampled in one launch of
+Mitsuba's path integrator over rays and wavelengths drawn here (:mod:`.path_sampling`: the
+radiance of each sample goes to its bins, without a film), whatever the materials: plastic
+coats are the spectral BSDF of :mod:`.path_coat`. Measured lab BRDF tables are not
 available in this mode; RGL ``.bsdf`` measured materials use Mitsuba's ``measured`` plugin
 (:mod:`.rgl`). A smooth mirror (``specular``, smooth plastic coat) lit by the directional
 (point) Sun reflects no light toward a given observer (a delta BSDF meets a delta light);
@@ -33,6 +34,7 @@ from numpy.typing import NDArray
 
 from speclight.render.camera import image_axes, primary_rays
 from speclight.render.path_plastic import group_bases, index_groups
+from speclight.render.path_sampling import PassSampler
 from speclight.render.path_scene import build_scene, set_epoch
 from speclight.render.raycast import Caster
 from speclight.render.result import RenderImage
@@ -99,16 +101,15 @@ def render_path(
             on_epoch,
         )
     else:
-        scene, params = build_scene(target, lo, hi, res, spp, solar_disk, passes=passes)
-        sensor = next(s for s in scene.sensors() if s.id() == "sensor")
+        scene, params = build_scene(target, lo, hi, res, spp, solar_disk, groups=[])
+        centre, _ = target.bounding_sphere()
+        sampler = PassSampler(mi, scene, centre, radius, lo, hi, res, spp, passes)
         for e in range(n_ep):
-            set_epoch(mi, params, target, sun_dir[e], obs_dir[e], solar_disk, "sensor")
-            s = (seed * 1_000_003 + e * MAX_PASSES) % (2**32)
-            img = np.asarray(mi.render(scene, sensor=sensor, seed=s, spp=spp), dtype=float)
-            views = img.reshape(res, passes, res, n_wl)  # the batch film: views side by side
-            sums[e] = views.sum(axis=(0, 2)) * pixel_area / width
-            if e in acc:
-                acc[e] += views.sum(axis=1)
+            set_epoch(mi, params, target, sun_dir[e], obs_dir[e], solar_disk)
+            s, img = sampler.epoch(obs_dir[e], seed, e, image=e in acc)
+            sums[e] = s / spp * pixel_area / width
+            if img is not None:
+                acc[e] += img / spp
             if on_epoch is not None:
                 on_epoch(1)
     mean = sums.mean(axis=1) * irradiance

@@ -10,9 +10,8 @@ previous model, kept as a reference); RGL measured materials through Mitsuba's
 ``measured`` plugin. The Sun is a ``directional`` emitter of unit spectral irradiance or,
 with ``solar_disk``, a far sphere emitter subtending the solar disk. The sensor is
 orthographic along the line of sight, its ``specfilm`` holding one box response per
-wavelength bin; with ``passes`` it is a ``batch`` sensor of that many identical orthographic
-views side by side on one film, so that all passes of an epoch render in one launch with
-independent samples.
+wavelength bin (the grouped reference and benchmarks render through it; path mode itself
+samples its own rays, :mod:`.path_sampling`).
 
 Reference: Jakob et al., Mitsuba 3 renderer, https://mitsuba-renderer.org (2022).
 """
@@ -190,14 +189,13 @@ def build_scene(
     spp: int,
     solar_disk: bool = False,
     groups: list[tuple[int, int]] | None = None,
-    passes: int | None = None,
     coat: str = "spectral",
 ) -> tuple[Any, Any]:
     """Mitsuba scene and its parameters (:func:`set_epoch` updates them per epoch).
 
-    With ``passes``: one ``batch`` sensor ``sensor`` of ``passes`` orthographic views side by
-    side, all bins on its film. Otherwise one orthographic sensor ``sensor{j}`` per group of
-    bins (``groups``: (first, end) bin indices; all bins in one group by default).
+    One orthographic sensor ``sensor{j}`` per group of bins (``groups``: (first, end) bin
+    indices; all bins in one group by default; none for ``[]``: path mode samples its own
+    rays, :mod:`.path_sampling`).
     ``coat``: ``'spectral'`` or ``'grouped'`` plastic materials (module docstring).
     """
     import mitsuba as mi
@@ -209,22 +207,7 @@ def build_scene(
         "sun": _sun(lo, hi, solar_disk),
     }
     sampler = {"type": "independent", "sample_count": spp}
-    if passes is not None:
-        n = len(edges_lo)
-        batch: dict[str, Any] = {
-            "type": "batch",
-            "film": _film(edges_lo, edges_hi, passes * resolution_px, resolution_px, range(n)),
-            "sampler": sampler,
-        }
-        for k in range(passes):
-            # each view's own film sets its wavelength sampling (the film's bands)
-            batch[f"view{k}"] = {
-                "type": "orthographic",
-                "to_world": mi.ScalarTransform4f(),
-                "film": _film(edges_lo, edges_hi, resolution_px, resolution_px, range(n)),
-            }
-        scene["sensor"] = batch
-    for j, (a, b) in enumerate(groups or ([] if passes else [(0, len(edges_lo))])):
+    for j, (a, b) in enumerate([(0, len(edges_lo))] if groups is None else groups):
         scene[f"sensor{j}"] = {
             "type": "orthographic",
             "to_world": mi.ScalarTransform4f(),
@@ -266,13 +249,19 @@ def build_scene(
 
 
 def set_epoch(
-    mi: Any, params: Any, target: Target, sun: F64, obs: F64, solar_disk: bool, sensor: str
+    mi: Any,
+    params: Any,
+    target: Target,
+    sun: F64,
+    obs: F64,
+    solar_disk: bool,
+    sensor: str | None = None,
 ) -> None:
-    """Point the Sun and the sensor ``sensor`` (a key prefix: every ``to_world`` under it, the
-    views of a batch sensor included) for one epoch, and update the scene."""
+    """Point the Sun and the sensor ``sensor`` (if given) for one epoch; update the scene."""
     sensor_tf, light_tf = _epoch_transforms(mi, target, sun, obs, solar_disk)
-    for key in _sensor_keys(params, sensor):
-        params[key] = sensor_tf
+    if sensor is not None:
+        for key in _sensor_keys(params, sensor):
+            params[key] = sensor_tf
     params["sun.to_world"] = light_tf
     params.update()
 
