@@ -72,6 +72,9 @@ def main() -> None:
     ap.add_argument("--epochs", type=int, default=60, help="epochs timed (of the 600)")
     ap.add_argument("--px", type=int, default=128)
     ap.add_argument("--spp", type=int, default=16)
+    ap.add_argument(
+        "--model", action="store_true", help="also time 16/64/256 spp (the time estimate's model)"
+    )
     args = ap.parse_args()
     loaded = parse_scenario(example_text("box-wing"))
     geo = scenario_geometry(loaded)
@@ -125,6 +128,23 @@ def main() -> None:
         f"speclight coated / bare: {per['speclight, coated'] / bare_s:.2f}; "
         f"speclight uncoated / bare: {per['speclight, uncoated'] / bare_s:.2f}"
     )
+
+    if args.model:
+        _model(coated, sun, obs, wl, args.px)
+
+
+def _model(target: Target, sun: Any, obs: Any, wl: Any, px: int) -> None:
+    """Seconds per epoch against spp: the fixed and per-sample costs of the time estimate."""
+    n = min(10, len(sun))
+    e = np.ones((n, len(wl)))
+    print(f"time per epoch against spp ({n} epochs, coated, {px} px):")
+    for spp in (16, 64, 256):
+        kw = dict(mode="path", resolution_px=px, samples_per_pixel=spp, seed=2)
+        render_intensity(target, sun[:1], obs[:1], e[:1], wl, **kw)
+        t0 = time.perf_counter()
+        render_intensity(target, sun[:n], obs[:n], e, wl, **kw)
+        dt = (time.perf_counter() - t0) / n
+        print(f"  {spp:4d} spp: {dt:.3f} s/epoch, {px * px * spp / dt:.3g} samples/s")
 
 
 if __name__ == "__main__":

@@ -84,6 +84,7 @@ def render_path(
     pixel_area = (2.0 * radius / resolution_px) ** 2
     n_ep, n_wl, res = len(sun_dir), len(wavelength_nm), resolution_px
     sums = np.zeros((n_ep, passes, n_wl))
+    # kept epochs' images, summed over passes (float64, filled as they are rendered)
     acc = {e: np.zeros((res, res, n_wl)) for e in set(keep)}
     if coat == "grouped":
         _render_grouped(
@@ -109,7 +110,7 @@ def render_path(
             s, img = sampler.epoch(obs_dir[e], seed, e, image=e in acc)
             sums[e] = s / spp * pixel_area / width
             if img is not None:
-                acc[e] += img / spp
+                acc[e] = img / spp
             if on_epoch is not None:
                 on_epoch(1)
     mean = sums.mean(axis=1) * irradiance

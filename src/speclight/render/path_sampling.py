@@ -92,15 +92,15 @@ class PassSampler:
         obs = np.asarray(obs, float)
         total = self.passes * self.res * self.res * self.spp
         sums = np.zeros(self.passes * self.n_bins)
-        pixels = np.zeros(self.res * self.res * self.n_bins) if image else None
+        pixels: F64 | None = None  # the first launch's array, then added to
         right, up = image_axes(obs[None, :])
         frame = (self.centre + 2.0 * self.radius * obs, right[0], up[0], -obs)
         for c, start in enumerate(range(0, total, MAX_LANES)):
             n = min(MAX_LANES, total - start)
             s, px = self._launch(frame, launch_seed(seed, epoch, c), start, n, image)
             sums += s
-            if pixels is not None and px is not None:
-                pixels += px
+            if px is not None:
+                pixels = px if pixels is None else pixels + px
         out = sums.reshape(self.passes, self.n_bins)
         img = None if pixels is None else pixels.reshape(self.res, self.res, self.n_bins)
         return out, img

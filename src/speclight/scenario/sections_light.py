@@ -360,9 +360,13 @@ class Spectrum(Strict):
 #: 5 nm bin and epoch at 16 spp (BENCHMARKS.md, "Rendering"), to 0.064 % at 65536, below any
 #: measurement's precision; more only costs time.
 MAX_SAMPLES_PER_PIXEL = 65_536
-#: Path-mode samples traced per second (box-wing, ``llvm_ad_spectral``, 128 px, 2 cores:
-#: BENCHMARKS.md "Rendering", 64 -> 256 spp adds 3.1e6 samples in 1.2 s per epoch).
-PATH_SAMPLES_PER_S = 2.5e6
+#: Path-mode samples traced per second (box-wing, coated, ``llvm_ad_spectral``, 128 px,
+#: 2 cores: BENCHMARKS.md "Path mode", 64 -> 256 spp adds 3.1e6 samples in 0.26 s per epoch,
+#: 1.2e7 samples/s, under load from other processes; rounded down).
+PATH_SAMPLES_PER_S = 1.0e7
+#: Fixed path-mode cost per epoch [s] (the Sun's update, one launch, the bin sums: the same
+#: measurement, extrapolated to 0 spp).
+PATH_SECONDS_PER_EPOCH = 0.02
 
 
 class Render(Strict):
@@ -378,7 +382,8 @@ class Render(Strict):
     @model_validator(mode="after")
     def _samples(self) -> Render:
         if self.samples_per_pixel > MAX_SAMPLES_PER_PIXEL:
-            per_epoch_s = self.resolution_px**2 * self.samples_per_pixel / PATH_SAMPLES_PER_S
+            samples = self.resolution_px**2 * self.samples_per_pixel
+            per_epoch_s = PATH_SECONDS_PER_EPOCH + samples / PATH_SAMPLES_PER_S
             raise ValueError(
                 f"samples_per_pixel = {self.samples_per_pixel} would take about "
                 f"{per_epoch_s:.3g} s per epoch at {self.resolution_px} px "
