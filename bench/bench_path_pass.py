@@ -142,9 +142,14 @@ def _model(target: Target, sun: Any, obs: Any, wl: Any, px: int) -> None:
         kw = dict(mode="path", resolution_px=px, samples_per_pixel=spp, seed=2)
         render_intensity(target, sun[:1], obs[:1], e[:1], wl, **kw)
         t0 = time.perf_counter()
-        render_intensity(target, sun[:n], obs[:n], e, wl, **kw)
+        r = render_intensity(target, sun[:n], obs[:n], e, wl, **kw)
         dt = (time.perf_counter() - t0) / n
-        print(f"  {spp:4d} spp: {dt:.3f} s/epoch, {px * px * spp / dt:.3g} samples/s")
+        i, err = r.intensity_W_sr_nm, r.intensity_std_W_sr_nm
+        noise = float(np.median(err[i > 0] / i[i > 0]))
+        print(
+            f"  {spp:4d} spp: {dt:.3f} s/epoch, {px * px * spp / dt:.3g} samples/s, "
+            f"median noise per 5 nm bin and epoch {100 * noise:.1f} %"
+        )
 
 
 if __name__ == "__main__":

@@ -72,7 +72,9 @@ def render_path(
     (directional) Sun, so that smooth mirrors and smooth plastic coats show their glint.
     ``coat``: ``'spectral'`` (plastic coats as :mod:`.path_coat`, one launch per epoch) or
     ``'grouped'`` (the previous model: Mitsuba's plastic with one coat index per group of
-    bins, one launch per group, epoch and pass; kept as a reference for the tests).
+    bins, one ``mi.render`` per group, epoch and pass; kept as a reference for the tests).
+    Scalar variants (no Dr.Jit kernels to trace a Python BSDF or a sample loop into) always
+    render the grouped way.
     """
     mi = session.activate()  # a *_spectral variant (RenderSession.create checks it)
     # A single wavelength is rendered as a 1 nm wide bin around it.
@@ -86,7 +88,9 @@ def render_path(
     sums = np.zeros((n_ep, passes, n_wl))
     # kept epochs' images, summed over passes (float64, filled as they are rendered)
     acc = {e: np.zeros((res, res, n_wl)) for e in set(keep)}
-    if coat == "grouped":
+    import drjit as dr
+
+    if coat == "grouped" or not dr.is_jit_v(mi.Float):  # scalar variants: the film loop
         _render_grouped(
             mi,
             target,
