@@ -135,7 +135,7 @@ def main() -> None:
 
 def _model(target: Target, sun: Any, obs: Any, wl: Any, px: int) -> None:
     """Seconds per epoch against spp: the fixed and per-sample costs of the time estimate."""
-    n = min(10, len(sun))
+    n = min(36, len(sun))  # >= FREEZE_MIN_LAUNCHES: frozen, as in a long run
     e = np.ones((n, len(wl)))
     print(f"time per epoch against spp ({n} epochs, coated, {px} px):")
     for spp in (16, 64, 256):

@@ -34,7 +34,7 @@ from numpy.typing import NDArray
 
 from speclight.render.camera import image_axes, primary_rays
 from speclight.render.path_plastic import group_bases, index_groups
-from speclight.render.path_sampling import PassSampler
+from speclight.render.path_sampling import FREEZE_MIN_LAUNCHES, PassSampler, launch_count
 from speclight.render.path_scene import build_scene, set_epoch
 from speclight.render.raycast import Caster
 from speclight.render.result import RenderImage
@@ -108,7 +108,8 @@ def render_path(
     else:
         scene, params = build_scene(target, lo, hi, res, spp, solar_disk, groups=[])
         centre, _ = target.bounding_sphere()
-        sampler = PassSampler(mi, scene, centre, radius, lo, hi, res, spp, passes)
+        freeze = launch_count(passes, res, spp, n_ep) >= FREEZE_MIN_LAUNCHES
+        sampler = PassSampler(mi, scene, centre, radius, lo, hi, res, spp, passes, freeze)
         for e in range(n_ep):
             set_epoch(mi, params, target, sun_dir[e], obs_dir[e], solar_disk)
             s, img = sampler.epoch(obs_dir[e], seed, e, image=e in acc)
@@ -117,6 +118,7 @@ def render_path(
                 acc[e] = img / spp
             if on_epoch is not None:
                 on_epoch(1)
+        sampler.close()
     mean = sums.mean(axis=1) * irradiance
     if passes > 1:
         err = sums.std(axis=1, ddof=1) / np.sqrt(passes) * irradiance
