@@ -316,11 +316,12 @@ def test_epochs_split_over_launches_agree_with_one_launch(monkeypatch):
     np.testing.assert_allclose(total, b.intensity_W_sr_nm[1], rtol=1e-9)
 
 
-def test_frozen_launches_equal_traced_launches(monkeypatch):
+@pytest.mark.parametrize("solar_disk", [False, True], ids=["point-sun", "solar-disk"])
+def test_frozen_launches_equal_traced_launches(monkeypatch, solar_disk):
     # The launch is frozen (dr.freeze: recorded on the first epoch, replayed with each
     # epoch's Sun, rays and seed). Replays must give what tracing every launch gives, bit for
     # bit, over epochs with different Suns and over launches of different widths (an epoch
-    # split in 2.4 launches).
+    # split in 2.4 launches), with the Sun a directional emitter or a far sphere.
     import drjit as dr
 
     import speclight.render.path as path
@@ -333,7 +334,14 @@ def test_frozen_launches_equal_traced_launches(monkeypatch):
     sun, obs = np.concatenate([sun, sun[::-1], sun]), np.concatenate([obs, obs, obs[::-1]])
     wl = np.arange(400.0, 801.0, 50.0)
     e = np.ones((len(sun), len(wl)))
-    kw = dict(mode="path", resolution_px=16, samples_per_pixel=16, seed=9, keep_images_for=[2])
+    kw = dict(
+        mode="path",
+        resolution_px=16,
+        samples_per_pixel=16,
+        seed=9,
+        keep_images_for=[2],
+        solar_disk=solar_disk,  # the Sun a sphere moved between epochs (the scene updated)
+    )
     monkeypatch.setattr(sampling, "MAX_LANES", 16 * 16 * 16 * 5 // 12)
     monkeypatch.setattr(path, "FREEZE_MIN_LAUNCHES", 1)  # frozen however short the run
     frozen = render_intensity(target, sun, obs, e, wl, **kw)
