@@ -140,7 +140,9 @@ class PassSampler:
 
         mi = self.mi
         origin, right, up, direction = (dr.opaque(mi.Vector3f, v.tolist()) for v in frame)
-        first = dr.opaque(mi.UInt32, start)
+        # 64-bit lane numbers: an epoch may have more than 2^32 samples (4096 px x 256 spp)
+        uint64: Any = dr.uint64_array_t(mi.UInt32)
+        first = dr.opaque(uint64, start)
         # n, image: Python values (a change re-traces a frozen launch)
         args: tuple[Any, ...] = (
             self.scene,
@@ -202,8 +204,10 @@ class PassSampler:
 
         mi, res, spp, nb = self.mi, self.res, self.spp, self.n_bins
         self.sampler.seed(seed, n)
-        idx = dr.arange(mi.UInt32, n) + first  # lanes first .. first + n - 1 of the epoch
-        pix = (idx // spp) % (res * res)
+        # lanes first .. first + n - 1 of the epoch (pass-major, then pixel, then sample)
+        uint64: Any = dr.uint64_array_t(mi.UInt32)
+        idx = uint64(dr.arange(mi.UInt32, n)) + first
+        pix = mi.UInt32((idx // spp) % (res * res))
         row, col = pix // res, pix % res
         u = self.sampler.next_2d()
         x = ((mi.Float(col) + u.x) * (2.0 / res) - 1.0) * self.radius
@@ -217,7 +221,7 @@ class PassSampler:
         radiance, _, _ = self.integrator.sample(
             scene, self.sampler, mi.RayDifferential3f(ray), None, True
         )
-        pas = idx // (res * res * spp)
+        pas = mi.UInt32(idx // (res * res * spp))
         keys, pixel_keys, values = [], [], []
         for j in range(n_wl):
             wl_j = lam[j]
