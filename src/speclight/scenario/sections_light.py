@@ -27,9 +27,9 @@ ConductorName = Literal["Al", "Ag", "Au"]
 DielectricName = Literal["SiO2", "Si", "GaAs", "Kapton"]
 BuiltinShape = Literal["sphere", "plate", "cube", "cylinder", "box_wing"]
 
-#: Largest ``render.seed``: Mitsuba's sampler seed is a 32-bit unsigned integer
-#: (``mi.render(seed=...)`` takes a ``UInt32``; :mod:`speclight.render.path` reduces its
-#: per-pass seeds modulo 2**32), so a larger seed would repeat the images of a smaller one.
+#: Largest ``render.seed``: Mitsuba's sampler seed is a 32-bit unsigned integer (path mode
+#: hashes the run's seed, the epoch and the launch into one, :mod:`speclight.render.path_sampling`;
+#: the grouped reference reduces its per-pass seeds modulo 2**32).
 MAX_RENDER_SEED = 2**32 - 1
 #: Largest ``instrument.noise.seed``: numpy's ``SeedSequence`` takes any integer >= 0, the
 #: NetCDF writer (h5netcdf) stores integer attributes up to uint64; 2**64 failed at write time.
