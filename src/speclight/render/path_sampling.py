@@ -107,8 +107,9 @@ class PassSampler:
 
         # Frozen (Dr.Jit >= 1.1): the launch is traced once and replayed per epoch. Earlier
         # runs' garbage is collected now, before any recording (see _launch).
-        gc.collect()
         self._frozen = dr.freeze(self._trace) if freeze and hasattr(dr, "freeze") else None
+        if self._frozen is not None:
+            gc.collect()
 
     def close(self) -> None:
         """Drop the frozen launch (its recordings, and the cycle through ``self``)."""
