@@ -65,7 +65,7 @@ def _spectral_variant() -> str | None:
 
 @pytest.mark.skipif(_spectral_variant() is None, reason="no Mitsuba spectral variant")
 def test_dihedral_interreflection_matches_mitsuba_path_tracer(monkeypatch):
-    import speclight.render.path as path_mode
+    import speclight.render.path_scene as path_mode
 
     target, obs, res = _dihedral(), _view(), 48
     mitsuba = {}

@@ -160,9 +160,9 @@ def test_white_concave_target_returns_all_intercepted_light_in_path_mode():
 def test_path_smooth_plastic_plate_diffuse_base():
     # Off the glint a smooth-coated plastic plate shows its base:
     # I = rho_d (1 - F_i)(1 - F_o) / (eta^2 pi (1 - F_dr,int)) E A cos(theta_i) cos(theta_o)
-    # (Weidlich & Wilkie 2007). Path mode gives Mitsuba a real coat index per group of
-    # wavelength bins (render/path_plastic.py); n of fused silica varies by 0.3 % over
-    # 500-700 nm, changing I by < 0.1 %.
+    # (Weidlich & Wilkie 2007). Path mode's coated BSDF takes the index at each sampled
+    # wavelength (render/path_coat.py); the reference below takes the mean index: n of
+    # fused silica varies by 0.3 % over 500-700 nm, changing I by < 0.1 %.
     from speclight.target import plate, refractive_index
 
     rho_d = 0.6
@@ -200,6 +200,6 @@ def test_path_smooth_plastic_plate_diffuse_base():
     f = rho_d * (1 - fresnel(np.cos(ti), eta)) * (1 - fresnel(np.cos(to), eta))
     ref = f / (eta**2 * np.pi * (1 - f_dr)) * np.cos(ti) * np.cos(to)
     sigma = np.sqrt((res.intensity_std_W_sr_nm**2).sum(axis=1)) / len(wl)
-    # Mitsuba's F_dr,int is a polynomial fit (d'Eon & Irving 2011), good to ~1e-3 of I.
+    # The mean index of the reference: I within 1e-3 (above).
     fit_error = 1e-3 * ref
     assert np.all(np.abs(res.intensity_W_sr_nm.mean(axis=1) - ref) < Z_MAX * sigma + fit_error)

@@ -83,13 +83,23 @@ def test_billion_wavelength_bins_are_refused_before_any_work() -> None:
 
 
 def test_day_long_path_render_is_refused_with_its_estimate() -> None:
-    # 256 px x 65536 spp x 481 epochs at 2.5e6 samples/s: about 230 h
+    # 256 px x 65536 spp x 481 epochs: 481 x (0.02 s + 256^2 x 65536 / 1e7 s) = 2.07e5 s,
+    # about 57.4 h (the model of speclight.simulate.memory.path_render_seconds)
     loaded = _loaded(render__mode="path", render__samples_per_pixel=65536)
     with pytest.raises(InputError) as err:
         simulate(loaded)
     msg = str(err.value)
     assert "render.samples_per_pixel: path mode at 256 px x 65536 spp x 481 epochs" in msg
-    assert "about 230 h" in msg and "at most 24 h per run" in msg
+    assert "about 57.4 h" in msg and "at most 24 h per run" in msg
+
+
+def test_path_render_note_states_the_up_front_estimate() -> None:
+    # 481 epochs x (0.02 s + 128^2 x 16 / 1e7 s) = 22.2 s; at 256 spp 481 x 0.439 s = 3.5 min
+    loaded = _loaded(render__mode="path", render__resolution_px=128)
+    note = memory.path_render_note(loaded.scenario, 481)
+    assert note == "path mode: 481 epochs x 128 px x 16 spp, about 22 s to render"
+    loaded = _loaded(render__mode="path", render__resolution_px=128, render__samples_per_pixel=256)
+    assert memory.path_render_note(loaded.scenario, 481).endswith("about 3.5 min to render")
 
 
 def test_million_spp_is_refused_at_load_with_its_estimate() -> None:
@@ -97,7 +107,8 @@ def test_million_spp_is_refused_at_load_with_its_estimate() -> None:
     with pytest.raises(InputError) as err:
         _loaded(render__mode="path", render__resolution_px=32, render__samples_per_pixel=10**6)
     msg = str(err.value)
-    assert "samples_per_pixel = 1000000 would take about 410 s per epoch at 32 px" in msg
+    # 0.02 s + 32^2 x 1e6 / 1e7 samples/s = 102 s per epoch
+    assert "samples_per_pixel = 1000000 would take about 102 s per epoch at 32 px" in msg
     assert "at most 65536" in msg
 
 

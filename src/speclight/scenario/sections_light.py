@@ -29,9 +29,9 @@ DielectricName = Literal["SiO2", "Si", "GaAs", "Kapton"]
 MaterialTableName = Literal["aluminium", "kapton_mli", "solar_cell", "white_paint"]
 BuiltinShape = Literal["sphere", "plate", "cube", "cylinder", "box_wing"]
 
-#: Largest ``render.seed``: Mitsuba's sampler seed is a 32-bit unsigned integer
-#: (``mi.render(seed=...)`` takes a ``UInt32``; :mod:`speclight.render.path` reduces its
-#: per-pass seeds modulo 2**32), so a larger seed would repeat the images of a smaller one.
+#: Largest ``render.seed``: Mitsuba's sampler seed is a 32-bit unsigned integer (path mode
+#: hashes the run's seed, the epoch and the launch into one, :mod:`speclight.render.path_sampling`;
+#: the grouped reference reduces its per-pass seeds modulo 2**32).
 MAX_RENDER_SEED = 2**32 - 1
 #: Largest ``instrument.noise.seed``: numpy's ``SeedSequence`` takes any integer >= 0, the
 #: NetCDF writer (h5netcdf) stores integer attributes up to uint64; 2**64 failed at write time.
@@ -370,9 +370,13 @@ class Spectrum(Strict):
 #: 5 nm bin and epoch at 16 spp (BENCHMARKS.md, "Rendering"), to 0.064 % at 65536, below any
 #: measurement's precision; more only costs time.
 MAX_SAMPLES_PER_PIXEL = 65_536
-#: Path-mode samples traced per second (box-wing, ``llvm_ad_spectral``, 128 px, 2 cores:
-#: BENCHMARKS.md "Rendering", 64 -> 256 spp adds 3.1e6 samples in 1.2 s per epoch).
-PATH_SAMPLES_PER_S = 2.5e6
+#: Path-mode samples traced per second (box-wing, coated, ``llvm_ad_spectral``, 128 px,
+#: 2 cores: BENCHMARKS.md "Path mode", 64 -> 256 spp adds 3.1e6 samples in 0.26 s per epoch,
+#: 1.2e7 samples/s, under load from other processes; rounded down).
+PATH_SAMPLES_PER_S = 1.0e7
+#: Fixed path-mode cost per epoch [s] (the Sun's update, one launch, the bin sums: the same
+#: measurement, extrapolated to 0 spp).
+PATH_SECONDS_PER_EPOCH = 0.02
 
 
 class Render(Strict):
@@ -398,7 +402,8 @@ class Render(Strict):
                 "come from single-scattering renders of each material alone"
             )
         if self.samples_per_pixel > MAX_SAMPLES_PER_PIXEL:
-            per_epoch_s = self.resolution_px**2 * self.samples_per_pixel / PATH_SAMPLES_PER_S
+            samples = self.resolution_px**2 * self.samples_per_pixel
+            per_epoch_s = PATH_SECONDS_PER_EPOCH + samples / PATH_SAMPLES_PER_S
             raise ValueError(
                 f"samples_per_pixel = {self.samples_per_pixel} would take about "
                 f"{per_epoch_s:.3g} s per epoch at {self.resolution_px} px "

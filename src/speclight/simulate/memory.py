@@ -40,7 +40,7 @@ from dataclasses import dataclass
 from speclight.errors import InputError
 from speclight.scenario import LoadedScenario
 from speclight.scenario.scenario_model import Scenario
-from speclight.scenario.sections_light import PATH_SAMPLES_PER_S
+from speclight.scenario.sections_light import PATH_SAMPLES_PER_S, PATH_SECONDS_PER_EPOCH
 
 MIB = 1024**2
 #: Peak of a run of a few epochs at small resolution, above the pixel term (measured).
@@ -152,9 +152,23 @@ def memory_limit_bytes() -> int:
 
 
 def path_render_seconds(scenario: Scenario, n_epochs: int) -> float:
-    """Estimated path-mode render time [s]: pixels x spp x epochs / :data:`PATH_SAMPLES_PER_S`."""
+    """Estimated path-mode render time [s]: per epoch :data:`PATH_SECONDS_PER_EPOCH` plus
+    pixels x spp / :data:`PATH_SAMPLES_PER_S` (measured on the box-wing, BENCHMARKS.md
+    "Path mode"; targets that fill more of the view, or bounce light more, take longer)."""
     render = scenario.render
-    return render.resolution_px**2 * render.samples_per_pixel * n_epochs / PATH_SAMPLES_PER_S
+    samples = render.resolution_px**2 * render.samples_per_pixel
+    return n_epochs * (PATH_SECONDS_PER_EPOCH + samples / PATH_SAMPLES_PER_S)
+
+
+def path_render_note(scenario: Scenario, n_epochs: int) -> str:
+    """The one-line up-front estimate shown before a path-mode render."""
+    r = scenario.render
+    seconds = path_render_seconds(scenario, n_epochs)
+    shown = f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.1f} min"
+    return (
+        f"path mode: {n_epochs} epochs x {r.resolution_px} px x {r.samples_per_pixel} spp, "
+        f"about {shown} to render"
+    )
 
 
 def _gib(n: float) -> str:
@@ -219,5 +233,6 @@ __all__ = [
     "estimate_memory",
     "grid_epochs",
     "memory_limit_bytes",
+    "path_render_note",
     "path_render_seconds",
 ]

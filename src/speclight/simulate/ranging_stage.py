@@ -42,7 +42,7 @@ from speclight.orbit.timescale import time_from_utc
 from speclight.ranging import link, transmitter_geometry
 from speclight.ranging.bins import RANGE_BINS, range_bin_edges_m
 from speclight.render.laser_returns import LaserLight, LaserReturnAccumulator
-from speclight.render.path import MAX_DEPTH as PATH_MAX_DEPTH
+from speclight.render.path_scene import MAX_DEPTH as PATH_MAX_DEPTH
 from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
 from speclight.simulate.geometry_stage import Geometry

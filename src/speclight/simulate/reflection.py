@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -156,6 +157,10 @@ def render_reflection(
         if session is None:
             session = RenderSession.create(sc.render.mode, sc.render.variant, target.materials)
         part_names = [part.name for part in target.parts]
+        if progress and sc.render.mode == "path":
+            from speclight.simulate.memory import path_render_note
+
+            print(path_render_note(sc, idx.size), file=sys.stderr)  # the bar follows
         result = render_intensity(
             target,
             geo.sun_direction_body[idx],
