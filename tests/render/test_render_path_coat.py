@@ -351,3 +351,36 @@ def test_frozen_launches_equal_traced_launches(monkeypatch, solar_disk):
     np.testing.assert_array_equal(
         frozen.images[2].radiance_W_m2_sr_nm, traced.images[2].radiance_W_m2_sr_nm
     )
+
+
+def test_freeze_env_zero_traces_every_launch(monkeypatch):
+    # SPECLIGHT_PATH_FREEZE=0 is the way around a Dr.Jit whose frozen functions fail: no
+    # launch may then be frozen, and the result is the traced one.
+    import drjit as dr
+
+    import speclight.render.path as path
+    import speclight.render.path_sampling as sampling
+
+    if not hasattr(dr, "freeze"):
+        pytest.skip("this Dr.Jit has no frozen functions")
+    calls = []
+    real = dr.freeze
+
+    def spy(f):  # type: ignore[no-untyped-def]
+        calls.append(f)
+        return real(f)
+
+    target = _coated_box_wing()
+    sun, obs = _box_wing_geometry()
+    wl = np.arange(400.0, 801.0, 100.0)
+    e = np.ones((len(sun), len(wl)))
+    kw = dict(mode="path", resolution_px=8, samples_per_pixel=4, seed=3)
+    monkeypatch.setattr(path, "FREEZE_MIN_LAUNCHES", 1)
+    monkeypatch.setattr(dr, "freeze", spy)
+    monkeypatch.setenv(sampling.FREEZE_ENV, "0")
+    off = render_intensity(target, sun, obs, e, wl, **kw)
+    assert calls == []
+    monkeypatch.delenv(sampling.FREEZE_ENV)
+    on = render_intensity(target, sun, obs, e, wl, **kw)
+    assert len(calls) == 1
+    np.testing.assert_array_equal(off.intensity_W_sr_nm, on.intensity_W_sr_nm)

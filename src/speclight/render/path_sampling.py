@@ -25,13 +25,15 @@ epoch (more only when an epoch has more than :data:`MAX_LANES` samples). The lau
 frozen function (``dr.freeze``, Dr.Jit >= 1.1): traced and recorded on the first epoch, then
 replayed with the new inputs, which halves an epoch's time (tracing Mitsuba's integrator and
 the Python BSDF took ~2/3 of it); where freezing is not available or fails, every launch is
-traced.
+traced. Setting the environment variable ``SPECLIGHT_PATH_FREEZE=0`` traces every launch
+(same results, about 2x slower per epoch): a way around a Dr.Jit whose frozen functions fail.
 """
 
 from __future__ import annotations
 
 import gc
 import hashlib
+import os
 from typing import Any
 
 import numpy as np
@@ -46,6 +48,8 @@ MAX_LANES = 1 << 21
 #: Fewest launches in a run for which the launch is frozen (break-even ~20, measured on the
 #: box-wing: recording ~0.5 s, each replay ~0.03 s faster than tracing).
 FREEZE_MIN_LAUNCHES = 32
+#: Environment variable: ``0`` turns frozen launches off (every launch traced).
+FREEZE_ENV = "SPECLIGHT_PATH_FREEZE"
 
 
 def launch_count(passes: int, resolution_px: int, spp: int, epochs: int) -> int:
@@ -107,7 +111,8 @@ class PassSampler:
 
         # Frozen (Dr.Jit >= 1.1): the launch is traced once and replayed per epoch. Earlier
         # runs' garbage is collected now, before any recording (see _launch).
-        self._frozen = dr.freeze(self._trace) if freeze and hasattr(dr, "freeze") else None
+        freeze = freeze and hasattr(dr, "freeze") and os.environ.get(FREEZE_ENV, "1") != "0"
+        self._frozen = dr.freeze(self._trace) if freeze else None
         if self._frozen is not None:
             gc.collect()
 
