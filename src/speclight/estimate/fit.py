@@ -1,0 +1,322 @@
+"""Fit of simulated to measured count rates: per-band scales and roughness (plain arrays).
+
+The model of the measured rate ``m[t, j]`` (epoch t, band j) is ``s_j * c[t, j](alpha)``: the
+simulated count rate ``c`` of the scenario, for the roughness values ``alpha`` of its rough
+materials, times a scale ``s_j`` on the target's reflectance in band j. Intensity is linear
+in the reflectance of a Lambertian or microfacet surface (see
+:func:`speclight.render.material_contributions`), so for fixed ``alpha`` the scales minimise
+
+.. math::
+
+    \\chi^2 = \\sum_{t, j} w_{tj} (m_{tj} - s_j c_{tj})^2, \\qquad w_{tj} = 1 / \\sigma_{tj}^2,
+
+in closed form (one weighted linear least-squares problem per band):
+``s_j = sum_t w m c / sum_t w c^2``. Only the roughness needs new simulations. It is fitted by
+variable projection (Golub & Pereyra 1973, doi:10.1137/0710036): bounded SLSQP
+(:func:`scipy.optimize.minimize`, Kraft 1988) minimises ``chi^2(alpha)`` with the scales
+solved in closed form at every ``alpha``; the gradient is a forward difference whose
+simulations are cached with the others (``model(alpha)`` is called once per distinct value).
+
+Uncertainties: the covariance of all fitted parameters is ``(J^T W J)^-1`` at the optimum (J
+the Jacobian of the model in the scales and roughness), multiplied by ``max(1, chi^2 / dof)``:
+when the residuals exceed the measurement sigmas (sigmas that leave out sky and read noise,
+or a model that is not exact, e.g. a rendered target), the spread of the residuals, not the
+sigmas, measures how well the data pin the parameters (as ``scipy.optimize.curve_fit`` does
+with ``absolute_sigma=False``); it is never scaled down.
+
+Missing sigmas: the shot noise of the measured rate,
+``sigma = sqrt(max(m, floor) / (t_exp n))`` for ``n`` exposures of ``t_exp`` seconds averaged,
+with ``floor`` one detected electron per averaged exposure time (``1 / (t_exp n)``) so that
+faint or negative (background-subtracted) rates do not get near-infinite weights.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import minimize
+
+F64 = NDArray[np.float64]
+
+#: Forward-difference step of the roughness gradient and Jacobian [1] (microfacet alpha).
+ROUGHNESS_STEP = 2e-3
+#: Roughness values are rounded to this before simulating (the cache key) [1].
+ROUGHNESS_RESOLUTION = 1e-5
+
+
+def shot_noise_sigma(rate_per_s: F64, exposure_s: float, n_samples: NDArray | int = 1) -> F64:
+    """Shot-noise standard deviation of measured rates [s-1] (module doc: the floor).
+
+    Parameters
+    ----------
+    rate_per_s
+        (N, B) measured rates [s-1].
+    exposure_s
+        Exposure time of one measurement [s].
+    n_samples
+        (N,) number of measurements averaged into each rate (1 unless binned).
+    """
+    r = np.asarray(rate_per_s, dtype=float)
+    t = float(exposure_s) * np.asarray(n_samples, dtype=float)
+    if r.ndim == 2 and t.ndim == 1:
+        t = t[:, None]
+    t = np.broadcast_to(t, r.shape)
+    electrons = np.maximum(np.where(np.isfinite(r), r, np.nan) * t, 1.0)
+    return np.asarray(np.sqrt(electrons) / t, dtype=np.float64)
+
+
+@dataclass
+class ScaleFit:
+    """Closed-form weighted least-squares scales, one per band.
+
+    Attributes
+    ----------
+    scale, scale_std
+        (B,) the scales and their standard deviations (NaN where a band is unconstrained).
+    chi2
+        (B,) weighted sum of squared residuals per band.
+    n_used
+        (B,) epochs used per band.
+    """
+
+    scale: F64
+    scale_std: F64
+    chi2: F64
+    n_used: NDArray[np.int64]
+
+
+def fit_scales(model: F64, measured: F64, sigma: F64) -> ScaleFit:
+    """Per-band scales ``s_j`` minimising ``sum_t (m - s_j c)^2 / sigma^2`` (module doc).
+
+    Entries where any of the three is not finite, or sigma <= 0, are skipped. The standard
+    deviation is ``sqrt(1 / sum_t w c^2)`` times ``sqrt(max(1, chi2_j / (n_j - 1)))``.
+
+    Parameters
+    ----------
+    model, measured, sigma
+        (N, B) simulated rates ``c``, measured rates ``m`` and their sigmas [s-1].
+    """
+    w, c, m = _weights(model, measured, sigma)
+    wcc = np.sum(w * c * c, axis=0)
+    wmc = np.sum(w * m * c, axis=0)
+    n_used = np.sum(w > 0, axis=0).astype(np.int64)
+    ok = (wcc > 0) & (n_used > 0)
+    scale = np.where(ok, wmc / np.where(ok, wcc, 1.0), np.nan)
+    chi2 = np.sum(w * (m - np.where(ok, scale, 0.0) * c) ** 2, axis=0)
+    dof = np.maximum(n_used - 1, 1)
+    inflate = np.maximum(1.0, chi2 / dof)
+    std = np.where(ok, np.sqrt(inflate / np.where(ok, wcc, 1.0)), np.nan)
+    return ScaleFit(scale, std, chi2, n_used)
+
+
+def _weights(model: F64, measured: F64, sigma: F64) -> tuple[F64, F64, F64]:
+    c = np.asarray(model, dtype=float)
+    m = np.asarray(measured, dtype=float)
+    s = np.asarray(sigma, dtype=float)
+    good = np.isfinite(c) & np.isfinite(m) & np.isfinite(s) & (s > 0)
+    w = np.where(good, 1.0 / np.where(good, s, 1.0) ** 2, 0.0)
+    return w, np.where(good, c, 0.0), np.where(good, m, 0.0)
+
+
+@dataclass
+class RoughnessFit:
+    """Result of :func:`fit_roughness`.
+
+    Attributes
+    ----------
+    roughness, roughness_std
+        (K,) fitted roughness values and their standard deviations [1].
+    scales
+        The band scales at the fitted roughness (:class:`ScaleFit`; their ``scale_std`` from
+        the joint covariance, so they include the roughness's uncertainty).
+    model
+        (N, B) simulated rates at the fitted roughness (unscaled) [s-1].
+    success
+        SLSQP's verdict; ``message`` its message.
+    n_simulations
+        Distinct roughness values simulated.
+    derivative
+        (K,) largest |d model / d alpha| over epochs and bands, relative to the largest
+        model rate (0: the data cannot see this roughness).
+    """
+
+    roughness: F64
+    roughness_std: F64
+    scales: ScaleFit
+    model: F64
+    success: bool
+    message: str
+    n_iterations: int
+    n_simulations: int
+    derivative: F64 = field(default_factory=lambda: np.zeros(0))
+
+
+def fit_roughness(
+    model: Callable[[F64], F64],
+    measured: F64,
+    sigma: F64,
+    start: F64,
+    bounds: tuple[float, float] = (0.01, 1.0),
+    *,
+    fit_scale: bool = True,
+    on_iteration: Callable[[int, F64, float], None] | None = None,
+    max_iterations: int = 50,
+) -> RoughnessFit:
+    """Fit roughness values (and the band scales) by bounded SLSQP with variable projection.
+
+    Parameters
+    ----------
+    model
+        ``model(alpha)`` -> (N, B) simulated rates [s-1] for roughness values (K,); called
+        once per distinct value (cached here).
+    measured, sigma
+        (N, B) measured rates and their sigmas [s-1].
+    start
+        (K,) initial roughness values.
+    bounds
+        Lower and upper bound of every roughness.
+    fit_scale
+        Fit the band scales (else they stay 1).
+    on_iteration
+        Called with (iteration, alpha, chi2) after each SLSQP iteration.
+    max_iterations
+        SLSQP's iteration limit.
+    """
+    cache: dict[tuple[float, ...], F64] = {}
+    lo, hi = float(bounds[0]), float(bounds[1])
+
+    def simulate(alpha: F64) -> F64:
+        key = tuple(float(x) for x in np.round(np.clip(alpha, lo, hi) / ROUGHNESS_RESOLUTION))
+        if key not in cache:
+            cache[key] = np.asarray(model(np.array(key) * ROUGHNESS_RESOLUTION), dtype=float)
+        return cache[key]
+
+    def chi2(alpha: F64) -> float:
+        c = simulate(alpha)
+        if fit_scale:
+            return float(np.sum(fit_scales(c, measured, sigma).chi2))
+        w, cc, m = _weights(c, measured, sigma)
+        return float(np.sum(w * (m - cc) ** 2))
+
+    x0 = np.clip(np.asarray(start, dtype=float), lo, hi)
+    norm = max(chi2(x0), 1e-300)
+
+    def objective(alpha: F64) -> float:
+        return chi2(alpha) / norm
+
+    def gradient(alpha: F64) -> F64:
+        f0 = objective(alpha)
+        g = np.zeros(alpha.size)
+        for k in range(alpha.size):
+            step = ROUGHNESS_STEP if alpha[k] + ROUGHNESS_STEP <= hi else -ROUGHNESS_STEP
+            a = alpha.copy()
+            a[k] += step
+            g[k] = (objective(a) - f0) / step
+        return g
+
+    iteration = [0]
+
+    def callback(alpha: F64) -> None:
+        iteration[0] += 1
+        if on_iteration is not None:
+            on_iteration(iteration[0], alpha, objective(alpha) * norm)
+
+    res = minimize(
+        objective,
+        x0,
+        jac=gradient,
+        method="SLSQP",
+        bounds=[(lo, hi)] * x0.size,
+        callback=callback,
+        options={"maxiter": max_iterations, "ftol": 1e-9},
+    )
+    alpha = np.clip(np.asarray(res.x, dtype=float), lo, hi)
+    c = simulate(alpha)
+    scales = (
+        fit_scales(c, measured, sigma)
+        if fit_scale
+        else ScaleFit(np.ones(c.shape[1]), np.zeros(c.shape[1]), np.zeros(c.shape[1]), np.zeros(0))
+    )
+    jac_cols, derivative = _jacobian(simulate, alpha, c, scales.scale, hi, fit_scale)
+    std_alpha, std_scale = _covariance(jac_cols, c, measured, sigma, scales.scale, fit_scale)
+    if fit_scale:
+        scales.scale_std = std_scale
+    return RoughnessFit(
+        roughness=alpha,
+        roughness_std=std_alpha,
+        scales=scales,
+        model=c,
+        success=bool(res.success),
+        message=str(res.message),
+        n_iterations=int(res.nit),
+        n_simulations=len(cache),
+        derivative=derivative,
+    )
+
+
+def _jacobian(
+    simulate: Callable[[F64], F64],
+    alpha: F64,
+    c: F64,
+    scale: F64,
+    hi: float,
+    fit_scale: bool,
+) -> tuple[list[F64], F64]:
+    """d(s_j c_tj)/d alpha_k as (N, B) arrays, and their size relative to the model."""
+    s = np.where(np.isfinite(scale), scale, 0.0) if fit_scale else np.ones(c.shape[1])
+    cols, size = [], np.zeros(alpha.size)
+    top = np.nanmax(np.abs(c)) if np.any(np.isfinite(c)) else 0.0
+    for k in range(alpha.size):
+        step = ROUGHNESS_STEP if alpha[k] + ROUGHNESS_STEP <= hi else -ROUGHNESS_STEP
+        a = alpha.copy()
+        a[k] += step
+        d = (simulate(a) - c) / step
+        cols.append(d * s[None, :])
+        size[k] = float(np.nanmax(np.abs(d)) / top) if top > 0 and np.any(np.isfinite(d)) else 0.0
+    return cols, size
+
+
+def _covariance(
+    cols: list[F64], c: F64, measured: F64, sigma: F64, scale: F64, fit_scale: bool
+) -> tuple[F64, F64]:
+    """Standard deviations of roughness and scales from ``(J^T W J)^-1`` (module doc)."""
+    n_b = c.shape[1]
+    s = np.where(np.isfinite(scale), scale, 0.0) if fit_scale else np.ones(n_b)
+    w, cc, m = _weights(c, measured, sigma)
+    sqrt_w = np.sqrt(w).ravel()
+    blocks = []
+    if fit_scale:
+        for j in range(n_b):
+            col = np.zeros_like(cc)
+            col[:, j] = cc[:, j]
+            blocks.append(col.ravel())
+    blocks += [np.where(w > 0, np.nan_to_num(d), 0.0).ravel() for d in cols]
+    jac = np.stack(blocks, axis=1) * sqrt_w[:, None]
+    resid = (m - s[None, :] * cc).ravel() * sqrt_w
+    n_used = int(np.count_nonzero(w))
+    dof = max(n_used - jac.shape[1], 1)
+    inflate = max(1.0, float(resid @ resid) / dof)
+    info = jac.T @ jac
+    try:
+        cov = np.linalg.inv(info) * inflate
+        std = np.sqrt(np.where(np.diag(cov) >= 0, np.diag(cov), np.nan))
+        if np.linalg.cond(info) > 1e14:
+            std = np.full(jac.shape[1], np.inf)
+    except np.linalg.LinAlgError:
+        std = np.full(jac.shape[1], np.inf)
+    k0 = n_b if fit_scale else 0
+    std_scale = std[:n_b] if fit_scale else np.zeros(n_b)
+    return std[k0:], std_scale
+
+
+__all__ = [
+    "ROUGHNESS_STEP",
+    "RoughnessFit",
+    "ScaleFit",
+    "fit_roughness",
+    "fit_scales",
+    "shot_noise_sigma",
+]
