@@ -235,6 +235,41 @@ def plot(
 
 
 @app.command()
+def fit(
+    scenario: Annotated[Path, typer.Argument(help="Scenario YAML file (the fit's start).")],
+    measured: Annotated[
+        Path, typer.Argument(help="Measured light curves: CSV (time, <band>...) or NetCDF.")
+    ],
+    output: Annotated[
+        str, typer.Option("--output", "-o", metavar="FILE", help="Output FIT.json.")
+    ] = "fit.json",
+    free: Annotated[
+        str, typer.Option("--free", help="Parameters to fit: albedo, roughness or both (a,b).")
+    ] = "albedo",
+    bin_s: Annotated[
+        float | None, typer.Option("--bin-s", help="Average the measurements into S-second bins.")
+    ] = None,
+    plot_file: Annotated[
+        str | None, typer.Option("--plot", metavar="FIG.png", help="Figure: rates and ratios.")
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite existing outputs.")] = False,
+) -> None:
+    """Fit per-band albedos (with --free albedo,roughness also the roughness of every rough
+    material) so that the scenario's count rates match MEASURED; write FIT.json.
+
+    The scenario is simulated at the measured epochs, starting from its own reflectance and
+    roughness. Outputs are claimed as `simulate` claims its output. See docs/fit.md.
+    """
+
+    def run() -> None:
+        from speclight.estimate.fit_cli import run_fit
+
+        run_fit(scenario, measured, output, free, bin_s, plot_file, force, _raise_if_signalled)
+
+    _guarded(run)
+
+
+@app.command()
 def info() -> None:
     """Versions of speclight and its engines, render variants, and data coverage."""
 

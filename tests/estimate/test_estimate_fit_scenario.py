@@ -55,7 +55,8 @@ def test_lambertian_sphere_albedo_073_is_recovered_in_every_band_from_04(tmp_pat
 
 
 def _cube(roughness: float) -> str:
-    return (DATA / "spinning_cube.yaml").read_text().replace("roughness: 0.12", f"roughness: {roughness}")
+    text = (DATA / "spinning_cube.yaml").read_text()
+    return text.replace("roughness: 0.12", f"roughness: {roughness}")
 
 
 def test_spinning_cube_roughness_012_is_recovered_from_03():

@@ -235,11 +235,12 @@ def fit_roughness(
     )
     alpha = np.clip(np.asarray(res.x, dtype=float), lo, hi)
     c = simulate(alpha)
-    scales = (
-        fit_scales(c, measured, sigma)
-        if fit_scale
-        else ScaleFit(np.ones(c.shape[1]), np.zeros(c.shape[1]), np.zeros(c.shape[1]), np.zeros(0))
-    )
+    scales = fit_scales(c, measured, sigma)
+    if not fit_scale:  # the scales stay 1: their chi2, no spread
+        w, cc, m = _weights(c, measured, sigma)
+        n_b = c.shape[1]
+        chi2_fixed = np.sum(w * (m - cc) ** 2, axis=0)
+        scales = ScaleFit(np.ones(n_b), np.zeros(n_b), chi2_fixed, scales.n_used)
     jac_cols, derivative = _jacobian(simulate, alpha, c, scales.scale, hi, fit_scale)
     std_alpha, std_scale = _covariance(jac_cols, c, measured, sigma, scales.scale, fit_scale)
     if fit_scale:

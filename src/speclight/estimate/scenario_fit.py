@@ -223,8 +223,10 @@ def _fit_rough(
 ) -> Any:
     from speclight.simulate import simulate
 
-    usable = np.isfinite(m).any(axis=1)
-    start = np.array([base.scenario.target.materials[n].roughness for n in rough], dtype=float)  # type: ignore[union-attr]
+    usable: NDArray[np.bool_] = np.asarray(np.isfinite(m).any(axis=1))
+    target = base.scenario.target
+    assert target is not None
+    start = np.array([float(target.materials[n].roughness or 0.0) for n in rough])
 
     def model(alpha: F64) -> F64:
         run = simulate(
@@ -270,7 +272,7 @@ def _roughness_problems(rough: list[str], fit: Any) -> list[str]:
 def _scale_problems(names: list[str], scale: F64, std: F64, n_used: NDArray) -> list[str]:
     out = []
     for j, name in enumerate(names):
-        if n_used.size and n_used[j] == 0:
+        if n_used[j] == 0:
             out.append(f"band '{name}' has no usable epochs (no finite, observable, lit data)")
         elif not np.isfinite(scale[j]) or not np.isfinite(std[j]):
             out.append(f"albedo of band '{name}' is not constrained (the model is zero there)")
@@ -337,7 +339,10 @@ def _result(
         time_utc=lc.time_utc,
         measured_per_s=np.where(used, m, np.nan),
         fitted_per_s=np.where(used, fitted, np.nan),
-        extra={"band_reflectance_of_scenario": {n: _num(r) for n, r in zip(names, rho)}, **extra},
+        extra={
+            "band_reflectance_of_scenario": {n: _num(r) for n, r in zip(names, rho, strict=True)},
+            **extra,
+        },
     )
 
 
