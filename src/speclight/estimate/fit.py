@@ -14,8 +14,12 @@ in closed form (one weighted linear least-squares problem per band):
 ``s_j = sum_t w m c / sum_t w c^2``. Only the roughness needs new simulations. It is fitted by
 variable projection (Golub & Pereyra 1973, doi:10.1137/0710036): bounded SLSQP
 (:func:`scipy.optimize.minimize`, Kraft 1988) minimises ``chi^2(alpha)`` with the scales
-solved in closed form at every ``alpha``; the gradient is a forward difference whose
+solved in closed form at every ``alpha``; the gradient is a central difference whose
 simulations are cached with the others (``model(alpha)`` is called once per distinct value).
+After the fit, chi2 is evaluated at two standard deviations on each side of every roughness
+(``profile``): a true minimum rises by about 4 (reduced chi2 units) on both sides; a side that
+rises by less than 1 or falls says that the linearised std does not hold (the data bound the
+parameter on one side only, or the fit stopped on a slope).
 
 Uncertainties: the covariance of all fitted parameters is ``(J^T W J)^-1`` at the optimum (J
 the Jacobian of the model in the scales and roughness), multiplied by ``max(1, chi^2 / dof)``:
@@ -41,10 +45,19 @@ from scipy.optimize import minimize
 
 F64 = NDArray[np.float64]
 
-#: Forward-difference step of the roughness gradient and Jacobian [1] (microfacet alpha).
+#: Half the central-difference step of the roughness gradient and Jacobian [1].
 ROUGHNESS_STEP = 2e-3
 #: Roughness values are rounded to this before simulating (the cache key) [1].
 ROUGHNESS_RESOLUTION = 1e-5
+#: SLSQP's ftol on chi2 / (chi2 at the start / number of data): stop when an iteration gains
+#: less than this many squared standard deviations (of the start's misfit) [1].
+FTOL = 1e-4
+#: The check of the minimum: chi2 is evaluated at PROFILE_SIGMAS standard deviations on each
+#: side of every fitted roughness, where a quadratic minimum rises by PROFILE_SIGMAS^2 (in
+#: units of the reduced chi2); a side that rises by less than 1 is not constrained.
+PROFILE_SIGMAS = 2.0
+#: SLSQP runs at most this many times, each from where the last stopped (see the code).
+MAX_PASSES = 3
 
 
 def shot_noise_sigma(rate_per_s: F64, exposure_s: float, n_samples: NDArray | int = 1) -> F64:
@@ -141,6 +154,9 @@ class RoughnessFit:
     derivative
         (K,) largest |d model / d alpha| over epochs and bands, relative to the largest
         model rate (0: the data cannot see this roughness).
+    profile
+        (K, 2) rise of chi2 (in units of the reduced chi2) at ``-/+ PROFILE_SIGMAS`` standard
+        deviations of each roughness (:data:`PROFILE_SIGMAS`); about 4 at a true minimum.
     """
 
     roughness: F64
@@ -152,6 +168,7 @@ class RoughnessFit:
     n_iterations: int
     n_simulations: int
     derivative: F64 = field(default_factory=lambda: np.zeros(0))
+    profile: F64 = field(default_factory=lambda: np.zeros((0, 2)))
 
 
 def fit_roughness(
@@ -202,19 +219,17 @@ def fit_roughness(
         return float(np.sum(w * (m - cc) ** 2))
 
     x0 = np.clip(np.asarray(start, dtype=float), lo, hi)
-    norm = max(chi2(x0), 1e-300)
+    n_data = int(np.count_nonzero(_weights(simulate(x0), measured, sigma)[0]))
+    norm = [1.0]
 
     def objective(alpha: F64) -> float:
-        return chi2(alpha) / norm
+        return chi2(alpha) / norm[0]
 
     def gradient(alpha: F64) -> F64:
-        f0 = objective(alpha)
         g = np.zeros(alpha.size)
-        for k in range(alpha.size):
-            step = ROUGHNESS_STEP if alpha[k] + ROUGHNESS_STEP <= hi else -ROUGHNESS_STEP
-            a = alpha.copy()
-            a[k] += step
-            g[k] = (objective(a) - f0) / step
+        for k in range(alpha.size):  # central: a forward difference would shift the minimum
+            a, b = _steps(alpha, k, lo, hi)
+            g[k] = (objective(b) - objective(a)) / (b[k] - a[k])
         return g
 
     iteration = [0]
@@ -222,18 +237,29 @@ def fit_roughness(
     def callback(alpha: F64) -> None:
         iteration[0] += 1
         if on_iteration is not None:
-            on_iteration(iteration[0], alpha, objective(alpha) * norm)
+            on_iteration(iteration[0], alpha, chi2(alpha))
 
-    res = minimize(
-        objective,
-        x0,
-        jac=gradient,
-        method="SLSQP",
-        bounds=[(lo, hi)] * x0.size,
-        callback=callback,
-        options={"maxiter": max_iterations, "ftol": 1e-9},
-    )
-    alpha = np.clip(np.asarray(res.x, dtype=float), lo, hi)
+    x, success, message = x0, False, ""
+    for _ in range(MAX_PASSES):
+        # chi2 in units of the mean squared normalised residual where this pass starts: SLSQP's
+        # ftol (absolute) stops at gains of FTOL of those; a pass that started far from the
+        # minimum (large residuals) is followed by one in the finer units of where it ended
+        norm[0] = max(chi2(x) / max(n_data, 1), 1e-300)
+        res = minimize(
+            objective,
+            x,
+            jac=gradient,
+            method="SLSQP",
+            bounds=[(lo, hi)] * x.size,
+            callback=callback,
+            options={"maxiter": max_iterations, "ftol": FTOL},
+        )
+        moved = np.max(np.abs(np.asarray(res.x) - x))
+        x = np.clip(np.asarray(res.x, dtype=float), lo, hi)
+        success, message = bool(res.success), str(res.message)
+        if moved < 10 * ROUGHNESS_RESOLUTION:
+            break
+    alpha = x
     c = simulate(alpha)
     scales = fit_scales(c, measured, sigma)
     if not fit_scale:  # the scales stay 1: their chi2, no spread
@@ -241,21 +267,56 @@ def fit_roughness(
         n_b = c.shape[1]
         chi2_fixed = np.sum(w * (m - cc) ** 2, axis=0)
         scales = ScaleFit(np.ones(n_b), np.zeros(n_b), chi2_fixed, scales.n_used)
-    jac_cols, derivative = _jacobian(simulate, alpha, c, scales.scale, hi, fit_scale)
+    jac_cols, derivative = _jacobian(simulate, alpha, c, scales.scale, (lo, hi), fit_scale)
     std_alpha, std_scale = _covariance(jac_cols, c, measured, sigma, scales.scale, fit_scale)
     if fit_scale:
         scales.scale_std = std_scale
+    profile = _profile(chi2, alpha, std_alpha, (lo, hi), n_data, fit_scale, scales.chi2)
     return RoughnessFit(
         roughness=alpha,
         roughness_std=std_alpha,
         scales=scales,
         model=c,
-        success=bool(res.success),
-        message=str(res.message),
-        n_iterations=int(res.nit),
+        success=bool(success),
+        message=str(message),
+        n_iterations=iteration[0],
         n_simulations=len(cache),
         derivative=derivative,
+        profile=profile,
     )
+
+
+def _profile(
+    chi2: Callable[[F64], float],
+    alpha: F64,
+    std: F64,
+    bounds: tuple[float, float],
+    n_data: int,
+    fit_scale: bool,
+    chi2_bands: F64,
+) -> F64:
+    """Rise of chi2 at -/+ PROFILE_SIGMAS std of each roughness, in units of the reduced
+    chi2 (K, 2); NaN for a side beyond a bound or an unconstrained (infinite std) value.
+
+    A quadratic minimum rises by PROFILE_SIGMAS^2 = 4 on both sides. Much less means that the
+    linearised std is wrong: chi2 is flat on that side (the data give only a bound), or the
+    fit stopped on a slope (negative: chi2 is lower there).
+    """
+    lo, hi = bounds
+    best = chi2(alpha)
+    n_par = alpha.size + (chi2_bands.size if fit_scale else 0)
+    reduced = max(1.0, best / max(n_data - n_par, 1))
+    out = np.full((alpha.size, 2), np.nan)
+    for k in range(alpha.size):
+        if not np.isfinite(std[k]) or std[k] > hi - lo:
+            continue
+        step = max(PROFILE_SIGMAS * std[k], 10 * ROUGHNESS_RESOLUTION)
+        for side, sign in enumerate((-1.0, 1.0)):
+            a = alpha.copy()
+            a[k] += sign * step
+            if lo <= a[k] <= hi:
+                out[k, side] = (chi2(a) - best) / reduced
+    return out
 
 
 def _jacobian(
@@ -263,21 +324,29 @@ def _jacobian(
     alpha: F64,
     c: F64,
     scale: F64,
-    hi: float,
+    bounds: tuple[float, float],
     fit_scale: bool,
 ) -> tuple[list[F64], F64]:
-    """d(s_j c_tj)/d alpha_k as (N, B) arrays, and their size relative to the model."""
+    """d(s_j c_tj)/d alpha_k as (N, B) arrays (central differences, the points of the last
+    gradient), and their size relative to the model."""
+    lo, hi = bounds
     s = np.where(np.isfinite(scale), scale, 0.0) if fit_scale else np.ones(c.shape[1])
     cols, size = [], np.zeros(alpha.size)
     top = np.nanmax(np.abs(c)) if np.any(np.isfinite(c)) else 0.0
     for k in range(alpha.size):
-        step = ROUGHNESS_STEP if alpha[k] + ROUGHNESS_STEP <= hi else -ROUGHNESS_STEP
-        a = alpha.copy()
-        a[k] += step
-        d = (simulate(a) - c) / step
+        a, b = _steps(alpha, k, lo, hi)
+        d = (simulate(b) - simulate(a)) / (b[k] - a[k])
         cols.append(d * s[None, :])
         size[k] = float(np.nanmax(np.abs(d)) / top) if top > 0 and np.any(np.isfinite(d)) else 0.0
     return cols, size
+
+
+def _steps(alpha: F64, k: int, lo: float, hi: float) -> tuple[F64, F64]:
+    """The two points of a central difference in alpha_k (one-sided at a bound)."""
+    a, b = alpha.copy(), alpha.copy()
+    a[k] = max(alpha[k] - ROUGHNESS_STEP, lo)
+    b[k] = min(alpha[k] + ROUGHNESS_STEP, hi)
+    return a, b
 
 
 def _covariance(

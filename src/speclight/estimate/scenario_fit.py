@@ -30,7 +30,13 @@ from numpy.typing import NDArray
 
 from speclight import schema
 from speclight.errors import InputError
-from speclight.estimate.fit import F64, fit_roughness, fit_scales, shot_noise_sigma
+from speclight.estimate.fit import (
+    F64,
+    PROFILE_SIGMAS,
+    fit_roughness,
+    fit_scales,
+    shot_noise_sigma,
+)
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve
 from speclight.estimate.upsampling import band_albedo
 from speclight.scenario import LoadedScenario
@@ -262,10 +268,19 @@ def _roughness_problems(rough: list[str], fit: Any) -> list[str]:
         if fit.derivative[k] == 0 or not np.isfinite(std) or std > span:
             out.append(
                 f"roughness of material '{name}' is not constrained by the data "
-                f"(std {std:.3g} for bounds {ROUGHNESS_BOUNDS}; e.g. no glint is seen)"
+                f"(std {std:.3g} for bounds {ROUGHNESS_BOUNDS}: changing it changes the "
+                "light curve not at all or only in brightness, which the albedo absorbs)"
             )
         elif min(value - ROUGHNESS_BOUNDS[0], ROUGHNESS_BOUNDS[1] - value) < 1e-6:
             out.append(f"roughness of material '{name}' stopped at a bound ({value:g})")
+        elif np.nanmin(fit.profile[k]) < 1.0:
+            side = "below" if fit.profile[k, 0] < fit.profile[k, 1] else "above"
+            out.append(
+                f"roughness of material '{name}' is not at a well-defined minimum: chi2 "
+                f"{'falls' if np.nanmin(fit.profile[k]) < 0 else 'barely rises'} "
+                f"{PROFILE_SIGMAS:g} std {side} {value:.4g} (the data may bound it only on "
+                "one side)"
+            )
     return out
 
 
