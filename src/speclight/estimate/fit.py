@@ -45,19 +45,25 @@ from scipy.optimize import minimize
 
 F64 = NDArray[np.float64]
 
-#: Half the central-difference step of the roughness gradient and Jacobian [1].
+#: Half the central-difference step of the roughness gradient and Jacobian [1], at first;
+#: once a pass of SLSQP has estimated the standard deviation, one std (down to FD_MIN).
 ROUGHNESS_STEP = 2e-3
+#: Smallest half step of the differences [1].
+FD_MIN = 1e-6
 #: Roughness values are rounded to this before simulating (the cache key) [1].
-ROUGHNESS_RESOLUTION = 1e-5
-#: SLSQP's ftol on chi2 / (chi2 at the start / number of data): stop when an iteration gains
-#: less than this many squared standard deviations (of the start's misfit) [1].
-FTOL = 1e-4
+ROUGHNESS_RESOLUTION = 1e-8
+#: SLSQP stops when an iteration lowers chi2 by less than FTOL reduced chi2 (FTOL x chi2 /
+#: number of data; SLSQP minimises log chi2 with ftol = FTOL / number of data) [1].
+FTOL = 1e-2
 #: The check of the minimum: chi2 is evaluated at PROFILE_SIGMAS standard deviations on each
 #: side of every fitted roughness, where a quadratic minimum rises by PROFILE_SIGMAS^2 (in
 #: units of the reduced chi2); a side that rises by less than 1 is not constrained.
 PROFILE_SIGMAS = 2.0
-#: SLSQP runs at most this many times, each from where the last stopped (see the code).
-MAX_PASSES = 3
+#: Roughness values tried before SLSQP starts, log-spaced over the bounds (one roughness).
+SCAN_POINTS = 7
+#: SLSQP runs at most this many times, each from where the last stopped, while it fails or
+#: the difference step shrinks (see the code).
+MAX_PASSES = 4
 
 
 def shot_noise_sigma(rate_per_s: F64, exposure_s: float, n_samples: NDArray | int = 1) -> F64:
@@ -220,15 +226,18 @@ def fit_roughness(
 
     x0 = np.clip(np.asarray(start, dtype=float), lo, hi)
     n_data = int(np.count_nonzero(_weights(simulate(x0), measured, sigma)[0]))
-    norm = [1.0]
 
     def objective(alpha: F64) -> float:
-        return chi2(alpha) / norm[0]
+        # log chi2: its changes are relative ones, so one ftol serves a start far from the
+        # minimum (chi2 huge) and the end (chi2 near the number of data) alike
+        return float(np.log(max(chi2(alpha), 1e-300)))
+
+    fd = np.full(x0.size, ROUGHNESS_STEP)  # half the difference step, per roughness
 
     def gradient(alpha: F64) -> F64:
         g = np.zeros(alpha.size)
         for k in range(alpha.size):  # central: a forward difference would shift the minimum
-            a, b = _steps(alpha, k, lo, hi)
+            a, b = _steps(alpha, k, lo, hi, fd[k])
             g[k] = (objective(b) - objective(a)) / (b[k] - a[k])
         return g
 
@@ -239,38 +248,36 @@ def fit_roughness(
         if on_iteration is not None:
             on_iteration(iteration[0], alpha, chi2(alpha))
 
-    x, success, message = x0, False, ""
+    x, success, message = _scan_start(x0, chi2, lo, hi), False, ""
     for _ in range(MAX_PASSES):
-        # chi2 in units of the mean squared normalised residual where this pass starts: SLSQP's
-        # ftol (absolute) stops at gains of FTOL of those; a pass that started far from the
-        # minimum (large residuals) is followed by one in the finer units of where it ended
-        norm[0] = max(chi2(x) / max(n_data, 1), 1e-300)
+        # SLSQP's first step is a steepest-descent step of unit length in its variables; in
+        # u = (alpha - x) / h with h = 1 / sqrt(curvature of the objective at x) it is a
+        # Newton step instead of a jump to a bound (the curvature comes from the gradient's
+        # cached points)
+        h = _step_scale(objective, x, lo, hi, fd)
         res = minimize(
-            objective,
-            x,
-            jac=gradient,
+            lambda u, x=x, h=h: objective(x + h * u),
+            np.zeros(x.size),
+            jac=lambda u, x=x, h=h: gradient(x + h * u) * h,
             method="SLSQP",
-            bounds=[(lo, hi)] * x.size,
-            callback=callback,
-            options={"maxiter": max_iterations, "ftol": FTOL},
+            bounds=list(zip((lo - x) / h, (hi - x) / h, strict=True)),
+            callback=lambda u, x=x, h=h: callback(x + h * u),
+            # stop when an iteration lowers chi2 by less than FTOL x chi2 / n_data, i.e. FTOL
+            # in units of the reduced chi2
+            options={"maxiter": max_iterations, "ftol": FTOL / max(n_data, 1)},
         )
-        moved = np.max(np.abs(np.asarray(res.x) - x))
-        x = np.clip(np.asarray(res.x, dtype=float), lo, hi)
+        x = np.clip(x + h * np.asarray(res.x, dtype=float), lo, hi)
         success, message = bool(res.success), str(res.message)
-        if moved < 10 * ROUGHNESS_RESOLUTION:
+        lin = _linearise(simulate, x, measured, sigma, fit_scale, (lo, hi), fd)
+        # a difference step much wider than the std misjudges the gradient near the
+        # minimum: resume with a step of one std (down to FD_MIN)
+        finite = np.where(np.isfinite(lin.std_alpha), lin.std_alpha, ROUGHNESS_STEP)
+        step = np.clip(finite, FD_MIN, ROUGHNESS_STEP)
+        if success and np.all(step >= fd / 3):
             break
-    alpha = x
-    c = simulate(alpha)
-    scales = fit_scales(c, measured, sigma)
-    if not fit_scale:  # the scales stay 1: their chi2, no spread
-        w, cc, m = _weights(c, measured, sigma)
-        n_b = c.shape[1]
-        chi2_fixed = np.sum(w * (m - cc) ** 2, axis=0)
-        scales = ScaleFit(np.ones(n_b), np.zeros(n_b), chi2_fixed, scales.n_used)
-    jac_cols, derivative = _jacobian(simulate, alpha, c, scales.scale, (lo, hi), fit_scale)
-    std_alpha, std_scale = _covariance(jac_cols, c, measured, sigma, scales.scale, fit_scale)
-    if fit_scale:
-        scales.scale_std = std_scale
+        fd = np.minimum(fd, step)
+    alpha, c, scales = x, lin.model, lin.scales
+    std_alpha, derivative = lin.std_alpha, lin.derivative
     profile = _profile(chi2, alpha, std_alpha, (lo, hi), n_data, fit_scale, scales.chi2)
     return RoughnessFit(
         roughness=alpha,
@@ -284,6 +291,38 @@ def fit_roughness(
         derivative=derivative,
         profile=profile,
     )
+
+
+@dataclass
+class _Linearised:
+    model: F64
+    scales: ScaleFit
+    std_alpha: F64
+    derivative: F64
+
+
+def _linearise(
+    simulate: Callable[[F64], F64],
+    alpha: F64,
+    measured: F64,
+    sigma: F64,
+    fit_scale: bool,
+    bounds: tuple[float, float],
+    fd: F64,
+) -> _Linearised:
+    """Scales, Jacobian and standard deviations at ``alpha`` (module doc: uncertainties)."""
+    c = simulate(alpha)
+    scales = fit_scales(c, measured, sigma)
+    if not fit_scale:  # the scales stay 1: their chi2, no spread
+        w, cc, m = _weights(c, measured, sigma)
+        n_b = c.shape[1]
+        chi2_fixed = np.sum(w * (m - cc) ** 2, axis=0)
+        scales = ScaleFit(np.ones(n_b), np.zeros(n_b), chi2_fixed, scales.n_used)
+    jac_cols, derivative = _jacobian(simulate, alpha, c, scales.scale, bounds, fit_scale, fd)
+    std_alpha, std_scale = _covariance(jac_cols, c, measured, sigma, scales.scale, fit_scale)
+    if fit_scale:
+        scales.scale_std = std_scale
+    return _Linearised(c, scales, std_alpha, derivative)
 
 
 def _profile(
@@ -326,6 +365,7 @@ def _jacobian(
     scale: F64,
     bounds: tuple[float, float],
     fit_scale: bool,
+    fd: F64,
 ) -> tuple[list[F64], F64]:
     """d(s_j c_tj)/d alpha_k as (N, B) arrays (central differences, the points of the last
     gradient), and their size relative to the model."""
@@ -334,18 +374,48 @@ def _jacobian(
     cols, size = [], np.zeros(alpha.size)
     top = np.nanmax(np.abs(c)) if np.any(np.isfinite(c)) else 0.0
     for k in range(alpha.size):
-        a, b = _steps(alpha, k, lo, hi)
+        a, b = _steps(alpha, k, lo, hi, fd[k])
         d = (simulate(b) - simulate(a)) / (b[k] - a[k])
         cols.append(d * s[None, :])
         size[k] = float(np.nanmax(np.abs(d)) / top) if top > 0 and np.any(np.isfinite(d)) else 0.0
     return cols, size
 
 
-def _steps(alpha: F64, k: int, lo: float, hi: float) -> tuple[F64, F64]:
+def _scan_start(x0: F64, chi2: Callable[[F64], float], lo: float, hi: float) -> F64:
+    """For one roughness: the best of the start and SCAN_POINTS log-spaced values between the
+    bounds. chi2 is nearly flat far from the minimum (a glint that does not overlap the
+    measured one misfits by about as much whatever its width), where SLSQP's first steps
+    wander; the scan starts it in the right valley. Several roughness values start as given.
+    """
+    if x0.size != 1:
+        return x0
+    grid = np.geomspace(lo, hi, SCAN_POINTS)
+    candidates = [x0, *[np.array([g]) for g in grid]]
+    return min(candidates, key=chi2)
+
+
+def _step_scale(objective: Callable[[F64], float], x: F64, lo: float, hi: float, fd: F64) -> F64:
+    """1 / sqrt(second difference of the objective) per roughness (where it is convex)."""
+    h = np.empty(x.size)
+    f0 = objective(x)
+    for k in range(x.size):
+        a, b = _steps(x, k, lo, hi, fd[k])
+        da, db = x[k] - a[k], b[k] - x[k]
+        fa, fb = objective(a), objective(b)
+        curv = 2 * ((fb - f0) / db - (f0 - fa) / da) / (da + db) if da > 0 and db > 0 else 0.0
+        if curv > 0:
+            h[k] = 1 / np.sqrt(curv)
+        else:  # not convex here: a first step of a quarter of the value, downhill
+            slope = abs(fb - fa) / max(da + db, 1e-300)
+            h[k] = np.sqrt(max(0.25 * x[k], fd[k]) / max(slope, 1e-300))
+    return np.clip(h, FD_MIN, hi - lo)
+
+
+def _steps(alpha: F64, k: int, lo: float, hi: float, step: float) -> tuple[F64, F64]:
     """The two points of a central difference in alpha_k (one-sided at a bound)."""
     a, b = alpha.copy(), alpha.copy()
-    a[k] = max(alpha[k] - ROUGHNESS_STEP, lo)
-    b[k] = min(alpha[k] + ROUGHNESS_STEP, hi)
+    a[k] = max(alpha[k] - step, lo)
+    b[k] = min(alpha[k] + step, hi)
     return a, b
 
 

@@ -161,7 +161,9 @@ def fit_scenario(
     free
         Parameters to fit: ``albedo``, ``roughness`` or both.
     bin_s
-        Average the measurements into bins of this many seconds first.
+        Average the measurements into bins of this many seconds first
+        (:func:`~speclight.estimate.bin_light_curve`); the model is evaluated at each bin's
+        mean epoch, and bins holding a flagged or penumbra epoch are left out.
     progress
         Show render progress and the roughness iterations on a terminal.
     """
@@ -177,7 +179,7 @@ def fit_scenario(
         raise InputError("the scenario has no instrument bands to fit", field="instrument.bands")
     lc = measured.select_bands(names)
     if bin_s is not None:
-        lc = bin_light_curve(lc, bin_s)
+        lc = _binned(loaded, lc, bin_s)
     rough = rough_materials(loaded) if "roughness" in free else []
     if "roughness" in free and not rough:
         raise InputError(
@@ -294,6 +296,21 @@ def _scale_problems(names: list[str], scale: F64, std: F64, n_used: NDArray) -> 
         elif scale[j] < 0:
             out.append(f"albedo of band '{name}' came out negative ({scale[j]:.3g} x start)")
     return out
+
+
+def _binned(loaded: LoadedScenario, lc: MeasuredLightCurve, bin_s: float) -> MeasuredLightCurve:
+    """``lc`` averaged into ``bin_s`` bins, without the bins that hold an epoch the model
+    cannot represent by one epoch: flagged (shadow, below the horizon...) or in penumbra, where
+    the light changes too fast for the bin's mean epoch to stand for it."""
+    from speclight.simulate.geometry_stage import scenario_geometry
+
+    binned = bin_light_curve(lc, bin_s)
+    flags = scenario_geometry(loaded, lc.time_utc).flags.astype(np.int64)
+    bad = ((flags & (_SKIP | schema.FLAG_PENUMBRA)) != 0).astype(float)[:, None]
+    marker = replace(lc, band_names=["flagged"], rate_per_s=bad, sigma_per_s=None)
+    keep = bin_light_curve(marker, bin_s).rate_per_s[:, 0] == 0
+    rate = np.where(keep[:, None], binned.rate_per_s, np.nan)
+    return replace(binned, rate_per_s=rate)
 
 
 def _band_reflectance(loaded: LoadedScenario, ds: Any) -> F64:

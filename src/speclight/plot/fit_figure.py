@@ -4,7 +4,7 @@ The layout of the reference paper's Figures 9 and 10 (Nussbaum et al. 2022, "Spe
 Light Curve Simulation for Parameter Estimation from Space Debris"): above, the count rate
 of each band, measured (solid) and fitted (dashed); below, the ratio of each band's rate to
 the rate of a reference band (the band with the largest summed measured signal), measured
-and fitted.
+and fitted, at the epochs where the reference band is above :data:`FAINT` of its peak.
 """
 
 from __future__ import annotations
@@ -18,6 +18,9 @@ from numpy.typing import NDArray
 from speclight.plot.style import new_figure
 
 F64 = NDArray[np.float64]
+#: Band ratios are drawn where the reference band's fitted rate is at least this fraction of
+#: its peak (fainter epochs' measured ratios are noise over noise) [1].
+FAINT = 0.05
 
 
 def fit_figure(
@@ -50,6 +53,12 @@ def fit_figure(
     top.set_title("measured (solid) and fitted (dashed) count rates")
     top.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False)
     ref = int(np.nanargmax(np.nansum(m, axis=0))) if np.any(np.isfinite(m)) else 0
+    # ratios of faint epochs are noise over noise: drawn only where the reference band's
+    # fitted rate reaches FAINT of its peak
+    peak = np.nanmax(f[:, ref]) if np.any(np.isfinite(f[:, ref])) else np.nan
+    bright = f[:, ref] >= FAINT * peak
+    m = np.where(bright[:, None], m, np.nan)
+    f = np.where(bright[:, None], f, np.nan)
     with np.errstate(divide="ignore", invalid="ignore"):
         for j, name in enumerate(band_names):
             if j == ref:
@@ -58,7 +67,11 @@ def fit_figure(
                         label=f"{name}/{band_names[ref]}")  # fmt: skip
             bottom.plot(t, f[:, j] / f[:, ref], "--", color=colours[j], lw=1.2)
     bottom.set_ylabel(f"ratio to {band_names[ref]}")
-    bottom.set_title("signal ratios between bands, measured (solid) and fitted (dashed)")
+    bottom.set_title(
+        "signal ratios between bands, measured (solid) and fitted (dashed), where the "
+        f"reference band is above {FAINT:.0%} of its peak",
+        fontsize="medium",
+    )
     if len(band_names) > 1:
         bottom.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small",
                       frameon=False)  # fmt: skip
