@@ -163,6 +163,9 @@ class RoughnessFit:
     profile
         (K, 2) rise of chi2 (in units of the reduced chi2) at ``-/+ PROFILE_SIGMAS`` standard
         deviations of each roughness (:data:`PROFILE_SIGMAS`); about 4 at a true minimum.
+    flat
+        Why the roughness was not refined after the scan (one roughness whose chi2 hardly
+        changes between scan points a factor 2.2 apart), or "".
     """
 
     roughness: F64
@@ -175,6 +178,7 @@ class RoughnessFit:
     n_simulations: int
     derivative: F64 = field(default_factory=lambda: np.zeros(0))
     profile: F64 = field(default_factory=lambda: np.zeros((0, 2)))
+    flat: str = ""
 
 
 def fit_roughness(
@@ -248,8 +252,15 @@ def fit_roughness(
         if on_iteration is not None:
             on_iteration(iteration[0], alpha, chi2(alpha))
 
-    x, success, message = _scan_start(x0, chi2, lo, hi), False, ""
-    for _ in range(MAX_PASSES):
+    n_par = x0.size + (measured.shape[1] if fit_scale else 0)
+
+    def unit(value: float) -> float:  # the reduced chi2 (at least 1)
+        return max(1.0, value / max(n_data - n_par, 1))
+
+    x, flat = _scan_start(x0, chi2, lo, hi, unit)
+    success, message = not flat, "not refined: the scan found chi2 flat" if flat else ""
+    lin = _linearise(simulate, x, measured, sigma, fit_scale, (lo, hi), fd)
+    for _ in range(0 if flat else MAX_PASSES):
         # SLSQP's first step is a steepest-descent step of unit length in its variables; in
         # u = (alpha - x) / h with h = 1 / sqrt(curvature of the objective at x) it is a
         # Newton step instead of a jump to a bound (the curvature comes from the gradient's
@@ -290,6 +301,7 @@ def fit_roughness(
         n_simulations=len(cache),
         derivative=derivative,
         profile=profile,
+        flat=flat,
     )
 
 
@@ -381,17 +393,34 @@ def _jacobian(
     return cols, size
 
 
-def _scan_start(x0: F64, chi2: Callable[[F64], float], lo: float, hi: float) -> F64:
+def _scan_start(
+    x0: F64, chi2: Callable[[F64], float], lo: float, hi: float, unit: Callable[[float], float]
+) -> tuple[F64, str]:
     """For one roughness: the best of the start and SCAN_POINTS log-spaced values between the
-    bounds. chi2 is nearly flat far from the minimum (a glint that does not overlap the
-    measured one misfits by about as much whatever its width), where SLSQP's first steps
-    wander; the scan starts it in the right valley. Several roughness values start as given.
+    bounds, and why not to refine it ("" to go on).
+
+    chi2 is nearly flat far from the minimum (a glint that does not overlap the measured one
+    misfits by about as much whatever its width), where SLSQP's first steps wander; the scan
+    starts it in the right valley. When chi2 at the scan's neighbours of the best (a factor
+    of 2.2 apart) is within one reduced chi2 (``unit(chi2)``) of the best, the data do not
+    tell these values apart and SLSQP would only chase noise: the reason is returned.
+    Several roughness values start as given.
     """
     if x0.size != 1:
-        return x0
-    grid = np.geomspace(lo, hi, SCAN_POINTS)
-    candidates = [x0, *[np.array([g]) for g in grid]]
-    return min(candidates, key=chi2)
+        return x0, ""
+    grid = [np.array([g]) for g in np.geomspace(lo, hi, SCAN_POINTS)]
+    values = [chi2(g) for g in grid]
+    k = int(np.argmin(values))
+    best, best_chi2 = (x0, chi2(x0)) if chi2(x0) < values[k] else (grid[k], values[k])
+    near = [values[i] for i in (k - 1, k + 1) if 0 <= i < len(values)]
+    rise = (min(near) - best_chi2) / unit(best_chi2)
+    if rise < 1.0:
+        i, j = max(k - 1, 0), min(k + 1, len(grid) - 1)
+        return best, (
+            f"chi2 changes by less than one reduced chi2 ({rise:.2g}) between roughness "
+            f"{grid[i][0]:.3g} and {grid[j][0]:.3g}"
+        )
+    return best, ""
 
 
 def _step_scale(objective: Callable[[F64], float], x: F64, lo: float, hi: float, fd: F64) -> F64:
@@ -408,7 +437,7 @@ def _step_scale(objective: Callable[[F64], float], x: F64, lo: float, hi: float,
         else:  # not convex here: a first step of a quarter of the value, downhill
             slope = abs(fb - fa) / max(da + db, 1e-300)
             h[k] = np.sqrt(max(0.25 * x[k], fd[k]) / max(slope, 1e-300))
-    return np.clip(h, FD_MIN, hi - lo)
+    return np.clip(h, FD_MIN, 0.1 * (hi - lo))
 
 
 def _steps(alpha: F64, k: int, lo: float, hi: float, step: float) -> tuple[F64, F64]:

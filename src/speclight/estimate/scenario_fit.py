@@ -263,6 +263,8 @@ def _fit_rough(
 def _roughness_problems(rough: list[str], fit: Any) -> list[str]:
     out = []
     span = ROUGHNESS_BOUNDS[1] - ROUGHNESS_BOUNDS[0]
+    if fit.flat:
+        return [f"roughness of material '{rough[0]}' is not constrained by the data: {fit.flat}"]
     if not fit.success:
         out.append(f"SLSQP did not converge: {fit.message}")
     for k, name in enumerate(rough):
