@@ -396,31 +396,47 @@ def _jacobian(
 def _scan_start(
     x0: F64, chi2: Callable[[F64], float], lo: float, hi: float, unit: Callable[[float], float]
 ) -> tuple[F64, str]:
-    """For one roughness: the best of the start and SCAN_POINTS log-spaced values between the
-    bounds, and why not to refine it ("" to go on).
+    """For one roughness: where to start SLSQP, and why not to ("" to go on).
 
     chi2 is nearly flat far from the minimum (a glint that does not overlap the measured one
-    misfits by about as much whatever its width), where SLSQP's first steps wander; the scan
-    starts it in the right valley. When chi2 at the scan's neighbours of the best (a factor
-    of 2.2 apart) is within one reduced chi2 (``unit(chi2)``) of the best, the data do not
-    tell these values apart and SLSQP would only chase noise: the reason is returned.
-    Several roughness values start as given.
+    misfits by about as much whatever its width), where SLSQP's first steps wander; so the
+    start and SCAN_POINTS log-spaced values over the bounds are simulated first and SLSQP
+    starts from the best. When chi2 at a scan neighbour of the best (the next value below or
+    above, a factor of about 2.2 away) is within one reduced chi2 (``unit(chi2)``) of the
+    best, the data do not tell these values apart and SLSQP would only chase noise: the
+    reason is returned, with the start kept if it is as good as the best to within that
+    unit. Several roughness values start as given.
     """
     if x0.size != 1:
         return x0, ""
-    grid = [np.array([g]) for g in np.geomspace(lo, hi, SCAN_POINTS)]
-    values = [chi2(g) for g in grid]
+    grid = np.geomspace(lo, hi, SCAN_POINTS)
+    values = np.array([chi2(np.array([g])) for g in grid])
+    start_chi2 = chi2(x0)
     k = int(np.argmin(values))
-    best, best_chi2 = (x0, chi2(x0)) if chi2(x0) < values[k] else (grid[k], values[k])
-    near = [values[i] for i in (k - 1, k + 1) if 0 <= i < len(values)]
-    rise = (min(near) - best_chi2) / unit(best_chi2)
-    if rise < 1.0:
-        i, j = max(k - 1, 0), min(k + 1, len(grid) - 1)
-        return best, (
-            f"chi2 changes by less than one reduced chi2 ({rise:.2g}) between roughness "
-            f"{grid[i][0]:.3g} and {grid[j][0]:.3g}"
-        )
-    return best, ""
+    if start_chi2 < values[k]:
+        best, best_chi2 = float(x0[0]), start_chi2
+    else:
+        best, best_chi2 = float(grid[k]), float(values[k])
+    below, above = grid[grid < best], grid[grid > best]
+    rise = {}
+    if below.size:
+        rise["below"] = (float(values[grid < best][-1]) - best_chi2, float(below[-1]))
+    if above.size:
+        rise["above"] = (float(values[grid > best][0]) - best_chi2, float(above[0]))
+    flat = {side: r for side, r in rise.items() if r[0] < unit(best_chi2)}
+    if not flat:
+        return np.array([best]), ""
+    keep = x0 if start_chi2 - best_chi2 < unit(best_chi2) else np.array([best])
+    parts = [
+        f"chi2 changes by less than one reduced chi2 from {best:.3g} to {at:.3g}"
+        for _, at in flat.values()
+    ]
+    bounded = [f"{side} {at:.3g} (chi2 +{r / unit(best_chi2):.3g})"
+               for side, (r, at) in rise.items() if side not in flat]  # fmt: skip
+    text = " and ".join(parts)
+    if bounded:
+        text += f"; it is bounded only on one side: {bounded[0]}"
+    return keep, text
 
 
 def _step_scale(objective: Callable[[F64], float], x: F64, lo: float, hi: float, fd: F64) -> F64:
