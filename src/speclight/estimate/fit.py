@@ -191,6 +191,7 @@ def fit_roughness(
     fit_scale: bool = True,
     on_iteration: Callable[[int, F64, float], None] | None = None,
     max_iterations: int = 50,
+    start_model: F64 | None = None,
 ) -> RoughnessFit:
     """Fit roughness values (and the band scales) by bounded SLSQP with variable projection.
 
@@ -211,9 +212,14 @@ def fit_roughness(
         Called with (iteration, alpha, chi2) after each SLSQP iteration.
     max_iterations
         SLSQP's iteration limit.
+    start_model
+        ``model(start)`` when already simulated (it is not simulated again).
     """
     cache: dict[tuple[float, ...], F64] = {}
     lo, hi = float(bounds[0]), float(bounds[1])
+    if start_model is not None and np.all((start >= lo) & (start <= hi)):
+        key = tuple(float(x) for x in np.round(np.clip(start, lo, hi) / ROUGHNESS_RESOLUTION))
+        cache[key] = np.asarray(start_model, dtype=float)
 
     def simulate(alpha: F64) -> F64:
         key = tuple(float(x) for x in np.round(np.clip(alpha, lo, hi) / ROUGHNESS_RESOLUTION))
@@ -259,7 +265,8 @@ def fit_roughness(
 
     x, flat = _scan_start(x0, chi2, lo, hi, unit)
     success, message = not flat, "not refined: the scan found chi2 flat" if flat else ""
-    lin = _linearise(simulate, x, measured, sigma, fit_scale, (lo, hi), fd)
+    if flat:  # the local std of a flat chi2 is noise: none is given (nor simulated)
+        lin = _linearise(simulate, x, measured, sigma, fit_scale, (lo, hi), None)
     for _ in range(0 if flat else MAX_PASSES):
         # SLSQP's first step is a steepest-descent step of unit length in its variables; in
         # u = (alpha - x) / h with h = 1 / sqrt(curvature of the objective at x) it is a
@@ -320,7 +327,7 @@ def _linearise(
     sigma: F64,
     fit_scale: bool,
     bounds: tuple[float, float],
-    fd: F64,
+    fd: F64 | None,
 ) -> _Linearised:
     """Scales, Jacobian and standard deviations at ``alpha`` (module doc: uncertainties)."""
     c = simulate(alpha)
@@ -330,6 +337,8 @@ def _linearise(
         n_b = c.shape[1]
         chi2_fixed = np.sum(w * (m - cc) ** 2, axis=0)
         scales = ScaleFit(np.ones(n_b), np.zeros(n_b), chi2_fixed, scales.n_used)
+    if fd is None:  # no roughness derivative: the scales' std at this roughness
+        return _Linearised(c, scales, np.full(alpha.size, np.nan), np.full(alpha.size, np.nan))
     jac_cols, derivative = _jacobian(simulate, alpha, c, scales.scale, bounds, fit_scale, fd)
     std_alpha, std_scale = _covariance(jac_cols, c, measured, sigma, scales.scale, fit_scale)
     if fit_scale:

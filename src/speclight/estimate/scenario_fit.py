@@ -255,8 +255,16 @@ def _fit_rough(
             values = ", ".join(f"{n}={a:.4f}" for n, a in zip(rough, alpha, strict=True))
             console.print(f"fit iteration {k}: roughness {values}, chi2 {chi2:.6g}")
 
+    c0 = first.dataset["count_rate"].transpose("time", "band").values.astype(float)
     return fit_roughness(
-        model, m, sigma, start, ROUGHNESS_BOUNDS, fit_scale=fit_scale, on_iteration=on_iteration
+        model,
+        m,
+        sigma,
+        start,
+        ROUGHNESS_BOUNDS,
+        fit_scale=fit_scale,
+        on_iteration=on_iteration,
+        start_model=np.where(usable[:, None], c0, np.nan),
     )
 
 
