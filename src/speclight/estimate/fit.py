@@ -445,6 +445,8 @@ def _scan_start(
     text = " and ".join(parts)
     if bounded:
         text += f"; it is bounded only on one side: {bounded[0]}"
+    if keep is x0 and float(x0[0]) != best:
+        text += f"; the start {float(x0[0]):.3g} is as good and is kept"
     return keep, text
 
 

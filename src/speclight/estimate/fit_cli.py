@@ -6,6 +6,7 @@ import json
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 import typer
 
 from speclight.errors import InputError
@@ -84,5 +85,6 @@ def run_fit(
     )
     typer.echo(f"albedo: {summary}")
     for name, (value, std) in result.roughness.items():
-        typer.echo(f"roughness {name}: {value:.4g} +- {std:.2g}")
+        spread = f"+- {std:.2g}" if np.isfinite(std) else "(not constrained)"
+        typer.echo(f"roughness {name}: {value:.4g} {spread}")
     typer.echo(f"wrote {output}" + (f" and {plot_file}" if plot_file else ""))
