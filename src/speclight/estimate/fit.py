@@ -150,7 +150,9 @@ class RoughnessFit:
         (K,) fitted roughness values and their standard deviations [1].
     scales
         The band scales at the fitted roughness (:class:`ScaleFit`; their ``scale_std`` from
-        the joint covariance, so they include the roughness's uncertainty).
+        the joint covariance, so they include the roughness's uncertainty; when ``flat``, at
+        least half the spread of the scales over the scanned roughness values whose chi2 is
+        within one reduced chi2 of the best).
     model
         (N, B) simulated rates at the fitted roughness (unscaled) [s-1].
     success
@@ -267,6 +269,13 @@ def fit_roughness(
     success, message = not flat, "not refined: the scan found chi2 flat" if flat else ""
     if flat:  # the local std of a flat chi2 is noise: none is given (nor simulated)
         lin = _linearise(simulate, x, measured, sigma, fit_scale, (lo, hi), None)
+        if fit_scale:  # the scales' std covers the roughness values the data cannot tell apart
+            tried = [x0, *[np.array([g]) for g in np.geomspace(lo, hi, SCAN_POINTS)]]
+            least = min(chi2(g) for g in tried)
+            alike = [g for g in tried if chi2(g) - least < unit(least)]
+            found = np.array([fit_scales(simulate(g), measured, sigma).scale for g in alike])
+            spread = (found.max(axis=0) - found.min(axis=0)) / 2
+            lin.scales.scale_std = np.maximum(lin.scales.scale_std, spread)
     for _ in range(0 if flat else MAX_PASSES):
         # SLSQP's first step is a steepest-descent step of unit length in its variables; in
         # u = (alpha - x) / h with h = 1 / sqrt(curvature of the objective at x) it is a
