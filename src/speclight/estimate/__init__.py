@@ -7,12 +7,14 @@ command line are built on them:
 * :mod:`.unmixing`: the linear mixing model x = S a (LS, NNLS, NNLS + normalisation, FCLS);
 * :mod:`.endmembers`: endmember extraction (ATGP, PCA, N-FINDR);
 * :mod:`.upsampling`: spectra from n band albedos (sigmoid polynomial, eq. 3-4);
-* :mod:`.fit` and :mod:`.scenario_fit`: band albedos and roughness fitted to measured rates.
+* :mod:`.fit`, :mod:`.roughness_fit`, :mod:`.scenario_fit`: band albedos and roughness
+  fitted to measured count rates (``speclight fit``).
 """
 
 from speclight.estimate.endmembers import EndmemberResult, extract_endmembers
-from speclight.estimate.fit import fit_roughness, fit_scales, shot_noise_sigma
+from speclight.estimate.fit import fit_scales, shot_noise_sigma
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
+from speclight.estimate.roughness_fit import fit_roughness
 from speclight.estimate.scenario_fit import FitResult, fit_scenario
 from speclight.estimate.unmixing import UNMIX_METHODS, UnmixResult, unmix
 from speclight.estimate.upsampling import UpsampledSpectrum, upsample

@@ -30,14 +30,9 @@ from numpy.typing import NDArray
 
 from speclight import schema
 from speclight.errors import InputError
-from speclight.estimate.fit import (
-    F64,
-    PROFILE_SIGMAS,
-    fit_roughness,
-    fit_scales,
-    shot_noise_sigma,
-)
+from speclight.estimate.fit import F64, fit_scales, shot_noise_sigma
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve
+from speclight.estimate.roughness_fit import PROFILE_SIGMAS, fit_roughness
 from speclight.estimate.upsampling import band_albedo
 from speclight.scenario import LoadedScenario
 
