@@ -9,6 +9,7 @@ removed by the next run writing to the same folder (see :mod:`speclight.io.outpu
 
 from __future__ import annotations
 
+import json
 import signal
 import sys
 import threading
@@ -230,6 +231,71 @@ def plot(
             )
         for path in written:
             typer.echo(f"wrote {path}")
+
+    _guarded(run)
+
+
+@app.command()
+def fit(
+    scenario: Annotated[Path, typer.Argument(help="Scenario YAML file (the fit's start).")],
+    measured: Annotated[
+        Path, typer.Argument(help="Measured light curves: CSV (time, <band>...) or NetCDF.")
+    ],
+    output: Annotated[
+        str, typer.Option("--output", "-o", metavar="FILE", help="Output FIT.json.")
+    ] = "fit.json",
+    free: Annotated[
+        str, typer.Option("--free", help="Parameters to fit: albedo, roughness or both (a,b).")
+    ] = "albedo",
+    bin_s: Annotated[
+        float | None, typer.Option("--bin-s", help="Average the measurements into S-second bins.")
+    ] = None,
+    plot_file: Annotated[
+        str | None, typer.Option("--plot", metavar="FIG.png", help="Figure: rates and ratios.")
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite existing outputs.")] = False,
+) -> None:
+    """Fit per-band albedos (with --free albedo,roughness also the roughness of every rough
+    material) so that the scenario's count rates match MEASURED; write FIT.json.
+
+    The scenario is simulated at the measured epochs, starting from its own reflectance and
+    roughness. Outputs are claimed as `simulate` claims its output. See docs/fit.md.
+    """
+
+    def run() -> None:
+        from speclight.estimate.measured import read_measured
+        from speclight.estimate.scenario_fit import fit_scenario, parse_free
+        from speclight.plot.figure_output import claim_outputs
+        from speclight.scenario import load_scenario
+
+        names = parse_free(free)
+        if bin_s is not None and not 0 < bin_s < float("inf"):
+            raise InputError(f"--bin-s = {bin_s!r} must be a duration > 0 s", field="--bin-s")
+        inputs = {"scenario file": scenario, "measurements": measured}
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+            result = fit_scenario(
+                load_scenario(scenario), read_measured(measured), free=names, bin_s=bin_s,
+                progress=sys.stderr.isatty(),
+            )  # fmt: skip
+            _raise_if_signalled()
+            claim.write((json.dumps(result.to_json(), indent=2) + "\n").encode())
+            if figure is not None:
+                from speclight.plot.fit_figure import fit_figure
+
+                figure.write(
+                    fit_figure(
+                        result.time_utc, result.measured_per_s, result.fitted_per_s,
+                        result.band_names,
+                    )
+                )  # fmt: skip
+        if not result.converged:
+            typer.echo(f"not converged: {result.message}", err=True)
+        albedos = zip(result.band_names, result.albedo, strict=True)
+        typer.echo("albedo: " + ", ".join(f"{b} {a:.4g}" for b, a in albedos))
+        for name, (value, std) in result.roughness.items():
+            spread = f"+- {std:.2g}" if std == std else "(not constrained)"  # NaN: unconstrained
+            typer.echo(f"roughness {name}: {value:.4g} {spread}")
+        typer.echo(f"wrote {output}" + (f" and {plot_file}" if plot_file else ""))
 
     _guarded(run)
 

@@ -14,6 +14,8 @@ command line are built on them:
 * :mod:`.upsample_io`, :mod:`.unmix_io` (with :mod:`.unmix_inputs`,
   :mod:`.endmember_spectra`, :mod:`.unmix_truth`, :mod:`.scenario_bands`): the
   ``speclight upsample`` and ``speclight unmix`` commands.
+* :mod:`.fit`, :mod:`.roughness_fit`, :mod:`.scenario_fit`: band albedos and roughness
+  fitted to measured count rates (``speclight fit``).
 """
 
 from speclight.estimate.accuracy import (
@@ -24,9 +26,12 @@ from speclight.estimate.accuracy import (
 )
 from speclight.estimate.endmember_spectra import endmembers_from_files, endmembers_from_scenario
 from speclight.estimate.endmembers import EndmemberResult, extract_endmembers
+from speclight.estimate.fit import fit_scales, shot_noise_sigma
 from speclight.estimate.ground_truth import fractions, material_signatures, true_contributions
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
+from speclight.estimate.roughness_fit import fit_roughness
 from speclight.estimate.scenario_bands import BandResponses, scenario_band_responses
+from speclight.estimate.scenario_fit import FitResult, fit_scenario
 from speclight.estimate.unmix_inputs import read_reflectance_factors
 from speclight.estimate.unmix_io import unmix_measured
 from speclight.estimate.unmixing import UNMIX_METHODS, UnmixResult, unmix
@@ -38,6 +43,7 @@ __all__ = [
     "UNMIX_METHODS",
     "BandResponses",
     "EndmemberResult",
+    "FitResult",
     "MeasuredLightCurve",
     "UnmixResult",
     "UpsampledSpectrum",
@@ -46,6 +52,9 @@ __all__ = [
     "endmembers_from_files",
     "endmembers_from_scenario",
     "extract_endmembers",
+    "fit_roughness",
+    "fit_scales",
+    "fit_scenario",
     "fractions",
     "in_reference_units",
     "material_signatures",
@@ -54,6 +63,7 @@ __all__ = [
     "read_measured",
     "read_reflectance_factors",
     "scenario_band_responses",
+    "shot_noise_sigma",
     "spectral_angle_rad",
     "true_contributions",
     "unmix",

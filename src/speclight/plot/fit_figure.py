@@ -1,0 +1,88 @@
+"""Figure of ``speclight fit``: measured and fitted count rates, and band signal ratios.
+
+The layout of the reference paper's Figures 9 and 10 (Nussbaum et al. 2022, "Spectral
+Light Curve Simulation for Parameter Estimation from Space Debris"): above, the count rate
+of each band, measured (solid) and fitted (dashed); below, the ratio of each band's rate to
+the rate of a reference band (the band with the largest summed measured signal), measured
+and fitted, at the epochs where the reference band is above :data:`FAINT` of its peak.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from speclight.plot.style import new_figure
+
+F64 = NDArray[np.float64]
+#: Band ratios are drawn where the reference band's fitted rate is at least this fraction of
+#: its peak (fainter epochs' measured ratios are noise over noise) [1].
+FAINT = 0.05
+
+
+def fit_figure(
+    time_utc: NDArray[np.datetime64], measured_per_s: F64, fitted_per_s: F64, band_names: list[str]
+) -> Any:
+    """The figure (a matplotlib ``Figure``) of one fit.
+
+    Parameters
+    ----------
+    time_utc
+        (N,) epochs, UTC.
+    measured_per_s, fitted_per_s
+        (N, B) measured and fitted count rates [s-1], NaN where not used.
+    band_names
+        (B,) band names.
+    """
+    import matplotlib.dates as mdates
+    from matplotlib import colormaps
+
+    fig = new_figure(7.0)
+    top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=[3, 2])
+    t = np.asarray(time_utc, dtype="datetime64[ns]")
+    m = np.asarray(measured_per_s, dtype=float)
+    f = np.asarray(fitted_per_s, dtype=float)
+    colours = [colormaps["tab10"](j % 10) for j in range(len(band_names))]
+    for j, name in enumerate(band_names):
+        top.plot(t, m[:, j], "-", color=colours[j], lw=1.0, label=f"{name}")
+        top.plot(t, f[:, j], "--", color=colours[j], lw=1.2)
+    top.set_ylabel("count rate [s$^{-1}$]")
+    top.set_title("measured (solid) and fitted (dashed) count rates")
+    top.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False)
+    ref = int(np.nanargmax(np.nansum(m, axis=0))) if np.any(np.isfinite(m)) else 0
+    # ratios of faint epochs are noise over noise: drawn only where the reference band's
+    # fitted rate reaches FAINT of its peak
+    peak = np.nanmax(f[:, ref]) if np.any(np.isfinite(f[:, ref])) else np.nan
+    bright = f[:, ref] >= FAINT * peak
+    m = np.where(bright[:, None], m, np.nan)
+    f = np.where(bright[:, None], f, np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for j, name in enumerate(band_names):
+            if j == ref:
+                continue
+            bottom.plot(t, m[:, j] / m[:, ref], "-", color=colours[j], lw=0.8,
+                        label=f"{name}/{band_names[ref]}")  # fmt: skip
+            bottom.plot(t, f[:, j] / f[:, ref], "--", color=colours[j], lw=1.2)
+    bottom.set_ylabel(f"ratio to {band_names[ref]}")
+    bottom.set_title(
+        "signal ratios between bands, measured (solid) and fitted (dashed), where the "
+        f"reference band is above {FAINT:.0%} of its peak",
+        fontsize="medium",
+    )
+    if len(band_names) > 1:
+        bottom.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small",
+                      frameon=False)  # fmt: skip
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratios = np.delete(f, ref, axis=1) / f[:, [ref]]
+        finite = ratios[np.isfinite(ratios)]
+        if finite.size:  # the measured ratios of faint epochs can be wild: frame the model's
+            lo, hi = np.percentile(finite, [0.5, 99.5])
+            pad = 0.25 * (hi - lo) + 0.05 * abs(hi)
+            bottom.set_ylim(lo - pad, hi + pad)
+    bottom.xaxis.set_major_locator(mdates.AutoDateLocator(minticks=5, maxticks=13))
+    bottom.xaxis.set_major_formatter(mdates.DateFormatter("%H:%M:%S"))
+    day = np.datetime_as_string(t[0], unit="D") if t.size else ""
+    bottom.set_xlabel(f"time [UTC] on {day}")
+    return fig
