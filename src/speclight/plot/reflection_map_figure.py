@@ -52,11 +52,9 @@ def _panel(ax: Any, grid: tuple, values: NDArray[np.float64], track: tuple, titl
 
     lon_e, lat_e, pix = grid
     image = np.ma.masked_invalid(values[pix])
-    cmap = colormaps["viridis"].copy()
-    cmap.set_bad("0.85")
+    cmap = colormaps["viridis"].with_extremes(bad="0.85")
     mesh = ax.pcolormesh(lon_e, lat_e, image, cmap=cmap, shading="flat", rasterized=True)
-    ax.plot(*track, color="white", lw=1.0, alpha=0.9)
-    ax.plot(*track, ls="none", marker=".", ms=1.5, color="black", alpha=0.5)
+    ax.plot(*track, color="white", lw=0.8, marker=".", ms=2.0, alpha=0.9)
     ax.set_title(title, fontsize="medium")
     ax.grid(alpha=0.4)
     ax.tick_params(labelsize="x-small")
