@@ -13,7 +13,9 @@ command line are built on them:
   aperture (Sun, coaxial lasers);
 * :mod:`.upsample_io`, :mod:`.unmix_io` (with :mod:`.unmix_inputs`,
   :mod:`.endmember_spectra`, :mod:`.unmix_truth`, :mod:`.scenario_bands`): the
-  ``speclight upsample`` and ``speclight unmix`` commands.
+  ``speclight upsample`` and ``speclight unmix`` commands;
+* :mod:`.reflection_map` (HEALPix maps in the body frame) and :mod:`.reflection_map_io`
+  (``speclight reflection-map``).
 """
 
 from speclight.estimate.accuracy import (
@@ -26,6 +28,8 @@ from speclight.estimate.endmember_spectra import endmembers_from_files, endmembe
 from speclight.estimate.endmembers import EndmemberResult, extract_endmembers
 from speclight.estimate.ground_truth import fractions, material_signatures, true_contributions
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
+from speclight.estimate.reflection_map import ReflectionMap, reflection_map
+from speclight.estimate.reflection_map_io import reflection_map_measured
 from speclight.estimate.scenario_bands import BandResponses, scenario_band_responses
 from speclight.estimate.unmix_inputs import read_reflectance_factors
 from speclight.estimate.unmix_io import unmix_measured
@@ -39,6 +43,7 @@ __all__ = [
     "BandResponses",
     "EndmemberResult",
     "MeasuredLightCurve",
+    "ReflectionMap",
     "UnmixResult",
     "UpsampledSpectrum",
     "bin_light_curve",
@@ -53,6 +58,8 @@ __all__ = [
     "read_fit_albedos",
     "read_measured",
     "read_reflectance_factors",
+    "reflection_map",
+    "reflection_map_measured",
     "scenario_band_responses",
     "spectral_angle_rad",
     "true_contributions",
