@@ -54,7 +54,7 @@ def _panel(ax: Any, grid: tuple, values: NDArray[np.float64], track: tuple, titl
     image = np.ma.masked_invalid(values[pix])
     cmap = colormaps["viridis"].with_extremes(bad="0.85")
     mesh = ax.pcolormesh(lon_e, lat_e, image, cmap=cmap, shading="flat", rasterized=True)
-    ax.plot(*track, color="white", lw=0.8, marker=".", ms=2.0, alpha=0.9)
+    ax.plot(*track, color="white", lw=0.6, alpha=0.8)
     ax.set_title(title, fontsize="medium")
     ax.grid(alpha=0.4)
     ax.tick_params(labelsize="x-small")
