@@ -102,8 +102,7 @@ def reflection_map_measured(
     """
     nside = check_nside(nside)
     check_light(light)
-    if endmembers:
-        check_unmix_options(endmembers, None, None, method, light)
+    check_unmix_options(endmembers or [SCENARIO_ENDMEMBERS], None, None, method, light)
     p = Path(measured)
     is_nc = p.suffix.lower() in NETCDF_SUFFIXES
     if endmembers == [SCENARIO_ENDMEMBERS] and loaded is None and is_nc:
