@@ -19,8 +19,11 @@ the pixel centres ``lon(pixel)``, ``lat(pixel)`` [degree] and the observed track
 ``healpix_order = "ring"``, ``frame = "body"``. With endmembers (spectrum files or the
 scenario's materials, as for ``speclight unmix``) every pixel is unmixed (eq. 6):
 ``abundance(endmember, pixel)``, ``residual(pixel)``, ``endmember_signature(endmember, band)``;
-a pixel's signatures are the mean over its epochs of each epoch's source-weighted signatures,
-which is exact for the pixel's mean factor (eq. 5 is linear in the rate).
+a pixel's signatures are the mean over its epochs of each epoch's source-weighted signatures
+(the atmosphere changes them along a pass). The pixel's mean factor is
+``mean_t sum_k g_k(t) s_k(t)``, so this is exact where the contributions ``g_k`` or the
+signatures ``s_k`` are the same for the pixel's epochs, and otherwise off by their
+covariance within the pixel (small: a pixel's epochs are close in time or in geometry).
 """
 
 from __future__ import annotations
