@@ -26,8 +26,9 @@ from speclight.errors import InputError
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
 
-#: Finest map: nside 1024 is 12.6 million pixels (100 MB per band in float64).
-MAX_NSIDE = 1024
+#: Finest map: nside 256 is 786,432 pixels of 0.23 deg (6 MB per band and variable in
+#: float64), far finer than a pass of thousands of epochs fills.
+MAX_NSIDE = 256
 
 
 def check_nside(nside: int, field: str = "--nside") -> int:

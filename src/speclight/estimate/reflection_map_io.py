@@ -275,23 +275,33 @@ def _with_abundance(
             field="--endmembers",
         )
     n_pix = ds.sizes["pixel"]
+    # unmix the mapped pixels only (their signatures: the mean over each pixel's epochs)
+    mapped, slot = np.unique(pixel[pixel >= 0], return_inverse=True)
     if members.signatures_epoch is None:
-        sig = np.broadcast_to(members.signatures, (n_pix, *members.signatures.shape))
+        sig = np.broadcast_to(members.signatures, (mapped.size, *members.signatures.shape))
     else:
-        sig, _ = pixel_mean(pixel, members.signatures_epoch, n_pix)
-    result = unmix_per_epoch(ds["reflectance_factor"].values.T, sig, method)  # type: ignore[arg-type]
+        local = np.full(pixel.shape, -1, dtype=np.int64)
+        local[pixel >= 0] = slot
+        sig, _ = pixel_mean(local, members.signatures_epoch, mapped.size)
+    abundance = np.full((n_pix, len(members.names)), np.nan)
+    residual = np.full(n_pix, np.nan)
+    if mapped.size:
+        x = ds["reflectance_factor"].values.T[mapped]
+        result = unmix_per_epoch(x, sig, method)  # type: ignore[arg-type]
+        abundance[mapped] = result.abundance
+        residual[mapped] = result.residual
     unit = "1" if method in ("nnls-norm", "fcls") else "m2 sr-1"
     ds = ds.assign_coords(
         endmember=("endmember", np.array(members.names, dtype=str), {"long_name": "endmember"})
     )
     ds["abundance"] = (
         ("endmember", "pixel"),
-        result.abundance.T,
+        abundance.T,
         {"units": unit, "long_name": f"contribution of each endmember to the pixel ({method})"},
     )
     ds["residual"] = (
         "pixel",
-        result.residual,
+        residual,
         {"units": "m2 sr-1", "long_name": "norm over the bands of reflectance_factor - S a"},
     )
     ds["endmember_signature"] = (
