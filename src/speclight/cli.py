@@ -465,6 +465,121 @@ def unmix(
     _guarded(run)
 
 
+@app.command("reflection-map")
+def reflection_map_cmd(
+    measured: Annotated[
+        list[Path],
+        typer.Argument(
+            help="MEASURED first: a speclight NetCDF, or a CSV of count rates (with "
+            "--scenario); any further arguments are more --endmembers files.",
+            metavar="MEASURED [E2.csv ...]",
+        ),
+    ],
+    output: Annotated[
+        str, typer.Option("--output", "-o", metavar="FILE", help="Output NetCDF (RMAP.nc).")
+    ] = "reflection-map.nc",
+    nside: Annotated[
+        int, typer.Option("--nside", help="HEALPix resolution, a power of 2 (12 nside^2 pixels).")
+    ] = 16,
+    scenario: Annotated[
+        Path | None,
+        typer.Option(
+            "--scenario",
+            help="Scenario YAML: the geometry at the epochs of a CSV (or of a NetCDF without "
+            "body-frame directions), the lasers' lines, -e scenario.",
+        ),
+    ] = None,
+    source: Annotated[
+        str | None,
+        typer.Option(
+            "--source",
+            help="sun (map along the phase vector) or laser (coaxial lasers: along the "
+            "observer direction); default: the lasers' where the data have no solar factors.",
+        ),
+    ] = None,
+    endmembers: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--endmembers",
+            "-e",
+            metavar="FILE",
+            help="Endmember spectrum CSV to unmix every pixel with (repeat for each), or "
+            "'scenario' for the scenario's materials.",
+        ),
+    ] = None,
+    method: Annotated[
+        str, typer.Option("--method", help="Unmixing: ls, nnls, nnls-norm (default) or fcls.")
+    ] = "nnls-norm",
+    bin_s: Annotated[
+        float | None, typer.Option("--bin-s", help="Average epochs into bins of S seconds.")
+    ] = None,
+    band: Annotated[
+        str | None, typer.Option("--band", help="Band of the figure (default: most pixels).")
+    ] = None,
+    plot_file: Annotated[
+        str | None, typer.Option("--plot", metavar="FIG", help="Figure (.png, .pdf, .svg).")
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite existing outputs.")] = False,
+) -> None:
+    """Reflection map: each epoch's band reflectance factor placed on a HEALPix sphere (RING)
+    in the body frame along its phase vector (the observer direction under coaxial lasers),
+    averaged per pixel (Kucharski; paper section 5.3). Writes RMAP.nc:
+    reflectance_factor(band, pixel), n_samples(pixel), range_offset(band, pixel) where the
+    input has ranging, abundance(endmember, pixel) with --endmembers.
+
+    Example: speclight reflection-map out.nc -o rmap.nc --nside 16 --plot rmap.png
+    """
+
+    def run() -> None:
+        from speclight.estimate.reflection_map import check_nside
+        from speclight.estimate.reflection_map_io import reflection_map_measured
+        from speclight.estimate.source_spectrum import check_light
+        from speclight.io.netcdf import dataset_bytes
+        from speclight.plot.figure_output import claim_outputs
+
+        members = _endmember_files(measured, endmembers)
+        check_nside(nside)
+        check_light(source)
+        inputs: dict[str, Path | str] = {"measured file": measured[0]}
+        if scenario is not None:
+            inputs["scenario file"] = scenario
+        for i, path in enumerate(members or []):
+            inputs[f"endmember file {i + 1}"] = path
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+            loaded = None
+            if scenario is not None:
+                from speclight.scenario import load_scenario
+
+                loaded = load_scenario(scenario)
+            ds = reflection_map_measured(
+                measured[0],
+                nside=nside,
+                loaded=loaded,
+                light=source,
+                endmembers=members,
+                method=method,
+                bin_s=bin_s,
+                progress=sys.stderr.isatty(),
+            )
+            _raise_if_signalled()
+            fig = None
+            if figure is not None:
+                from speclight.plot.reflection_map_figure import reflection_map_figure
+
+                fig = reflection_map_figure(ds, band)
+            claim.write(dataset_bytes(ds))
+            if figure is not None:
+                figure.write(fig)
+        mapped = int((ds["n_samples"].values > 0).sum())
+        typer.echo(
+            f"{int(ds['n_samples'].values.sum())} epochs in {mapped} of "
+            f"{ds.sizes['pixel']} pixels (nside {nside}, {ds.attrs['light']})"
+        )
+        typer.echo(f"wrote {output}" + (f" and {plot_file}" if plot_file else ""))
+
+    _guarded(run)
+
+
 @app.command()
 def info() -> None:
     """Versions of speclight and its engines, render variants, and data coverage."""

@@ -13,9 +13,11 @@ command line are built on them:
   aperture (Sun, coaxial lasers);
 * :mod:`.upsample_io`, :mod:`.unmix_io` (with :mod:`.unmix_inputs`,
   :mod:`.endmember_spectra`, :mod:`.unmix_truth`, :mod:`.scenario_bands`): the
-  ``speclight upsample`` and ``speclight unmix`` commands.
+  ``speclight upsample`` and ``speclight unmix`` commands;
 * :mod:`.fit`, :mod:`.roughness_fit`, :mod:`.scenario_fit`: band albedos and roughness
-  fitted to measured count rates (``speclight fit``).
+  fitted to measured count rates (``speclight fit``);
+* :mod:`.reflection_map` (HEALPix maps in the body frame) and :mod:`.reflection_map_io`
+  (``speclight reflection-map``).
 """
 
 from speclight.estimate.accuracy import (
@@ -29,6 +31,8 @@ from speclight.estimate.endmembers import EndmemberResult, extract_endmembers
 from speclight.estimate.fit import fit_scales, shot_noise_sigma
 from speclight.estimate.ground_truth import fractions, material_signatures, true_contributions
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
+from speclight.estimate.reflection_map import ReflectionMap, reflection_map
+from speclight.estimate.reflection_map_io import reflection_map_measured
 from speclight.estimate.roughness_fit import fit_roughness
 from speclight.estimate.scenario_bands import BandResponses, scenario_band_responses
 from speclight.estimate.scenario_fit import FitResult, fit_scenario
@@ -45,6 +49,7 @@ __all__ = [
     "EndmemberResult",
     "FitResult",
     "MeasuredLightCurve",
+    "ReflectionMap",
     "UnmixResult",
     "UpsampledSpectrum",
     "bin_light_curve",
@@ -62,6 +67,8 @@ __all__ = [
     "read_fit_albedos",
     "read_measured",
     "read_reflectance_factors",
+    "reflection_map",
+    "reflection_map_measured",
     "scenario_band_responses",
     "shot_noise_sigma",
     "spectral_angle_rad",

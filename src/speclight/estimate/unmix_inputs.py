@@ -89,7 +89,7 @@ class ReflectanceFactors:
     material_labels: list[str] | None = None
 
 
-def _bin(time: NDArray[np.datetime64], values: F64, bin_s: float, src: str) -> tuple:
+def bin_factors(time: NDArray[np.datetime64], values: F64, bin_s: float, src: str) -> tuple:
     """Average the rows of ``values`` (N, ...) into ``bin_s`` bins (bin_light_curve)."""
     flat = values.reshape(values.shape[0], -1)
     lc = MeasuredLightCurve(
@@ -185,10 +185,10 @@ def read_reflectance_factors(
         time = ds["time"].values.astype("datetime64[ns]")
     if bin_s is not None:
         t0 = time
-        time, factor = _bin(t0, factor, bin_s, src)
-        _, source = _bin(t0, source, bin_s, src)
+        time, factor = bin_factors(t0, factor, bin_s, src)
+        _, source = bin_factors(t0, source, bin_s, src)
         if truth is not None:
-            _, truth = _bin(t0, truth, bin_s, src)
+            _, truth = bin_factors(t0, truth, bin_s, src)
     return ReflectanceFactors(
         time, factor, bands, f"{src}: {what}", truth, names, source, chosen, labels
     )

@@ -175,7 +175,7 @@ def unmix_measured(
         else:
             members = endmembers_from_files(list(endmembers), data.bands, data.source_W_m2_nm)
             origin = "spectra " + ", ".join(str(p) for p in endmembers)
-        _check_distinct(members)
+        check_distinct(members)
         if len(members.names) > n_bands:
             raise InputError(
                 f"{len(members.names)} endmembers is more than the {n_bands} bands: the "
@@ -190,7 +190,9 @@ def unmix_measured(
     return ds
 
 
-def _check_distinct(members: Endmembers) -> None:
+def check_distinct(members: Endmembers) -> None:
+    """Refuse endmembers whose band signatures are proportional (an unmixing cannot tell
+    them apart)."""
     angle = accuracy.spectral_angle_rad(members.signatures, members.signatures)
     np.fill_diagonal(angle, np.inf)
     i, j = np.unravel_index(np.argmin(angle), angle.shape)
