@@ -147,7 +147,9 @@ def reflectivity_map(
     target = build_target(loaded)
     session = RenderSession.create(sc.render.mode, sc.render.variant, target.materials)
     wl = wavelength_grid_nm(sc.spectrum)
-    kernel = instrument_response(loaded, wl, np.zeros((1, wl.size)), np.ones((1, wl.size)), np.ones(1))
+    kernel = instrument_response(
+        loaded, wl, np.zeros((1, wl.size)), np.ones((1, wl.size)), np.ones(1)
+    )
     band_names = kernel.band_names
     dirs = healpix_directions(nside)
     parameters = {
@@ -239,7 +241,7 @@ def _render_chunk(
         obs,
         solar,
         wl,
-        mode=sc.render.mode,
+        mode=session.mode,
         resolution_px=sc.render.resolution_px,
         samples_per_pixel=sc.render.samples_per_pixel,
         seed=(sc.render.seed + k) % 2**32,  # each chunk its own Monte Carlo samples

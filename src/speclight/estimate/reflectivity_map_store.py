@@ -97,7 +97,7 @@ def open_or_create(
     if path.exists() and not force:
         try:
             group = zarr.open_group(str(path), mode="r+")
-            old = dict(group.attrs.get("parameters", {}))
+            old: dict[str, Any] = dict(group.attrs.get("parameters", {}))  # type: ignore[arg-type]
             complete = bool(group.attrs.get("complete", False))
         except Exception as exc:  # not a Zarr group at all
             raise InputError(
@@ -126,7 +126,11 @@ def open_or_create(
     n_wl, n_band = shapes["wavelength"], shapes["band"]
     n_chunks = -(-d // chunk)
     group.create_array(
-        "intensity", shape=(d, p, r, n_wl), chunks=(chunk, p, r, n_wl), dtype="f4", fill_value=np.nan
+        "intensity",
+        shape=(d, p, r, n_wl),
+        chunks=(chunk, p, r, n_wl),
+        dtype="f4",
+        fill_value=np.nan,
     )
     if n_band:
         group.create_array(
@@ -136,7 +140,9 @@ def open_or_create(
             dtype="f4",
             fill_value=np.nan,
         )
-    group.create_array("chunk_state", shape=(n_chunks,), chunks=(n_chunks,), dtype="u1", fill_value=0)
+    group.create_array(
+        "chunk_state", shape=(n_chunks,), chunks=(n_chunks,), dtype="u1", fill_value=0
+    )
     group.attrs.update({"format": FORMAT_NAME, "parameters": parameters, "complete": False})
     return group, False
 
@@ -158,7 +164,7 @@ def chunk_states(group: Any) -> NDArray[np.uint8]:
 
 def mark(group: Any, k: int, state: int, message: str | None = None) -> None:
     """Record chunk ``k`` as done or failed (with its message)."""
-    failed = dict(group.attrs.get("failed_chunks", {}))
+    failed: dict[str, Any] = dict(group.attrs.get("failed_chunks", {}))
     if state == FAILED:
         failed[str(k)] = message or "failed"
     else:

@@ -62,7 +62,7 @@ def _open_group(path: Path) -> Any:
     if attrs.get("format") != FORMAT_NAME:
         raise InputError(f"{path} is not a speclight reflectivity map", field=FIELD)
     if not attrs.get("complete", False):
-        failed = attrs.get("failed_chunks", {})
+        failed: Any = attrs.get("failed_chunks", {})
         why = f"{len(failed)} chunk(s) failed" if failed else "it was interrupted"
         raise InputError(
             f"{path} is an unfinished reflectivity map ({why}); rerun speclight "
