@@ -13,7 +13,10 @@ command line are built on them:
   aperture (Sun, coaxial lasers);
 * :mod:`.upsample_io`, :mod:`.unmix_io` (with :mod:`.unmix_inputs`,
   :mod:`.endmember_spectra`, :mod:`.unmix_truth`, :mod:`.scenario_bands`): the
-  ``speclight upsample`` and ``speclight unmix`` commands.
+  ``speclight upsample`` and ``speclight unmix`` commands;
+* :mod:`.reflectivity_map` (with :mod:`.reflectivity_map_store`): ``speclight
+  reflectivity-map``, the target rendered over body-frame geometries into a Zarr store
+  (read back by :mod:`speclight.render.map_lookup`).
 """
 
 from speclight.estimate.accuracy import (
@@ -26,6 +29,7 @@ from speclight.estimate.endmember_spectra import endmembers_from_files, endmembe
 from speclight.estimate.endmembers import EndmemberResult, extract_endmembers
 from speclight.estimate.ground_truth import fractions, material_signatures, true_contributions
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
+from speclight.estimate.reflectivity_map import MapRun, reflectivity_map
 from speclight.estimate.scenario_bands import BandResponses, scenario_band_responses
 from speclight.estimate.unmix_inputs import read_reflectance_factors
 from speclight.estimate.unmix_io import unmix_measured
@@ -38,6 +42,7 @@ __all__ = [
     "UNMIX_METHODS",
     "BandResponses",
     "EndmemberResult",
+    "MapRun",
     "MeasuredLightCurve",
     "UnmixResult",
     "UpsampledSpectrum",
@@ -53,6 +58,7 @@ __all__ = [
     "read_fit_albedos",
     "read_measured",
     "read_reflectance_factors",
+    "reflectivity_map",
     "scenario_band_responses",
     "spectral_angle_rad",
     "true_contributions",

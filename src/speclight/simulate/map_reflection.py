@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -35,6 +37,7 @@ def map_reflection(loaded: LoadedScenario, geo: Geometry, wavelength_nm: F64) ->
     idx = np.flatnonzero(lit)
     if idx.size:
         the_map = load_map(loaded.resolve(sc.render.map_file))
+        _warn_outside(the_map.header.phase_angle_deg, geo.phase_angle_deg[idx])
         at_1au = the_map.intensity_1au(
             geo.sun_direction_body[idx], geo.observer_direction_body[idx]
         )
@@ -50,3 +53,17 @@ def map_reflection(loaded: LoadedScenario, geo: Geometry, wavelength_nm: F64) ->
         variant="map",
         flags=np.zeros(n, dtype=np.uint8),
     )
+
+
+def _warn_outside(stored_deg: F64, phase_deg: F64) -> None:
+    """A notice when epochs' phase angles lie outside the map's (they are clamped)."""
+    lo, hi = float(stored_deg[0]), float(stored_deg[-1])
+    outside = int(np.count_nonzero((phase_deg < lo - 0.5) | (phase_deg > hi + 0.5)))
+    if outside:
+        warnings.warn(
+            f"{outside} epochs have phase angles outside the map's {lo:g}..{hi:g} deg "
+            f"(this pass: {np.nanmin(phase_deg):.0f}..{np.nanmax(phase_deg):.0f} deg); they "
+            "take the nearest stored phase angle: make the map with --phase-angles-deg "
+            "covering the pass",
+            stacklevel=2,
+        )
