@@ -89,7 +89,7 @@ def test_lookup_between_stored_phase_angles_is_linear(sphere_map):
     np.testing.assert_allclose(m.intensity_1au(s, o), expected, rtol=TOLERANCE)
 
 
-def test_map_mode_pass_scales_by_sun_distance_and_shadow(sphere_map):
+def test_map_mode_pass_scales_by_sun_distance(sphere_map):
     folder, _ = sphere_map
     _, loaded = write_scenario(
         folder,

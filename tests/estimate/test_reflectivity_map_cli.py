@@ -67,6 +67,15 @@ def test_output_is_an_existing_file(scenario, tmp_path):
     _one_line_error(result, 2, "--output", "not a Zarr store")
 
 
+def test_force_never_deletes_a_folder_that_is_not_a_map(scenario, tmp_path):
+    folder = tmp_path / "data"
+    folder.mkdir()
+    (folder / "precious.txt").write_text("keep me")
+    result = _run("reflectivity-map", str(scenario), "-o", str(folder), "--force")
+    _one_line_error(result, 2, "--output", "not a speclight reflectivity map")
+    assert (folder / "precious.txt").read_text() == "keep me"
+
+
 def _map_scenario(tmp_path: Path, map_file: str, step_nm: int = 100) -> Path:
     path = tmp_path / "pass.yaml"
     render = f"render: {{mode: map, map_file: {map_file}}}"

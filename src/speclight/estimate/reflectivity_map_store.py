@@ -119,7 +119,13 @@ def open_or_create(
                 field=FIELD,
             )
         return group, True
-    if path.exists():
+    if path.exists():  # --force: replace a map, never another folder
+        if any(path.iterdir()) and _format_of(path) != FORMAT_NAME:
+            raise InputError(
+                f"{path} is a folder but not a speclight reflectivity map; --force replaces "
+                "only maps: choose another name",
+                field=FIELD,
+            )
         shutil.rmtree(path)
     group = zarr.open_group(str(path), mode="w", zarr_format=3)
     d, p, r = shapes["direction"], shapes["phase"], shapes["roll"]
@@ -171,3 +177,14 @@ def mark(group: Any, k: int, state: int, message: str | None = None) -> None:
         failed.pop(str(k), None)
     group.attrs["failed_chunks"] = failed
     group["chunk_state"][k] = state
+
+
+def _format_of(path: Path) -> str | None:
+    """The ``format`` attribute of the Zarr group at ``path`` (``None`` if it is none)."""
+    import json
+
+    try:
+        meta = json.loads((path / "zarr.json").read_text())
+        return str(meta.get("attributes", {}).get("format"))
+    except (OSError, ValueError, AttributeError):
+        return None
