@@ -20,9 +20,10 @@ def map_scenario_text(
     step_nm: int = 20,
     target: str | None = None,
     render: str | None = None,
+    example: str = "box-wing",
 ) -> str:
     """The box-wing example with a coarser render and grid; another target or render line."""
-    text = example_text("box-wing")
+    text = example_text(example)
     text = re.sub(r"resolution_px: \d+", f"resolution_px: {resolution_px}", text)
     text = re.sub(r"step_nm: \d+", f"step_nm: {step_nm}", text)
     if target is not None:

@@ -159,7 +159,9 @@ def reflectivity_map(
         "chunk": int(chunk),
         "scenario_sha256": hashlib.sha256(loaded.yaml_text.encode()).hexdigest(),
     }
+    ranging = bool(sc.illumination.lasers) and 0.0 in angles
     shapes = {
+        "ranging": int(ranging),
         "direction": len(dirs),
         "phase": len(angles),
         "roll": n_rolls,
@@ -200,6 +202,9 @@ def reflectivity_map(
                 group["intensity"][lo:hi] = inten.astype(np.float32)
                 if band_names:
                     group["count_rate"][lo:hi] = rate.astype(np.float32)
+                if ranging:
+                    offset = coaxial_range_offset_m(target, session, dirs[lo:hi], wl, loaded)
+                    group["range_offset"][lo:hi] = offset.astype(np.float32)
                 store.mark(group, k, store.DONE)
             except Exception as exc:  # recorded, the run goes on
                 store.mark(group, k, store.FAILED, f"{type(exc).__name__}: {exc}")
@@ -267,6 +272,34 @@ def _render_chunk(
     return inten, rate.reshape(n, shapes["phase"], shapes["roll"], -1)
 
 
+def coaxial_range_offset_m(
+    target: Any, session: Any, dirs: F64, wl: F64, loaded: LoadedScenario
+) -> F64:
+    """Mean one-way range offset (n, L) [m] of a coaxial laser's return per wavelength bin.
+
+    ``speclight.render.laser_returns`` (single scattering, the centre of mass at the body
+    origin as in ``simulate``): the intensity-weighted mean of each pixel's offset
+    ``-(p - c) . o`` (negative: in front of the centre of mass), per bin, so that a laser
+    line at any wavelength of the grid reads its bin. NaN where nothing returns.
+    """
+    from speclight.render.laser_returns import LaserLight, render_laser_returns
+
+    light = LaserLight(dirs, np.arange(wl.size), np.ones((len(dirs), wl.size)))
+    edges = np.array([-1e9, 1e9])  # one bin: the first moment is exact, histograms not kept
+    returns = render_laser_returns(
+        target,
+        dirs,
+        [light],
+        wl,
+        resolution_px=loaded.scenario.render.resolution_px,
+        bin_edges_m=edges,
+        session=session,
+    )
+    total = returns.intensity_W_sr_nm(0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(total > 0, returns.moment_m[0] / total, np.nan)
+
+
 def _metadata(
     loaded: LoadedScenario, band_names: list[str], nside: int, variant: str
 ) -> dict[str, Any]:
@@ -289,6 +322,7 @@ def _metadata(
         "units": {
             "intensity": "W sr-1 nm-1",
             "count_rate": "s-1",
+            "range_offset": "m",
             "wavelength": "nm",
             "phase_angle_deg": "deg",
             "roll_deg": "deg",

@@ -8,6 +8,9 @@ Layout (Zarr format 3, a folder ``MAP.zarr``):
 * ``count_rate(direction, phase, roll, band)`` float32 [s-1]: photo-electrons per second
   for a range of 1 m, an aperture of 1 m^2, no atmosphere (transmission 1), the scenario's
   optics, QE and bands;
+* ``range_offset(direction, wavelength)`` float32 [m], only for a scenario with lasers and
+  phase angle 0 among the map's: a coaxial laser's mean one-way range offset from the
+  centre of mass per wavelength bin (single scattering; range histograms are not stored);
 * ``direction_body(direction, xyz)``, ``phase_angle_deg(phase)``, ``roll_deg(roll)``,
   ``wavelength(wavelength)`` [nm];
 * ``chunk_state(chunk)`` uint8: 0 to do, 1 done, 2 failed (each written after its chunk's
@@ -145,6 +148,10 @@ def open_or_create(
             chunks=(chunk, p, r, n_band),
             dtype="f4",
             fill_value=np.nan,
+        )
+    if shapes.get("ranging"):
+        group.create_array(
+            "range_offset", shape=(d, n_wl), chunks=(chunk, n_wl), dtype="f4", fill_value=np.nan
         )
     group.create_array(
         "chunk_state", shape=(n_chunks,), chunks=(n_chunks,), dtype="u1", fill_value=0
