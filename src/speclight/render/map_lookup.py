@@ -9,7 +9,9 @@ epoch's intensity is interpolated:
   ``bilinear_interpolation_weights``: the 4 nearest pixel centres);
 * linearly in phase angle between the two stored angles around it (clamped to the first
   and last stored angle outside their range);
-* linearly and periodically in roll (all rolls are equal at phase angle 0).
+* linearly and periodically in roll (all rolls are equal at phase angle 0), the roll
+  measured in each of the 4 pixel centres' own reference frame (``u`` projected on it), so
+  that the interpolation is smooth across the poles of the roll reference.
 
 No Mitsuba here: reading the map and interpolating is numpy and astropy-healpix only.
 """
@@ -25,7 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError
-from speclight.render.map_geometry import lonlat_deg, map_coordinates
+from speclight.render.map_geometry import lonlat_deg, map_coordinates, roll_reference
 
 F64 = NDArray[np.float64]
 FIELD = "render.map_file"
@@ -125,7 +127,7 @@ class ReflectivityMap:
         from astropy import units as u
         from astropy_healpix import bilinear_interpolation_weights
 
-        p, a, r = map_coordinates(sun_body, observer_body)
+        p, a, _ = map_coordinates(sun_body, observer_body)
         n = len(p)
         out = np.full((n, self.intensity_W_sr_nm.shape[-1]), np.nan)
         ok = np.isfinite(a)
@@ -136,15 +138,31 @@ class ReflectivityMap:
             lon * u.deg, lat * u.deg, self.header.nside, order="ring"
         )
         j, w_phase = _phase_weights(self.header.phase_angle_deg, np.degrees(a[ok]))
-        k, w_roll = _roll_weights(self.header.roll_deg.size, r[ok])
+        u = _plane_axis(sun_body, observer_body)[ok]
         acc = np.zeros((int(ok.sum()), out.shape[1]))
         for i in range(4):
+            # the roll in the reference frame of this pixel centre (the frames of neighbouring
+            # pixels differ by their longitude difference, much near the poles)
+            e_lon, e_lat = roll_reference(self.direction_body[pix[i]])
+            roll = np.arctan2(np.sum(u * e_lat, axis=1), np.sum(u * e_lon, axis=1))
+            k, w_roll = _roll_weights(self.header.roll_deg.size, roll)
             for jj in range(2):
                 for kk in range(2):
                     w = w_pix[i] * w_phase[jj] * w_roll[kk]
                     acc += w[:, None] * self.intensity_W_sr_nm[pix[i], j[jj], k[kk]]
         out[ok] = acc
         return out
+
+
+def _plane_axis(sun: ArrayLike, observer: ArrayLike) -> F64:
+    """``u = normalize(sun - observer)`` (N, 3): the Sun's side of the Sun-observer plane
+    (any unit vector at phase angle 0, where the roll does not matter)."""
+    s = np.atleast_2d(np.asarray(sun, dtype=float))
+    o = np.atleast_2d(np.asarray(observer, dtype=float))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d = s / np.linalg.norm(s, axis=1)[:, None] - o / np.linalg.norm(o, axis=1)[:, None]
+        n = np.linalg.norm(d, axis=1)
+    return np.where((n > 1e-12)[:, None], d / np.where(n > 1e-12, n, 1.0)[:, None], [1.0, 0, 0])
 
 
 def _phase_weights(stored_deg: F64, a_deg: F64) -> tuple[NDArray[np.int64], F64]:
