@@ -14,9 +14,10 @@ command line are built on them:
 * :mod:`.upsample_io`, :mod:`.unmix_io` (with :mod:`.unmix_inputs`,
   :mod:`.endmember_spectra`, :mod:`.unmix_truth`, :mod:`.scenario_bands`): the
   ``speclight upsample`` and ``speclight unmix`` commands;
-* :mod:`.reflectivity_map` (with :mod:`.reflectivity_map_store`): ``speclight
-  reflectivity-map``, the target rendered over body-frame geometries into a Zarr store
-  (read back by :mod:`speclight.render.map_lookup`).
+* :mod:`.reflectivity_map` (with :mod:`.reflectivity_map_store`,
+  :mod:`.reflectivity_map_render`): ``speclight reflectivity-map``, the target rendered
+  over body-frame geometries into a Zarr store (read back by
+  :mod:`speclight.render.map_lookup`).
 """
 
 from speclight.estimate.accuracy import (
