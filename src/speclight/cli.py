@@ -580,6 +580,79 @@ def reflection_map_cmd(
     _guarded(run)
 
 
+def _phase_angles(text: str) -> list[float]:
+    """``--phase-angles-deg 0,30,60,90``: comma-separated numbers."""
+    try:
+        return [float(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise InputError(
+            f"--phase-angles-deg = {text!r} must be comma-separated numbers, e.g. 0,30,60,90",
+            field="--phase-angles-deg",
+        ) from None
+
+
+@app.command("reflectivity-map")
+def reflectivity_map(
+    scenario: Annotated[
+        Path, typer.Argument(help="Scenario YAML: target, materials, spectrum, render, bands.")
+    ],
+    output: Annotated[
+        str, typer.Option("--output", "-o", metavar="MAP.zarr", help="Output Zarr store.")
+    ] = "map.zarr",
+    directions: Annotated[
+        int, typer.Option("--directions", help="At least N phase-vector directions (HEALPix).")
+    ] = 10_000,
+    phase_angles_deg: Annotated[
+        str, typer.Option("--phase-angles-deg", metavar="LIST", help="e.g. 0 or 0,30,60,90.")
+    ] = "0",
+    rolls: Annotated[
+        int, typer.Option("--rolls", help="Rolls of the Sun-observer plane (phase > 0).")
+    ] = 8,
+    chunk: Annotated[int, typer.Option("--chunk", help="Directions per chunk.")] = 512,
+    force: Annotated[bool, typer.Option("--force", help="Replace an existing store.")] = False,
+) -> None:
+    """Render the target for N body-frame phase-vector directions x phase angles x rolls and
+    store intensity (Sun at 1 AU) and count rates per band (1 m, 1 m2, no atmosphere) in a
+    chunked Zarr store. An interrupted run resumes where it stopped when rerun with the same
+    parameters; a chunk that fails is recorded and retried on the next run (exit 1).
+
+    Example: speclight reflectivity-map box-wing.yaml -o map.zarr --phase-angles-deg 0,30,60,90
+    """
+
+    def run() -> None:
+        from speclight.estimate.reflectivity_map import check_map_options
+        from speclight.estimate.reflectivity_map import reflectivity_map as build
+        from speclight.scenario import load_scenario
+
+        angles = _phase_angles(phase_angles_deg)
+        check_map_options(directions, angles, rolls, chunk)  # before loading anything
+        result = build(
+            load_scenario(scenario),
+            output,
+            directions=directions,
+            phase_angles_deg=angles,
+            rolls=rolls,
+            chunk=chunk,
+            force=force,
+            progress=sys.stderr.isatty(),
+        )
+        _raise_if_signalled()
+        typer.echo(
+            f"{result.n_directions} directions in {result.n_chunks} chunks: rendered "
+            f"{result.rendered}, skipped {result.skipped} done before, in {result.seconds:.1f} s"
+        )
+        if result.failed:
+            first = next(iter(result.failed.items()))
+            _fail(
+                f"{len(result.failed)} chunk(s) failed (chunk {first[0]}: {first[1]}); "
+                f"{output} is unfinished: rerun the same command to retry them",
+                1,
+            )
+        typer.echo(f"wrote {output}")
+
+    _guarded(run)
+
+
 @app.command()
 def info() -> None:
     """Versions of speclight and its engines, render variants, and data coverage."""

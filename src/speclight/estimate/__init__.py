@@ -17,7 +17,11 @@ command line are built on them:
 * :mod:`.fit`, :mod:`.roughness_fit`, :mod:`.scenario_fit`: band albedos and roughness
   fitted to measured count rates (``speclight fit``);
 * :mod:`.reflection_map` (HEALPix maps in the body frame) and :mod:`.reflection_map_io`
-  (``speclight reflection-map``).
+  (``speclight reflection-map``);
+* :mod:`.reflectivity_map` (with :mod:`.reflectivity_map_store`,
+  :mod:`.reflectivity_map_render`): ``speclight reflectivity-map``, the target rendered
+  over body-frame geometries into a Zarr store (read back by
+  :mod:`speclight.render.map_lookup`).
 """
 
 from speclight.estimate.accuracy import (
@@ -33,6 +37,7 @@ from speclight.estimate.ground_truth import fractions, material_signatures, true
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
 from speclight.estimate.reflection_map import ReflectionMap, reflection_map
 from speclight.estimate.reflection_map_io import reflection_map_measured
+from speclight.estimate.reflectivity_map import MapRun, reflectivity_map
 from speclight.estimate.roughness_fit import fit_roughness
 from speclight.estimate.scenario_bands import BandResponses, scenario_band_responses
 from speclight.estimate.scenario_fit import FitResult, fit_scenario
@@ -48,6 +53,7 @@ __all__ = [
     "BandResponses",
     "EndmemberResult",
     "FitResult",
+    "MapRun",
     "MeasuredLightCurve",
     "ReflectionMap",
     "UnmixResult",
@@ -69,6 +75,7 @@ __all__ = [
     "read_reflectance_factors",
     "reflection_map",
     "reflection_map_measured",
+    "reflectivity_map",
     "scenario_band_responses",
     "shot_noise_sigma",
     "spectral_angle_rad",

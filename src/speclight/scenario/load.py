@@ -119,7 +119,31 @@ def parse_scenario(
     except ValidationError as exc:
         raise InputError(_describe(exc, data, root), source=source) from None
     check_engines(scenario, source)  # a missing engine is reported now, not after rendering
-    return LoadedScenario(scenario, text, source, base_dir or Path.cwd())
+    loaded = LoadedScenario(scenario, text, source, base_dir or Path.cwd())
+    if scenario.render.mode == "map":
+        _check_map_file(loaded)
+    return loaded
+
+
+def _check_map_file(loaded: LoadedScenario) -> None:
+    """``render.mode: map``: the map opens, is complete and matches the grid and bands."""
+    from speclight.render.map_lookup import check_map_matches, read_header
+    from speclight.wavelength_grid import grid_from_range_nm
+
+    sc = loaded.scenario
+    if sc.illumination.lasers:
+        raise InputError(
+            "render.mode 'map' interpolates the Sun's light only; lasers need mode single or path",
+            source=loaded.source,
+            field="illumination.lasers",
+        )
+    assert sc.render.map_file is not None
+    try:
+        header = read_header(loaded.resolve(sc.render.map_file))
+        grid = grid_from_range_nm(sc.spectrum.min_nm, sc.spectrum.max_nm, sc.spectrum.step_nm)
+        check_map_matches(header, grid, [band.name for band in sc.instrument.bands])
+    except InputError as exc:
+        raise InputError(exc.message, source=loaded.source, field=exc.field) from None
 
 
 def _at(mark: yaml.error.Mark) -> str:

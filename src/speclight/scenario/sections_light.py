@@ -380,7 +380,12 @@ PATH_SECONDS_PER_EPOCH = 0.02
 
 
 class Render(Strict):
-    mode: Literal["single", "path"] = "single"
+    mode: Literal["single", "path", "map"] = "single"
+    map_file: str | None = Field(
+        default=None,
+        description="mode map: a reflectivity map (Zarr store of speclight reflectivity-map) "
+        "interpolated instead of rendering",
+    )
     resolution_px: int = Field(default=256, ge=8, le=8192)
     samples_per_pixel: int = Field(default=16, ge=1)
     seed: int = Field(default=0, ge=0, le=MAX_RENDER_SEED)
@@ -396,6 +401,13 @@ class Render(Strict):
 
     @model_validator(mode="after")
     def _samples(self) -> Render:
+        if (self.mode == "map") != (self.map_file is not None):
+            raise ValueError(
+                "mode: map needs map_file (a store written by speclight reflectivity-map), "
+                "and map_file needs mode: map"
+            )
+        if self.mode == "map" and self.save_images_at:
+            raise ValueError("save_images_at needs mode single or path: mode map renders nothing")
         if self.per_material and self.mode != "single":
             raise ValueError(
                 f"per_material: true needs mode: single (got mode: {self.mode}); the shares "

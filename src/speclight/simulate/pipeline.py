@@ -14,6 +14,7 @@ from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
 from speclight.simulate.dataset import geometry_dataset, global_attributes
 from speclight.simulate.geometry_stage import Geometry, scenario_geometry
+from speclight.simulate.map_reflection import map_reflection
 from speclight.simulate.memory import check_run_limits, grid_epochs
 from speclight.simulate.per_material import (
     add_per_material,
@@ -108,7 +109,8 @@ def _simulate(
     sc = loaded.scenario
     given = geometry.t_s if geometry is not None else time_utc
     check_run_limits(loaded, grid_epochs(sc) if given is None else int(np.size(given)))
-    target = build_target(loaded) if sc.target is not None else None  # once, and early
+    map_mode = sc.render.mode == "map"  # interpolate a reflectivity map: no target, no render
+    target = build_target(loaded) if sc.target is not None and not map_mode else None
     # the one render variant of the run, handed to every render (Sun and lasers)
     session = (
         RenderSession.create(sc.render.mode, sc.render.variant, target.materials)
@@ -119,20 +121,23 @@ def _simulate(
     wavelength_nm = wavelength_grid_nm(sc.spectrum)
     setup = prepare_ranging(loaded, geo, wavelength_nm, target, session)  # None without lasers
     flags = geo.flags.copy()  # every stage's flag bits: geometry, render, lasers
-    if target is None:  # geometry only: nothing is rendered, so no (N, L) spectra at all
+    if target is None and not map_mode:  # geometry only: no (N, L) spectra at all
         ds = geometry_dataset(geo, flags)
         modes = {"render_mode": sc.render.mode, "atmosphere_model": sc.atmosphere.model}
         ds.attrs.update(global_attributes(loaded, modes))
         return SimulationResult(dataset=ds, geometry=geo, notes=_visibility_notes(geo))
-    reflection = render_reflection(
-        loaded,
-        geo,
-        wavelength_nm,
-        progress=progress,
-        on_hits=setup.on_hits_for if setup is not None else None,
-        target=target,
-        session=session,
-    )
+    if map_mode:
+        reflection = map_reflection(loaded, geo, wavelength_nm)
+    else:
+        reflection = render_reflection(
+            loaded,
+            geo,
+            wavelength_nm,
+            progress=progress,
+            on_hits=setup.on_hits_for if setup is not None else None,
+            target=target,
+            session=session,
+        )
     elevation = np.where(geo.observable, geo.elevation_deg, np.nan)
     transmission = atmosphere_transmission(loaded, wavelength_nm, elevation)
     radiometry = None
@@ -158,7 +163,7 @@ def _simulate(
     ds = add_spectral(ds, wavelength_nm, reflection, transmission, radiometry)
     ds = add_images(ds, reflection.images, reflection.part_names)
     if sc.render.per_material and radiometry is not None and radiometry.band_names:
-        assert session is not None  # a target is rendered, so the run has a session
+        assert session is not None and target is not None  # per_material: rendered
         solar = None
         if sc.illumination.sun:
             solar = solar_material_factors(

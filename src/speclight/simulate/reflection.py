@@ -167,7 +167,7 @@ def render_reflection(
             geo.observer_direction_body[idx],
             solar[idx],
             wavelength_nm,
-            mode=sc.render.mode,
+            mode=session.mode,
             resolution_px=sc.render.resolution_px,
             samples_per_pixel=sc.render.samples_per_pixel,
             seed=sc.render.seed,

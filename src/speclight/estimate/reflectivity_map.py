@@ -1,0 +1,271 @@
+"""Reflectivity maps: the target rendered for many body-frame geometries, in a Zarr store.
+
+:func:`reflectivity_map` renders the scenario's target (its materials, spectrum, render
+settings and bands) for every HEALPix phase-vector direction x phase angle x roll
+(conventions: :mod:`speclight.render.map_geometry`) and streams the results, chunk by chunk
+of directions, into a resumable store (layout: :mod:`.reflectivity_map_store`).
+``render: {mode: map, map_file: MAP.zarr}`` then interpolates the map instead of rendering
+(:mod:`speclight.render.map_lookup`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from speclight.errors import InputError
+from speclight.estimate import reflectivity_map_store as store
+from speclight.estimate.reflectivity_map_render import coaxial_range_offset_m, render_chunk
+from speclight.render.map_geometry import healpix_directions, nside_for
+from speclight.scenario import LoadedScenario
+
+F64 = NDArray[np.float64]
+#: Directions per chunk by default: 512 x 25 geometries x 189 bins x 8 B = 19 MB of
+#: intensity per chunk (passive map of 4 phase angles x 8 rolls).
+DEFAULT_CHUNK = 512
+#: Largest phase angle of a map [deg]: at 180 deg there is no phase vector.
+MAX_PHASE_ANGLE_DEG = 179.0
+
+
+@dataclass
+class MapRun:
+    """What a :func:`reflectivity_map` run did."""
+
+    path: Path
+    n_directions: int
+    n_chunks: int
+    rendered: int
+    skipped: int
+    failed: dict[str, str] = field(default_factory=dict)
+    complete: bool = False
+    seconds: float = 0.0
+
+
+def check_map_options(
+    directions: int, phase_angles_deg: Sequence[float], rolls: int, chunk: int
+) -> tuple[int, list[float], int]:
+    """Validate the options; return ``(nside, sorted phase angles, stored rolls)``."""
+    nside = nside_for(directions)
+    angles = [float(a) for a in phase_angles_deg]
+    if not angles or not all(np.isfinite(angles)):
+        raise InputError(
+            f"--phase-angles-deg = {phase_angles_deg} must be one or more numbers",
+            field="--phase-angles-deg",
+        )
+    if min(angles) < 0 or max(angles) > MAX_PHASE_ANGLE_DEG:
+        raise InputError(
+            f"--phase-angles-deg = {phase_angles_deg}: each must be in 0..{MAX_PHASE_ANGLE_DEG:g}",
+            field="--phase-angles-deg",
+        )
+    if len(set(angles)) != len(angles):
+        raise InputError(
+            f"--phase-angles-deg = {phase_angles_deg} repeats an angle", field="--phase-angles-deg"
+        )
+    if int(rolls) < 1:
+        raise InputError(f"--rolls = {rolls} must be >= 1", field="--rolls")
+    if int(chunk) < 1:
+        raise InputError(f"--chunk = {chunk} must be >= 1", field="--chunk")
+    stored_rolls = 1 if all(a == 0 for a in angles) else int(rolls)
+    return nside, sorted(angles), stored_rolls
+
+
+def _geometries(angles: list[float], n_rolls: int) -> list[tuple[int, int, float, float]]:
+    """(phase index, roll index, phase [rad], roll [rad]) rendered per direction; phase 0
+    once (roll 0), copied to every roll."""
+    out = []
+    for j, a in enumerate(angles):
+        for k in range(1 if a == 0 else n_rolls):
+            out.append((j, k, np.radians(a), 2 * np.pi * k / n_rolls))
+    return out
+
+
+def reflectivity_map(
+    loaded: LoadedScenario,
+    output: str | os.PathLike[str],
+    *,
+    directions: int = 10_000,
+    phase_angles_deg: Sequence[float] = (0.0,),
+    rolls: int = 8,
+    chunk: int = DEFAULT_CHUNK,
+    force: bool = False,
+    progress: bool = False,
+    max_chunks: int | None = None,
+) -> MapRun:
+    """Render the scenario's target into a reflectivity map (SPEC section 5).
+
+    Parameters
+    ----------
+    loaded
+        Scenario: target, materials, spectrum, render settings (single or path), bands.
+    output
+        The Zarr store (a folder). An unfinished store made with the same parameters is
+        resumed (done chunks are skipped, failed ones retried).
+    directions
+        At least this many phase-vector directions (HEALPix, the next power-of-two nside).
+    phase_angles_deg
+        Phase angles [deg], 0 (coaxial, e.g. a laser) to 179.
+    rolls
+        Rolls of the Sun-observer plane about the phase vector, evenly over 360 deg (one
+        is stored when every phase angle is 0).
+    chunk
+        Directions per chunk (the unit of work, of resume and of memory).
+    force
+        Replace an existing store.
+    progress
+        Show a progress bar over chunks on a terminal.
+    max_chunks
+        Render at most this many chunks in this call (the rest stay to do: resume later).
+
+    Returns
+    -------
+    MapRun
+        Counts, failed chunks (index -> message) and whether the map is complete.
+    """
+    sc = loaded.scenario
+    if sc.target is None:
+        raise InputError("a reflectivity map needs a target section", field="target")
+    if sc.render.mode not in ("single", "path"):
+        raise InputError(
+            f"render.mode = '{sc.render.mode}': a map is rendered in mode single or path",
+            field="render.mode",
+        )
+    nside, angles, n_rolls = check_map_options(directions, phase_angles_deg, rolls, chunk)
+    path = store.check_store_path(output, {"scenario file": Path(loaded.source)})
+    from speclight.render import RenderSession, engine_versions
+    from speclight.simulate.radiometry import instrument_response, wavelength_grid_nm
+    from speclight.simulate.reflection import build_target
+
+    target = build_target(loaded)
+    session = RenderSession.create(sc.render.mode, sc.render.variant, target.materials)
+    wl = wavelength_grid_nm(sc.spectrum)
+    kernel = instrument_response(
+        loaded, wl, np.zeros((1, wl.size)), np.ones((1, wl.size)), np.ones(1)
+    )
+    band_names = kernel.band_names
+    dirs = healpix_directions(nside)
+    parameters = {
+        "healpix_nside": nside,
+        "phase_angle_deg": angles,
+        "rolls": n_rolls,
+        "chunk": int(chunk),
+        "scenario_sha256": hashlib.sha256(loaded.yaml_text.encode()).hexdigest(),
+    }
+    ranging = bool(sc.illumination.lasers) and 0.0 in angles
+    shapes = {
+        "ranging": int(ranging),
+        "direction": len(dirs),
+        "phase": len(angles),
+        "roll": n_rolls,
+        "wavelength": wl.size,
+        "band": len(band_names),
+    }
+    started = time.perf_counter()
+    with store.store_lock(path):
+        group, resumed = store.open_or_create(path, parameters, shapes, int(chunk), force)
+        if not resumed:
+            store.write_coordinates(
+                group,
+                {
+                    "direction_body": dirs,
+                    "phase_angle_deg": np.array(angles),
+                    "roll_deg": 360.0 * np.arange(n_rolls) / n_rolls,
+                    "wavelength": wl,
+                },
+            )
+            group.attrs.update(_metadata(loaded, band_names, nside, session.variant))
+            group.attrs["engine_versions"] = engine_versions()
+        from speclight.illumination import solar_irradiance_W_m2_nm
+
+        solar = solar_irradiance_W_m2_nm(wl, 1.0)
+        geoms = _geometries(angles, n_rolls)
+        states = store.chunk_states(group)
+        todo = [k for k in range(states.size) if states[k] != store.DONE]
+        if max_chunks is not None:
+            todo = todo[: max(int(max_chunks), 0)]
+        run = MapRun(path, len(dirs), states.size, 0, int(np.sum(states == store.DONE)))
+
+        def one(k: int) -> None:
+            lo, hi = k * int(chunk), min((k + 1) * int(chunk), len(dirs))
+            try:
+                inten, rate = render_chunk(
+                    loaded, target, session, dirs[lo:hi], geoms, shapes, wl, solar, kernel, k
+                )
+                group["intensity"][lo:hi] = inten.astype(np.float32)
+                if band_names:
+                    group["count_rate"][lo:hi] = rate.astype(np.float32)
+                if ranging:
+                    offset = coaxial_range_offset_m(target, session, dirs[lo:hi], wl, loaded)
+                    group["range_offset"][lo:hi] = offset.astype(np.float32)
+                store.mark(group, k, store.DONE)
+            except Exception as exc:  # recorded, the run goes on
+                store.mark(group, k, store.FAILED, f"{type(exc).__name__}: {exc}")
+            run.rendered += 1
+
+        _over_chunks(todo, one, progress)
+        states = store.chunk_states(group)
+        run.failed = dict(group.attrs.get("failed_chunks", {}))
+        run.complete = bool(np.all(states == store.DONE))
+        group.attrs["complete"] = run.complete
+    run.seconds = time.perf_counter() - started
+    return run
+
+
+def _metadata(
+    loaded: LoadedScenario, band_names: list[str], nside: int, variant: str
+) -> dict[str, Any]:
+    from speclight import __version__
+
+    sc = loaded.scenario
+    assert sc.target is not None
+    return {
+        "healpix_nside": nside,
+        "healpix_order": "ring",
+        "band_names": band_names,
+        "scenario_yaml": loaded.yaml_text,
+        "scenario_source": loaded.source,
+        "target": sc.target.model_dump(mode="json"),
+        "render_mode": sc.render.mode,
+        "render_variant": variant,
+        "resolution_px": sc.render.resolution_px,
+        "samples_per_pixel": sc.render.samples_per_pixel,
+        "speclight_version": __version__,
+        "units": {
+            "intensity": "W sr-1 nm-1",
+            "count_rate": "s-1",
+            "range_offset": "m",
+            "wavelength": "nm",
+            "phase_angle_deg": "deg",
+            "roll_deg": "deg",
+        },
+        "intensity_conditions": "the Sun at 1 AU (bin-averaged ASTM E490 spectrum), "
+        "no Earth shadow",
+        "count_rate_conditions": "range 1 m, aperture area 1 m2, no atmosphere "
+        "(transmission 1); the scenario's optics transmission, detector QE and bands",
+        "conventions": "phase vector p = HEALPix RING pixel centre (body frame); roll r about "
+        "p from e_lon = normalize(z x p) toward e_lat = p x e_lon; sun = cos(a/2) p + "
+        "sin(a/2) u, observer = cos(a/2) p - sin(a/2) u, u = cos r e_lon + sin r e_lat",
+        "failed_chunks": {},
+    }
+
+
+def _over_chunks(todo: list[int], one: Any, progress: bool) -> None:
+    if not (progress and sys.stderr.isatty()):
+        for k in todo:
+            one(k)
+        return
+    from rich.progress import Progress
+
+    with Progress(transient=True) as bar:
+        task = bar.add_task("reflectivity map", total=len(todo))
+        for k in todo:
+            one(k)
+            bar.advance(task)

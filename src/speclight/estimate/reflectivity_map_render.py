@@ -1,0 +1,100 @@
+"""Rendering one chunk of a reflectivity map: Sun intensity, unit count rates, laser offsets.
+
+Used by :func:`speclight.estimate.reflectivity_map.reflectivity_map`; conventions in
+:mod:`speclight.render.map_geometry`.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from speclight import instrument
+from speclight.render.map_geometry import sun_observer
+from speclight.scenario import LoadedScenario
+
+F64 = NDArray[np.float64]
+
+
+def render_chunk(
+    loaded: LoadedScenario,
+    target: Any,
+    session: Any,
+    dirs: F64,
+    geoms: list[tuple[int, int, float, float]],
+    shapes: dict[str, int],
+    wl: F64,
+    solar: F64,
+    kernel: Any,
+    k: int,
+) -> tuple[F64, F64]:
+    """Intensity (n, P, R, L) and unit count rates (n, P, R, B) of one chunk of directions."""
+    from speclight.render import render_intensity
+
+    sc = loaded.scenario
+    n = len(dirs)
+    p = np.repeat(dirs, len(geoms), axis=0)
+    a = np.tile([g[2] for g in geoms], n)
+    r = np.tile([g[3] for g in geoms], n)
+    sun, obs = sun_observer(p, a, r)
+    result = render_intensity(
+        target,
+        sun,
+        obs,
+        solar,
+        wl,
+        mode=session.mode,
+        resolution_px=sc.render.resolution_px,
+        samples_per_pixel=sc.render.samples_per_pixel,
+        seed=(sc.render.seed + k) % 2**32,  # each chunk its own Monte Carlo samples
+        variant=sc.render.variant,
+        workers=os.cpu_count(),
+        solar_disk=sc.illumination.solar_disk,
+        session=session,
+    )
+    rows = result.intensity_W_sr_nm.reshape(n, len(geoms), wl.size)
+    inten = np.empty((n, shapes["phase"], shapes["roll"], wl.size))
+    for g, (j, kk, angle, _) in enumerate(geoms):
+        if angle == 0:
+            inten[:, j, :, :] = rows[:, g, None, :]
+        else:
+            inten[:, j, kk, :] = rows[:, g, :]
+    rows_all = inten.reshape(-1, wl.size)
+    unit = np.ones(len(rows_all))  # range 1 m, area 1 m2, transmission 1
+    flux = instrument.spectral_flux_W_nm(rows_all, np.ones_like(rows_all), 1.0, unit)
+    ones = np.ones(wl.size)
+    rate = instrument.count_rate_per_s(
+        flux, wl, kernel.optics, ones, kernel.band_response * kernel.qe
+    )
+    return inten, rate.reshape(n, shapes["phase"], shapes["roll"], -1)
+
+
+def coaxial_range_offset_m(
+    target: Any, session: Any, dirs: F64, wl: F64, loaded: LoadedScenario
+) -> F64:
+    """Mean one-way range offset (n, L) [m] of a coaxial laser's return per wavelength bin.
+
+    ``speclight.render.laser_returns`` (single scattering, the centre of mass at the body
+    origin as in ``simulate``): the intensity-weighted mean of each pixel's offset
+    ``-(p - c) . o`` (negative: in front of the centre of mass), per bin, so that a laser
+    line at any wavelength of the grid reads its bin. NaN where nothing returns.
+    """
+    from speclight.render.laser_returns import LaserLight, render_laser_returns
+
+    light = LaserLight(dirs, np.arange(wl.size), np.ones((len(dirs), wl.size)))
+    edges = np.array([-1e9, 1e9])  # one bin: the first moment is exact, histograms not kept
+    returns = render_laser_returns(
+        target,
+        dirs,
+        [light],
+        wl,
+        resolution_px=loaded.scenario.render.resolution_px,
+        bin_edges_m=edges,
+        session=session,
+    )
+    total = returns.intensity_W_sr_nm(0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(total > 0, returns.moment_m[0] / total, np.nan)

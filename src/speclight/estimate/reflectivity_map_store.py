@@ -1,0 +1,197 @@
+"""The Zarr store of a reflectivity map: layout, parameters check, resume bookkeeping.
+
+Layout (Zarr format 3, a folder ``MAP.zarr``):
+
+* ``intensity(direction, phase, roll, wavelength)`` float32 [W sr-1 nm-1]: the target's
+  radiant intensity under the Sun at 1 AU (bin-averaged spectrum of
+  :func:`speclight.illumination.solar_irradiance_W_m2_nm`), no Earth shadow;
+* ``count_rate(direction, phase, roll, band)`` float32 [s-1]: photo-electrons per second
+  for a range of 1 m, an aperture of 1 m^2, no atmosphere (transmission 1), the scenario's
+  optics, QE and bands;
+* ``range_offset(direction, wavelength)`` float32 [m], only for a scenario with lasers and
+  phase angle 0 among the map's: a coaxial laser's mean one-way range offset from the
+  centre of mass per wavelength bin (single scattering; range histograms are not stored);
+* ``direction_body(direction, xyz)``, ``phase_angle_deg(phase)``, ``roll_deg(roll)``,
+  ``wavelength(wavelength)`` [nm];
+* ``chunk_state(chunk)`` uint8: 0 to do, 1 done, 2 failed (each written after its chunk's
+  data, so a killed run loses at most the chunk in flight);
+* attributes: ``parameters`` (what a resumed run must match), band names, units, the
+  scenario YAML, target and materials, engine and speclight versions, render variant,
+  ``failed_chunks`` (chunk -> message) and ``complete``.
+
+The store is written in place, not to a temporary name: its partial content is the resume
+state. Readers (``render.mode: map``) accept only a store whose ``complete`` is true.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import shutil
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from speclight.errors import InputError
+from speclight.io.output import lock_path
+
+FIELD = "--output"
+FORMAT_NAME = "speclight reflectivity map"
+TODO, DONE, FAILED = 0, 1, 2
+
+
+def check_store_path(output: str | os.PathLike[str], inputs: dict[str, Path]) -> Path:
+    """Refuse a store name that cannot be written: empty, missing folder, a file, an input."""
+    text = os.fspath(output)
+    if not text.strip():
+        raise InputError("the store name is empty; give one such as map.zarr", field=FIELD)
+    path = Path(text)
+    if not path.parent.is_dir():
+        raise InputError(f"folder {path.parent} of {text} does not exist", field=FIELD)
+    for role, other in inputs.items():
+        if path.exists() and Path(other).exists() and path.resolve() == Path(other).resolve():
+            raise InputError(f"{text} is the {role}; choose another name", field=FIELD)
+    if path.exists() and not path.is_dir():
+        raise InputError(
+            f"{text} exists and is not a Zarr store (a folder); choose another name", field=FIELD
+        )
+    if not os.access(path.parent, os.W_OK | os.X_OK):
+        raise InputError(f"cannot write in folder {path.parent} (permission denied)", field=FIELD)
+    return path
+
+
+@contextmanager
+def store_lock(path: Path) -> Iterator[None]:
+    """Hold ``.NAME.speclight.lock`` beside the store (one writer at a time)."""
+    lock = lock_path(path)
+    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o666)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise InputError(
+                f"another speclight run is writing {path}; wait for it to end", field=FIELD
+            ) from None
+        yield
+    finally:
+        os.close(fd)
+        lock.unlink(missing_ok=True)
+
+
+def open_or_create(
+    path: Path,
+    parameters: dict[str, Any],
+    shapes: dict[str, int],
+    chunk: int,
+    force: bool,
+) -> tuple[Any, bool]:
+    """Open the store to resume it, or create it; ``(group, resumed)``.
+
+    An existing store is resumed when its ``parameters`` equal ``parameters`` and it is not
+    complete; a complete one, or one made with other parameters, is refused unless ``force``
+    (which deletes it first).
+    """
+    import zarr
+
+    if path.exists() and not force:
+        try:
+            group = zarr.open_group(str(path), mode="r+")
+            old: dict[str, Any] = dict(group.attrs.get("parameters", {}))  # type: ignore[arg-type]
+            complete = bool(group.attrs.get("complete", False))
+        except Exception as exc:  # not a Zarr group at all
+            raise InputError(
+                f"{path} exists and is not a speclight reflectivity map ({exc}); choose another "
+                "name or pass --force to replace it",
+                field=FIELD,
+            ) from None
+        if complete:
+            raise InputError(
+                f"{path} exists and is complete; choose another name or pass --force to "
+                "render it again",
+                field=FIELD,
+            )
+        if old != parameters:
+            diff = sorted(k for k in set(old) | set(parameters) if old.get(k) != parameters.get(k))
+            raise InputError(
+                f"{path} is an unfinished map made with other parameters ({', '.join(diff)}); "
+                "rerun with the same ones to resume it, or pass --force to start again",
+                field=FIELD,
+            )
+        return group, True
+    if path.exists():  # --force: replace a map, never another folder
+        if any(path.iterdir()) and _format_of(path) != FORMAT_NAME:
+            raise InputError(
+                f"{path} is a folder but not a speclight reflectivity map; --force replaces "
+                "only maps: choose another name",
+                field=FIELD,
+            )
+        shutil.rmtree(path)
+    group = zarr.open_group(str(path), mode="w", zarr_format=3)
+    d, p, r = shapes["direction"], shapes["phase"], shapes["roll"]
+    n_wl, n_band = shapes["wavelength"], shapes["band"]
+    n_chunks = -(-d // chunk)
+    group.create_array(
+        "intensity",
+        shape=(d, p, r, n_wl),
+        chunks=(chunk, p, r, n_wl),
+        dtype="f4",
+        fill_value=np.nan,
+    )
+    if n_band:
+        group.create_array(
+            "count_rate",
+            shape=(d, p, r, n_band),
+            chunks=(chunk, p, r, n_band),
+            dtype="f4",
+            fill_value=np.nan,
+        )
+    if shapes.get("ranging"):
+        group.create_array(
+            "range_offset", shape=(d, n_wl), chunks=(chunk, n_wl), dtype="f4", fill_value=np.nan
+        )
+    group.create_array(
+        "chunk_state", shape=(n_chunks,), chunks=(n_chunks,), dtype="u1", fill_value=0
+    )
+    group.attrs.update({"format": FORMAT_NAME, "parameters": parameters, "complete": False})
+    return group, False
+
+
+def write_coordinates(group: Any, coords: dict[str, NDArray[Any]]) -> None:
+    """Write the coordinate arrays (small, one chunk each)."""
+    for name, values in coords.items():
+        values = np.asarray(values, dtype=float)
+        arr = group.create_array(
+            name, shape=values.shape, chunks=values.shape, dtype="f8", overwrite=True
+        )
+        arr[...] = values
+
+
+def chunk_states(group: Any) -> NDArray[np.uint8]:
+    """The per-chunk state array (0 to do, 1 done, 2 failed)."""
+    return np.asarray(group["chunk_state"][...], dtype=np.uint8)
+
+
+def mark(group: Any, k: int, state: int, message: str | None = None) -> None:
+    """Record chunk ``k`` as done or failed (with its message)."""
+    failed: dict[str, Any] = dict(group.attrs.get("failed_chunks", {}))
+    if state == FAILED:
+        failed[str(k)] = message or "failed"
+    else:
+        failed.pop(str(k), None)
+    group.attrs["failed_chunks"] = failed
+    group["chunk_state"][k] = state
+
+
+def _format_of(path: Path) -> str | None:
+    """The ``format`` attribute of the Zarr group at ``path`` (``None`` if it is none)."""
+    import json
+
+    try:
+        meta = json.loads((path / "zarr.json").read_text())
+        return str(meta.get("attributes", {}).get("format"))
+    except (OSError, ValueError, AttributeError):
+        return None
