@@ -1,0 +1,150 @@
+"""Photometric period or rotation period: does the light curve repeat after P or after 2P?
+
+A body that looks alike after half a turn (a box-wing spinning about its antenna axis, a
+cylinder tumbling end over end) repeats its light curve twice per turn: the periodogram's
+best period is then half the rotation period. The decision compares the light curve folded
+at P and at 2P through a nested-model F-test (Press et al., Numerical Recipes, 14.2; the
+"halves of the 2P fold differ" test):
+
+* the *full* model has the harmonics ``1..2K`` of ``1/(2P)`` in each band, the *reduced*
+  model only its even ones ``2, 4, ..., 2K`` (the harmonics ``1..K`` of ``1/P``, a curve
+  that repeats after P);
+* ``F = ((chi2_r - chi2_f) / (p_f - p_r)) / (chi2_f / (n - p_f))`` is F-distributed with
+  ``(p_f - p_r, n - p_f)`` degrees of freedom when the two halves of the 2P fold are the same
+  curve; its residual variance is estimated from the data, so mis-stated sigmas or a light
+  curve that changes over the pass make the test more cautious, not less;
+* the halves differ when the p-value is below ``alpha`` (0.001);
+* a fold period is tested only when it fits at least 3 times into the span (with fewer
+  cycles the odd harmonics of the long period fit the slow change of the light curve over
+  the pass, not a difference of the halves).
+
+:func:`rotation_period` first halves P while the halves of the P fold do not differ (the best
+peak was a multiple of the photometric period), then doubles it when the halves of the 2P
+fold differ. When they do not (a body whose halves look alike within the noise), the data
+cannot tell; with ``if_symmetric="double"`` (the default) a light curve with one maximum per
+photometric cycle (first harmonic stronger than the second) is taken as half a turn and P is
+doubled, the convention of asteroid photometry that a rotating body shows two maxima per turn
+(Harris et al. 1984, Icarus 57, 251, doi:10.1016/0019-1035(84)90140-1); a light curve that
+already shows two maxima per cycle is kept.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from speclight.estimate.periodogram import BandSeries, harmonic_chi2
+
+#: p-value below which the two halves of a fold differ.
+ALPHA = 1e-3
+#: Fewest cycles of a fold period in the span for its halves to be tested: with fewer, the
+#: odd harmonics of the long period fit the slow change of the light curve over the pass.
+MIN_CYCLES = 3.0
+IfSymmetric = Literal["double", "keep"]
+
+
+@dataclass
+class HalvesTest:
+    """F-test of the two halves of the fold at ``period_s`` (module docstring)."""
+
+    period_s: float
+    f_statistic: float
+    p_value: float
+    differ: bool
+
+
+def halves_test(series: BandSeries, period_s: float, harmonics: int) -> HalvesTest:
+    """Do the two halves of the light curve folded at ``period_s`` differ? (F-test)."""
+    from scipy.stats import f as f_dist
+
+    freq = 1.0 / period_s
+    full, p_full, _ = harmonic_chi2(series, freq, list(range(1, 2 * harmonics + 1)))
+    reduced, p_red, _ = harmonic_chi2(series, freq, list(range(2, 2 * harmonics + 1, 2)))
+    d1, d2 = p_full - p_red, series.t_s.size - p_full
+    if d2 <= 0 or full <= 0:
+        return HalvesTest(period_s, float("nan"), float("nan"), False)
+    stat = max((reduced - full) / d1, 0.0) / (full / d2)
+    p = float(f_dist.sf(stat, d1, d2))
+    return HalvesTest(period_s, float(stat), p, p < ALPHA)
+
+
+def harmonic_amplitudes(series: BandSeries, period_s: float, harmonics: int) -> np.ndarray:
+    """Amplitude of each harmonic ``1..harmonics`` of ``1/period_s``, averaged over bands
+    with weights ``sum(1/dy^2)`` (the units of the series, magnitudes in :mod:`.period_io`)."""
+    _, _, coefs = harmonic_chi2(series, 1.0 / period_s, list(range(1, harmonics + 1)))
+    amp = np.zeros(harmonics)
+    wsum = 0.0
+    for b, beta in enumerate(coefs):
+        w = float(np.sum(1.0 / series.dy[series.band == b] ** 2))
+        amp += w * np.hypot(beta[1::2], beta[2::2])
+        wsum += w
+    return amp / wsum
+
+
+@dataclass
+class RotationDecision:
+    """The rotation period chosen from the photometric one, and why."""
+
+    photometric_period_s: float
+    rotation_period_s: float
+    factor: float
+    decision: str
+    tests: list[HalvesTest]
+
+
+def rotation_period(
+    series: BandSeries,
+    period_s: float,
+    harmonics: int,
+    min_period_s: float,
+    if_symmetric: IfSymmetric = "double",
+) -> RotationDecision:
+    """Decide between the photometric and the rotation period (module docstring)."""
+    tests: list[HalvesTest] = []
+    p_ph, factor = period_s, 1.0
+    for _ in range(2):  # the best peak may be a multiple of the photometric period
+        if p_ph / 2 < min_period_s:
+            break
+        test = halves_test(series, p_ph, harmonics)
+        tests.append(test)
+        if test.differ:
+            break
+        p_ph, factor = p_ph / 2, factor / 2
+    if series.span_s < MIN_CYCLES * 2 * p_ph:
+        text = (
+            f"2P = {2 * p_ph:.6g} s fits fewer than {MIN_CYCLES:g} times into the span "
+            f"({series.span_s:.6g} s): the halves of the 2P fold are not tested and the "
+            "rotation period is taken as the photometric period"
+        )
+        return RotationDecision(p_ph, p_ph, factor, text, tests)
+    double = halves_test(series, 2 * p_ph, harmonics)
+    tests.append(double)
+    if double.differ:
+        text = (
+            f"the two halves of the light curve folded at 2P = {2 * p_ph:.6g} s differ "
+            f"(F = {double.f_statistic:.3g}, p = {double.p_value:.2g} < {ALPHA:g}): "
+            "the rotation period is twice the photometric period"
+        )
+        return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests)
+    same = (
+        f"the halves of the 2P fold agree within the noise (F = {double.f_statistic:.3g}, "
+        f"p = {double.p_value:.2g} >= {ALPHA:g})"
+    )
+    amp = harmonic_amplitudes(series, p_ph, max(harmonics, 2))
+    if if_symmetric == "double" and amp[0] > amp[1]:
+        text = (
+            f"{same}; the light curve shows one maximum per photometric cycle (first "
+            f"harmonic {amp[0]:.3g} > second {amp[1]:.3g}): taken as half a turn of a body "
+            "that looks alike after half a turn (two maxima per turn), so the rotation "
+            "period is 2P; give --if-symmetric keep to keep P"
+        )
+        return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests)
+    why = (
+        "the light curve already shows two maxima per cycle"
+        if amp[0] <= amp[1]
+        else "--if-symmetric keep"
+    )
+    text = f"{same}; {why}: the rotation period is the photometric period"
+    return RotationDecision(p_ph, p_ph, factor, text, tests)
