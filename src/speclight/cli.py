@@ -425,11 +425,11 @@ def period(
     ] = None,
     max_period_s: Annotated[
         float | None,
-        typer.Option("--max-period-s", help="Longest period searched [s] (default span/2)."),
+        typer.Option("--max-period-s", help="Longest period searched [s] (default span/3)."),
     ] = None,
     harmonics: Annotated[
         int, typer.Option("--harmonics", help="Harmonics K of the periodogram's model.")
-    ] = 3,
+    ] = 2,
     bin_s: Annotated[
         float | None, typer.Option("--bin-s", help="Average epochs into bins of S seconds.")
     ] = None,
@@ -441,10 +441,19 @@ def period(
         str,
         typer.Option(
             "--if-symmetric",
-            help="double or keep: the rotation period of a light curve whose 2P fold has "
-            "equal halves and one maximum per cycle (default double, see docs/period.md).",
+            help="auto, double or keep: the rotation period when the halves of the 2P fold "
+            "agree: double (the body looks alike after half a turn), keep, or auto (double "
+            "when the light curve has one maximum per cycle); see docs/period.md.",
         ),
-    ] = "double",
+    ] = "auto",
+    synodic: Annotated[
+        str,
+        typer.Option(
+            "--synodic",
+            help="report (default) or bisector: apply the synodic correction in the "
+            "phase-angle bisector's frame to the period (see docs/period.md).",
+        ),
+    ] = "report",
     plot_file: Annotated[
         str | None, typer.Option("--plot", metavar="FIG", help="Figure (.png, .pdf, .svg).")
     ] = None,
@@ -460,14 +469,22 @@ def period(
     def run() -> None:
         import json
 
+        from speclight.estimate.period_decision import IfSymmetric
         from speclight.estimate.period_io import estimate_period
         from speclight.plot.figure_output import claim_outputs
 
-        if if_symmetric not in ("double", "keep"):
+        if if_symmetric not in ("auto", "double", "keep"):
             raise InputError(
-                f"--if-symmetric = '{if_symmetric}' (choices: double, keep)",
+                f"--if-symmetric = '{if_symmetric}' (choices: auto, double, keep)",
                 field="--if-symmetric",
             )
+        if synodic not in ("report", "bisector"):
+            raise InputError(
+                f"--synodic = '{synodic}' (choices: report, bisector)", field="--synodic"
+            )
+        rule: IfSymmetric = (
+            "double" if if_symmetric == "double" else "keep" if if_symmetric == "keep" else "auto"
+        )
         inputs: dict[str, Path | str] = {"measured file": measured}
         if scenario is not None:
             inputs["scenario file"] = scenario
@@ -487,7 +504,8 @@ def period(
                 bin_s=bin_s,
                 draws=draws,
                 seed=seed,
-                if_symmetric="keep" if if_symmetric == "keep" else "double",
+                if_symmetric=rule,
+                synodic="bisector" if synodic == "bisector" else "report",
             )
             _raise_if_signalled()
             summary = result.to_json()

@@ -47,9 +47,7 @@ def test_multiband_power_is_the_chi2_fraction_of_the_joint_harmonic_fit():
     s = _series(t, y + rng.normal(0, 0.1, y.shape), 0.1)
     freq = np.array([1 / 60.0, 1 / 41.0, 1 / 17.0])
     power = multiband_power(s, freq, 2)
-    chi0 = sum(
-        np.sum((s.y[s.band == b] - s.y[s.band == b].mean()) ** 2) / 0.1**2 for b in range(2)
-    )
+    chi0 = sum(np.sum((s.y[s.band == b] - s.y[s.band == b].mean()) ** 2) / 0.1**2 for b in range(2))
     direct = [1 - harmonic_chi2(s, f, [1, 2])[0] / chi0 for f in freq]
     np.testing.assert_allclose(power, direct, rtol=1e-8, atol=1e-10)
 

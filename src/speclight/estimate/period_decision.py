@@ -21,11 +21,15 @@ at P and at 2P through a nested-model F-test (Press et al., Numerical Recipes, 1
 :func:`rotation_period` first halves P while the halves of the P fold do not differ (the best
 peak was a multiple of the photometric period), then doubles it when the halves of the 2P
 fold differ. When they do not (a body whose halves look alike within the noise), the data
-cannot tell; with ``if_symmetric="double"`` (the default) a light curve with one maximum per
-photometric cycle (first harmonic stronger than the second) is taken as half a turn and P is
-doubled, the convention of asteroid photometry that a rotating body shows two maxima per turn
-(Harris et al. 1984, Icarus 57, 251, doi:10.1016/0019-1035(84)90140-1); a light curve that
-already shows two maxima per cycle is kept.
+cannot tell, and ``if_symmetric`` says what to assume: ``"double"``, the body looks alike
+after half a turn (a box-wing with two like wings spinning about its antenna axis): P is
+doubled; ``"keep"``: P is kept; ``"auto"`` (the default): a light curve with one maximum per
+photometric cycle is taken as half a turn and P is doubled (maxima: the brightness maxima of
+the fitted K-harmonic curve, averaged over the bands with weights ``sum 1/dy^2``, whose
+prominence is at least a quarter of the curve's peak-to-peak range), the convention of
+asteroid photometry that a rotating body shows two maxima per turn (Harris et al. 1984,
+Icarus 57, 251, doi:10.1016/0019-1035(84)90140-1); a light curve that already shows two
+maxima per cycle is kept.
 """
 
 from __future__ import annotations
@@ -35,14 +39,14 @@ from typing import Literal
 
 import numpy as np
 
-from speclight.estimate.periodogram import BandSeries, harmonic_chi2
+from speclight.estimate.periodogram import BandSeries, design_matrix, harmonic_chi2
 
 #: p-value below which the two halves of a fold differ.
 ALPHA = 1e-3
 #: Fewest cycles of a fold period in the span for its halves to be tested: with fewer, the
 #: odd harmonics of the long period fit the slow change of the light curve over the pass.
 MIN_CYCLES = 3.0
-IfSymmetric = Literal["double", "keep"]
+IfSymmetric = Literal["auto", "double", "keep"]
 
 
 @dataclass
@@ -70,17 +74,31 @@ def halves_test(series: BandSeries, period_s: float, harmonics: int) -> HalvesTe
     return HalvesTest(period_s, float(stat), p, p < ALPHA)
 
 
-def harmonic_amplitudes(series: BandSeries, period_s: float, harmonics: int) -> np.ndarray:
-    """Amplitude of each harmonic ``1..harmonics`` of ``1/period_s``, averaged over bands
-    with weights ``sum(1/dy^2)`` (the units of the series, magnitudes in :mod:`.period_io`)."""
-    _, _, coefs = harmonic_chi2(series, 1.0 / period_s, list(range(1, harmonics + 1)))
-    amp = np.zeros(harmonics)
+#: Prominence of a maximum, as a fraction of the folded curve's peak-to-peak range.
+PROMINENCE = 0.25
+
+
+def maxima_per_cycle(series: BandSeries, period_s: float, harmonics: int) -> int:
+    """Brightness maxima per cycle of the fitted curve folded at ``period_s`` (module doc);
+    the series holds magnitudes, so maxima of brightness are minima of the curve."""
+    from scipy.signal import find_peaks
+
+    orders = list(range(1, harmonics + 1))
+    _, _, coefs = harmonic_chi2(series, 1.0 / period_s, orders)
+    phase = np.linspace(0.0, 3.0, 3 * 360, endpoint=False)
+    x = design_matrix(phase * period_s, 1.0 / period_s, orders)
+    curve = np.zeros(phase.size)
     wsum = 0.0
     for b, beta in enumerate(coefs):
         w = float(np.sum(1.0 / series.dy[series.band == b] ** 2))
-        amp += w * np.hypot(beta[1::2], beta[2::2])
+        curve += w * (x @ beta)
         wsum += w
-    return amp / wsum
+    curve /= wsum
+    span = float(np.ptp(curve))
+    if span <= 0:
+        return 0
+    peaks, _ = find_peaks(-curve, prominence=PROMINENCE * span)
+    return int(np.sum((phase[peaks] >= 1.0) & (phase[peaks] < 2.0)))
 
 
 @dataclass
@@ -99,7 +117,7 @@ def rotation_period(
     period_s: float,
     harmonics: int,
     min_period_s: float,
-    if_symmetric: IfSymmetric = "double",
+    if_symmetric: IfSymmetric = "auto",
 ) -> RotationDecision:
     """Decide between the photometric and the rotation period (module docstring)."""
     tests: list[HalvesTest] = []
@@ -132,18 +150,24 @@ def rotation_period(
         f"the halves of the 2P fold agree within the noise (F = {double.f_statistic:.3g}, "
         f"p = {double.p_value:.2g} >= {ALPHA:g})"
     )
-    amp = harmonic_amplitudes(series, p_ph, max(harmonics, 2))
-    if if_symmetric == "double" and amp[0] > amp[1]:
+    if if_symmetric == "double":
         text = (
-            f"{same}; the light curve shows one maximum per photometric cycle (first "
-            f"harmonic {amp[0]:.3g} > second {amp[1]:.3g}): taken as half a turn of a body "
+            f"{same}; the body is said to look alike after half a turn (--if-symmetric "
+            "double): the rotation period is 2P"
+        )
+        return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests)
+    maxima = maxima_per_cycle(series, p_ph, harmonics)
+    if if_symmetric == "auto" and maxima <= 1:
+        text = (
+            f"{same}; the light curve shows one maximum per photometric cycle: taken as "
+            "half a turn of a body "
             "that looks alike after half a turn (two maxima per turn), so the rotation "
-            "period is 2P; give --if-symmetric keep to keep P"
+            "period is 2P (--if-symmetric keep keeps P)"
         )
         return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests)
     why = (
-        "the light curve already shows two maxima per cycle"
-        if amp[0] <= amp[1]
+        f"the light curve already shows {maxima} maxima per cycle"
+        if maxima > 1
         else "--if-symmetric keep"
     )
     text = f"{same}; {why}: the rotation period is the photometric period"

@@ -8,27 +8,36 @@ Steps (``docs/period.md``):
    with ``rate <= 2 sigma`` are left out; a weighted polynomial in time (degree 3) is
    subtracted per band: the slow change of range, phase angle and airmass over the pass;
 2. the multi-band multi-harmonic periodogram (:mod:`.periodogram`) on a regular frequency
-   grid from ``1/max_period_s`` (default: half the span) to ``1/min_period_s`` (default:
+   grid from ``1/max_period_s`` (default: a third of the span: a light curve that changes
+   over the pass is fitted by a few harmonics of any period longer than that, so at least 3
+   cycles are asked for) to ``1/min_period_s`` (default:
    ``2 K dt``, so that the K-th harmonic stays below the Nyquist frequency of the median
    spacing ``dt``), 5 samples per peak width ``1/span``; the best peak refined;
 3. false-alarm probability by permutation bootstrap (:mod:`.period_fap`);
 4. photometric or rotation period (:mod:`.period_decision`);
 5. synodic correction where the geometry is known (:mod:`.synodic`): from the dataset's
    ``attitude_quaternion`` and ``phase_vector_body`` or the scenario's geometry at the
-   measured epochs; the spin axis from a scenario with ``attitude.model: spin``.
+   measured epochs; the spin axis from a scenario with ``attitude.model: spin``. Reported
+   by default, applied to ``period_s`` with ``synodic="bisector"``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
 from speclight.errors import InputError
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
-from speclight.estimate.period_decision import ALPHA, IfSymmetric, RotationDecision, rotation_period
+from speclight.estimate.period_decision import (
+    ALPHA,
+    MIN_CYCLES,
+    IfSymmetric,
+    RotationDecision,
+    rotation_period,
+)
 from speclight.estimate.period_fap import DRAWS, BootstrapMaxima, bootstrap_maxima
 from speclight.estimate.periodogram import (
     F64,
@@ -41,6 +50,8 @@ from speclight.estimate.periodogram import (
 )
 from speclight.estimate.synodic import SynodicCorrection, sidereal_period
 from speclight.scenario import LoadedScenario
+
+SynodicMode = Literal["report", "bisector"]
 
 #: Fewest epochs accepted, and the polynomial degree of the trend removed per band.
 MIN_EPOCHS = 20
@@ -167,6 +178,7 @@ class PeriodResult:
             "synodic_correction_s": None if syn is None else syn.correction_s,
             "synodic_bound_s": None if syn is None else syn.bound_s,
             "synodic_linear_period_s": None if syn is None else syn.linear_period_s,
+            "bisector_fit_period_s": None if syn is None else syn.bisector_fit_period_s,
             "bisector_rate_rad_s": None if syn is None else syn.bisector_rate_rad_s,
             "synodic_method": (
                 "geometry unknown (a CSV without --scenario): no correction"
@@ -206,11 +218,12 @@ def estimate_period(
     bands: list[str] | None = None,
     min_period_s: float | None = None,
     max_period_s: float | None = None,
-    harmonics: int = 3,
+    harmonics: int = 2,
     bin_s: float | None = None,
     draws: int = DRAWS,
     seed: int = 0,
-    if_symmetric: IfSymmetric = "double",
+    if_symmetric: IfSymmetric = "auto",
+    synodic: SynodicMode = "report",
 ) -> PeriodResult:
     """Rotation period of the light curves in ``measured`` (module docstring)."""
     from speclight.estimate.period_geometry import pass_geometry
@@ -237,7 +250,7 @@ def estimate_period(
     span = series.span_s
     dt = float(np.median(np.diff(np.unique(series.t_s))))
     min_p = min_period_s if min_period_s is not None else 2 * harmonics * dt
-    max_p = max_period_s if max_period_s is not None else span / 2
+    max_p = max_period_s if max_period_s is not None else span / MIN_CYCLES
     if min_p >= max_p:
         raise InputError(
             f"the period range {min_p:g} .. {max_p:g} s is empty (span {span:g} s, spacing "
@@ -251,12 +264,19 @@ def estimate_period(
     peak = refine_peak(series, float(freq[top[0]]), list(range(1, harmonics + 1)))
     decision = rotation_period(series, 1 / peak.frequency_hz, harmonics, min_p, if_symmetric)
     boot = bootstrap_maxima(series, freq, harmonics, draws, seed)
-    synodic = None
+    correction = None
     geometry = pass_geometry(measured, lc, loaded)
     if geometry is not None:
         pab, axis = geometry
-        synodic = sidereal_period(
-            series, decision.rotation_period_s, harmonics, t_s, pab, weight, axis
+        correction = sidereal_period(
+            series,
+            decision.rotation_period_s,
+            harmonics,
+            t_s,
+            pab,
+            weight,
+            axis,
+            apply=synodic == "bisector",
         )
     return PeriodResult(
         series,
@@ -268,7 +288,7 @@ def estimate_period(
         harmonics,
         boot,
         decision,
-        synodic,
+        correction,
         n_epochs,
         lc.source,
     )
