@@ -8,7 +8,8 @@ at P and at 2P through a nested-model F-test (Press et al., Numerical Recipes, 1
 
 * the *full* model has the harmonics ``1..2K`` of ``1/(2P)`` in each band, the *reduced*
   model only its even ones ``2, 4, ..., 2K`` (the harmonics ``1..K`` of ``1/P``, a curve
-  that repeats after P);
+  that repeats after P); both also have a cubic polynomial in time per band, so that a slow
+  trend left by the detrending is not taken for a difference of the halves;
 * ``F = ((chi2_r - chi2_f) / (p_f - p_r)) / (chi2_f / (n - p_f))`` is F-distributed with
   ``(p_f - p_r, n - p_f)`` degrees of freedom when the two halves of the 2P fold are the same
   curve; its residual variance is estimated from the data, so mis-stated sigmas or a light
@@ -43,6 +44,10 @@ from speclight.estimate.periodogram import BandSeries, design_matrix, harmonic_c
 
 #: p-value below which the two halves of a fold differ.
 ALPHA = 1e-3
+#: Degree of the polynomial in time fitted per band beside both models of the F-test: what the
+#: detrending before the periodogram left of the pass's slow change (or took of the signal)
+#: is not counted as a difference of the halves.
+TREND_DEGREE = 3
 #: Fewest cycles of a fold period in the span for its halves to be tested: with fewer, the
 #: odd harmonics of the long period fit the slow change of the light curve over the pass.
 MIN_CYCLES = 3.0
@@ -64,8 +69,12 @@ def halves_test(series: BandSeries, period_s: float, harmonics: int) -> HalvesTe
     from scipy.stats import f as f_dist
 
     freq = 1.0 / period_s
-    full, p_full, _ = harmonic_chi2(series, freq, list(range(1, 2 * harmonics + 1)))
-    reduced, p_red, _ = harmonic_chi2(series, freq, list(range(2, 2 * harmonics + 1, 2)))
+    full, p_full, _ = harmonic_chi2(
+        series, freq, list(range(1, 2 * harmonics + 1)), trend_degree=TREND_DEGREE
+    )
+    reduced, p_red, _ = harmonic_chi2(
+        series, freq, list(range(2, 2 * harmonics + 1, 2)), trend_degree=TREND_DEGREE
+    )
     d1, d2 = p_full - p_red, series.t_s.size - p_full
     if d2 <= 0 or full <= 0:
         return HalvesTest(period_s, float("nan"), float("nan"), False)

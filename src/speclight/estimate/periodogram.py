@@ -125,10 +125,16 @@ def design_matrix(
 
 
 def harmonic_chi2(
-    series: BandSeries, frequency_hz: float, orders: list[int], phase_rad: F64 | None = None
+    series: BandSeries,
+    frequency_hz: float,
+    orders: list[int],
+    phase_rad: F64 | None = None,
+    trend_degree: int = 0,
 ) -> tuple[float, int, list[F64]]:
     """Weighted least-squares fit of the harmonics ``orders`` of ``frequency_hz`` per band
-    (``phase_rad``: per point, see :func:`design_matrix`).
+    (``phase_rad``: per point, see :func:`design_matrix`), with a polynomial in time of
+    ``trend_degree`` per band beside the constant (the coefficients of the harmonics come
+    first, the trend's last).
 
     Returns
     -------
@@ -145,6 +151,9 @@ def harmonic_chi2(
         w = 1.0 / series.dy[m]
         ph = None if phase_rad is None else phase_rad[m]
         x = design_matrix(series.t_s[m], frequency_hz, orders, ph)
+        if trend_degree > 0:
+            u = 2 * (series.t_s[m] - series.t_s.min()) / max(series.span_s, 1e-12) - 1
+            x = np.hstack([x, np.stack([u**d for d in range(1, trend_degree + 1)], axis=1)])
         beta, *_ = np.linalg.lstsq(x * w[:, None], series.y[m] * w, rcond=None)
         chi2 += float(np.sum(((series.y[m] - x @ beta) * w) ** 2))
         npar += x.shape[1]
