@@ -13,7 +13,9 @@ command line are built on them:
   aperture (Sun, coaxial lasers);
 * :mod:`.upsample_io`, :mod:`.unmix_io` (with :mod:`.unmix_inputs`,
   :mod:`.endmember_spectra`, :mod:`.unmix_truth`, :mod:`.scenario_bands`): the
-  ``speclight upsample`` and ``speclight unmix`` commands.
+  ``speclight upsample`` and ``speclight unmix`` commands;
+* :mod:`.period_io` (with :mod:`.periodogram`, :mod:`.period_fap`, :mod:`.period_decision`,
+  :mod:`.synodic`, :mod:`.period_geometry`): the ``speclight period`` command.
 """
 
 from speclight.estimate.accuracy import (
@@ -26,6 +28,7 @@ from speclight.estimate.endmember_spectra import endmembers_from_files, endmembe
 from speclight.estimate.endmembers import EndmemberResult, extract_endmembers
 from speclight.estimate.ground_truth import fractions, material_signatures, true_contributions
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
+from speclight.estimate.period_io import PeriodResult, estimate_period
 from speclight.estimate.scenario_bands import BandResponses, scenario_band_responses
 from speclight.estimate.unmix_inputs import read_reflectance_factors
 from speclight.estimate.unmix_io import unmix_measured
@@ -39,12 +42,14 @@ __all__ = [
     "BandResponses",
     "EndmemberResult",
     "MeasuredLightCurve",
+    "PeriodResult",
     "UnmixResult",
     "UpsampledSpectrum",
     "bin_light_curve",
     "confusion_matrix",
     "endmembers_from_files",
     "endmembers_from_scenario",
+    "estimate_period",
     "extract_endmembers",
     "fractions",
     "in_reference_units",
