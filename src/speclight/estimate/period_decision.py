@@ -40,14 +40,10 @@ from typing import Literal
 
 import numpy as np
 
-from speclight.estimate.periodogram import BandSeries, design_matrix, harmonic_chi2
+from speclight.estimate.periodogram import TREND_DEGREE, BandSeries, design_matrix, harmonic_chi2
 
 #: p-value below which the two halves of a fold differ.
 ALPHA = 1e-3
-#: Degree of the polynomial in time fitted per band beside both models of the F-test: what the
-#: detrending before the periodogram left of the pass's slow change (or took of the signal)
-#: is not counted as a difference of the halves.
-TREND_DEGREE = 3
 #: Fewest cycles of a fold period in the span for its halves to be tested: with fewer, the
 #: odd harmonics of the long period fit the slow change of the light curve over the pass.
 MIN_CYCLES = 3.0

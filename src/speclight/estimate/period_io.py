@@ -158,8 +158,10 @@ class PeriodResult:
                 f"{self.bootstrap.draws} permutation draws (seed {self.bootstrap.seed}; the "
                 "(value, sigma) pairs shuffled among the epochs of each band, same grid; "
                 "Suveges 2014); period_std_s from "
-                "a parabola fitted to chi2(f) at the peak, delta chi2 = 1 after scaling by "
-                "the reduced chi2"
+                "the curvature of chi2(f) at its minimum (harmonics and a cubic trend per "
+                "band), delta chi2 = 1 after scaling by "
+                "the reduced chi2, times sqrt((1 + rho) / (1 - rho)) for the lag-1 "
+                f"correlation rho = {self.peak.residual_correlation:.3f} of the residuals"
             ),
             "candidates": [{"period_s": p, "power": w} for p, w in self.candidates],
             "photometric_period_s": self.decision.photometric_period_s,

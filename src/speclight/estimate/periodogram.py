@@ -26,6 +26,10 @@ from numpy.typing import NDArray
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
+#: Degree of the polynomial in time fitted per band beside the harmonics in the refinement
+#: (and the P/2P test): the detrending before the periodogram takes a little of the signal
+#: with the pass's slow change, and leaves residuals correlated over the pass otherwise.
+TREND_DEGREE = 3
 #: Points per band above which astropy's ``fastchi2`` (extirpolation) beats ``chi2`` (direct).
 FAST_ABOVE = 3000
 
@@ -124,6 +128,14 @@ def design_matrix(
     return np.stack(cols, axis=1)
 
 
+def _with_trend(series: BandSeries, m: NDArray[np.bool_], x: F64, degree: int) -> F64:
+    """``x`` with the columns ``u^1..u^degree``, ``u`` the time scaled to -1..1 over the span."""
+    if degree <= 0:
+        return x
+    u = 2 * (series.t_s[m] - series.t_s.min()) / max(series.span_s, 1e-12) - 1
+    return np.hstack([x, np.stack([u**d for d in range(1, degree + 1)], axis=1)])
+
+
 def harmonic_chi2(
     series: BandSeries,
     frequency_hz: float,
@@ -150,10 +162,9 @@ def harmonic_chi2(
         m = series.band == b
         w = 1.0 / series.dy[m]
         ph = None if phase_rad is None else phase_rad[m]
-        x = design_matrix(series.t_s[m], frequency_hz, orders, ph)
-        if trend_degree > 0:
-            u = 2 * (series.t_s[m] - series.t_s.min()) / max(series.span_s, 1e-12) - 1
-            x = np.hstack([x, np.stack([u**d for d in range(1, trend_degree + 1)], axis=1)])
+        x = _with_trend(
+            series, m, design_matrix(series.t_s[m], frequency_hz, orders, ph), trend_degree
+        )
         beta, *_ = np.linalg.lstsq(x * w[:, None], series.y[m] * w, rcond=None)
         chi2 += float(np.sum(((series.y[m] - x @ beta) * w) ** 2))
         npar += x.shape[1]
@@ -178,43 +189,87 @@ class Peak:
         Best frequency and its standard deviation [Hz].
     chi2, dof
         Chi-square of the fit at the best frequency and its degrees of freedom.
+    residual_correlation
+        Lag-1 autocorrelation of the residuals (:func:`residual_lag1_correlation`).
     """
 
     frequency_hz: float
     frequency_std_hz: float
     chi2: float
     dof: int
+    residual_correlation: float = 0.0
 
 
 def refine_peak(
-    series: BandSeries, frequency_hz: float, orders: list[int], phase_rad: F64 | None = None
+    series: BandSeries,
+    frequency_hz: float,
+    orders: list[int],
+    phase_rad: F64 | None = None,
+    trend_degree: int = TREND_DEGREE,
 ) -> Peak:
     """Best frequency near ``frequency_hz`` and its standard deviation.
 
-    The chi-square of the model with the harmonics ``orders`` is evaluated on 41 frequencies within
-    ``+-0.1 / span`` (a tenth of the peak width) and a parabola fitted to it; its vertex is
-    the best frequency. The standard deviation follows from ``delta chi2 = 1`` on that
-    parabola after scaling the chi-square by its reduced value at the minimum (so that
-    mis-stated sigmas and model misfit widen it): ``sigma_f = sqrt(chi2_min / dof / c2)``
-    for ``chi2(f) ~ chi2_min + c2 (f - f0)^2`` (Press et al., Numerical Recipes, 15.6).
+    The chi-square of the model with the harmonics ``orders`` and a polynomial trend of
+    ``trend_degree`` per band is minimised over ``+-0.1 / span`` around ``frequency_hz`` (a
+    tenth of the peak width; scipy's bounded Brent search, to 1e-6 of that window). Its
+    curvature at the minimum, ``c2`` of ``chi2(f) ~ chi2_min + c2 (f - f0)^2``, comes from a
+    central difference whose step is set to twice the resulting standard deviation (two
+    passes). The standard deviation follows from ``delta chi2 = 1`` after scaling the
+    chi-square by its reduced value at the minimum (so that mis-stated sigmas and model
+    misfit widen it): ``sigma_f = sqrt(chi2_min / dof / c2)`` (Press et al., Numerical
+    Recipes, 15.6). That rule assumes independent residuals; a light curve that changes over
+    a pass leaves residuals correlated over many epochs, so ``sigma_f`` is multiplied by
+    ``sqrt((1 + rho) / (1 - rho))``, ``rho > 0`` the lag-1 autocorrelation of the residuals:
+    the variance inflation of the mean of an AR(1) series, whose effective sample size is
+    ``N (1 - rho) / (1 + rho)`` (von Storch & Zwiers, Statistical Analysis in Climate
+    Research, Cambridge 1999).
     """
+    from scipy.optimize import minimize_scalar
+
+    def chi(f: float) -> float:
+        return harmonic_chi2(series, f, orders, phase_rad, trend_degree)[0]
+
     half = 0.1 / series.span_s
-    best = frequency_hz
-    for _ in range(3):  # recentre when the vertex leaves the window
-        grid = np.linspace(best - half, best + half, 41)
-        chi = np.array([harmonic_chi2(series, f, orders, phase_rad)[0] for f in grid])
-        x = grid - best
-        c2, c1, _ = np.polyfit(x / half, chi, 2)
-        if c2 <= 0:
-            best = float(grid[np.argmin(chi)])
-            continue
-        vertex = -c1 / (2 * c2) * half
-        if abs(vertex) <= half:
-            best = best + vertex
-            break
-        best = float(grid[np.argmin(chi)])
-    chi2, npar, _ = harmonic_chi2(series, best, orders, phase_rad)
+    found = minimize_scalar(
+        chi,
+        bounds=(frequency_hz - half, frequency_hz + half),
+        method="bounded",
+        options={"xatol": 1e-6 * half},
+    )
+    best = float(found.x)
+    chi2, npar, coefs = harmonic_chi2(series, best, orders, phase_rad, trend_degree)
     dof = max(series.t_s.size - npar - 1, 1)
-    curvature = c2 / half**2
-    std = float(np.sqrt((chi2 / dof) / curvature)) if curvature > 0 else float("nan")
-    return Peak(float(best), std, chi2, dof)
+    step, std = half / 10, float("nan")
+    for _ in range(2):
+        c2 = (chi(best + step) + chi(best - step) - 2 * chi2) / (2 * step**2)
+        if not c2 > 0:
+            break
+        std = float(np.sqrt((chi2 / dof) / c2))
+        step = min(2 * std, half)
+    rho = residual_lag1_correlation(series, best, orders, coefs, phase_rad, trend_degree)
+    inflation = float(np.sqrt((1 + rho) / (1 - rho))) if rho > 0 else 1.0
+    return Peak(float(best), std * inflation, chi2, dof, rho)
+
+
+def residual_lag1_correlation(
+    series: BandSeries,
+    frequency_hz: float,
+    orders: list[int],
+    coefs: list[F64],
+    phase_rad: F64 | None = None,
+    trend_degree: int = 0,
+) -> float:
+    """Lag-1 autocorrelation of the normalised residuals, consecutive points of each band
+    pooled (``sum r_i r_(i+1) / sum r_i^2``), capped at 0.99."""
+    num = den = 0.0
+    for b, beta in enumerate(coefs):
+        m = series.band == b
+        ph = None if phase_rad is None else phase_rad[m]
+        x = _with_trend(
+            series, m, design_matrix(series.t_s[m], frequency_hz, orders, ph), trend_degree
+        )
+        order = np.argsort(series.t_s[m])
+        r = ((series.y[m] - x @ beta) / series.dy[m])[order]
+        num += float(np.sum(r[1:] * r[:-1]))
+        den += float(np.sum(r**2))
+    return min(num / den, 0.99) if den > 0 else 0.0

@@ -39,7 +39,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from speclight.estimate.periodogram import F64, BandSeries, harmonic_chi2, refine_peak
+from speclight.estimate.periodogram import (
+    F64,
+    TREND_DEGREE,
+    BandSeries,
+    harmonic_chi2,
+    refine_peak,
+)
 
 
 def _unit(v: F64) -> F64:
@@ -150,7 +156,7 @@ def sidereal_period(
     reach = max(1.5 * abs(rate) / (2 * np.pi), 1.0 / series.span_s)
     grid = np.arange(f_syn - reach, f_syn + reach, 0.1 / series.span_s)
     grid = grid[grid > 0]
-    chi = [harmonic_chi2(series, f, orders, phase)[0] for f in grid]
+    chi = [harmonic_chi2(series, f, orders, phase, TREND_DEGREE)[0] for f in grid]
     fitted = refine_peak(series, float(grid[int(np.argmin(chi))]), orders, phase)
     common = (
         f"Omega = {rate:.4g} rad/s (weighted mean rate of the phase-angle bisector's azimuth "
