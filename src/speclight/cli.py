@@ -654,6 +654,131 @@ def reflectivity_map(
 
 
 @app.command()
+def period(
+    measured: Annotated[
+        Path, typer.Argument(help="Light curves: a speclight NetCDF or a CSV of count rates.")
+    ],
+    output: Annotated[
+        str, typer.Option("--output", "-o", metavar="FILE", help="Output JSON (PERIOD.json).")
+    ] = "period.json",
+    scenario: Annotated[
+        Path | None,
+        typer.Option(
+            "--scenario",
+            help="Scenario YAML: geometry and spin axis for the synodic correction (for a "
+            "NetCDF default: the one it carries).",
+        ),
+    ] = None,
+    bands: Annotated[
+        list[str] | None,
+        typer.Option("--bands", help="Bands to use (repeatable; default: all)."),
+    ] = None,
+    min_period_s: Annotated[
+        float | None,
+        typer.Option("--min-period-s", help="Shortest period searched [s] (default 2 K dt)."),
+    ] = None,
+    max_period_s: Annotated[
+        float | None,
+        typer.Option("--max-period-s", help="Longest period searched [s] (default span/3)."),
+    ] = None,
+    harmonics: Annotated[
+        int, typer.Option("--harmonics", help="Harmonics K of the periodogram's model.")
+    ] = 2,
+    bin_s: Annotated[
+        float | None, typer.Option("--bin-s", help="Average epochs into bins of S seconds.")
+    ] = None,
+    draws: Annotated[
+        int, typer.Option("--draws", help="Bootstrap draws for the false-alarm probability.")
+    ] = 40,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the bootstrap.")] = 0,
+    if_symmetric: Annotated[
+        str,
+        typer.Option(
+            "--if-symmetric",
+            help="auto, double or keep: the rotation period when the halves of the 2P fold "
+            "agree: double (the body looks alike after half a turn), keep, or auto (double "
+            "when the light curve has one maximum per cycle); see docs/period.md.",
+        ),
+    ] = "auto",
+    synodic: Annotated[
+        str,
+        typer.Option(
+            "--synodic",
+            help="report (default) or bisector: apply the synodic correction in the "
+            "phase-angle bisector's frame to the period (see docs/period.md).",
+        ),
+    ] = "report",
+    plot_file: Annotated[
+        str | None, typer.Option("--plot", metavar="FIG", help="Figure (.png, .pdf, .svg).")
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite existing outputs.")] = False,
+) -> None:
+    """Rotation period from one or many bands: multi-band multi-harmonic Lomb-Scargle,
+    bootstrap false-alarm probability, photometric or rotation period (the halves of the
+    2P fold), synodic correction where the geometry is known. Writes PERIOD.json.
+
+    Example: speclight period pass.nc -o period.json --plot period.png
+    """
+
+    def run() -> None:
+        import json
+
+        from speclight.estimate.period_decision import IfSymmetric
+        from speclight.estimate.period_io import estimate_period
+        from speclight.plot.figure_output import claim_outputs
+
+        if if_symmetric not in ("auto", "double", "keep"):
+            raise InputError(
+                f"--if-symmetric = '{if_symmetric}' (choices: auto, double, keep)",
+                field="--if-symmetric",
+            )
+        if synodic not in ("report", "bisector"):
+            raise InputError(
+                f"--synodic = '{synodic}' (choices: report, bisector)", field="--synodic"
+            )
+        rule: IfSymmetric = (
+            "double" if if_symmetric == "double" else "keep" if if_symmetric == "keep" else "auto"
+        )
+        inputs: dict[str, Path | str] = {"measured file": measured}
+        if scenario is not None:
+            inputs["scenario file"] = scenario
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+            loaded = None
+            if scenario is not None:
+                from speclight.scenario import load_scenario
+
+                loaded = load_scenario(scenario)
+            result = estimate_period(
+                measured,
+                loaded=loaded,
+                bands=bands,
+                min_period_s=min_period_s,
+                max_period_s=max_period_s,
+                harmonics=harmonics,
+                bin_s=bin_s,
+                draws=draws,
+                seed=seed,
+                if_symmetric=rule,
+                synodic="bisector" if synodic == "bisector" else "report",
+            )
+            _raise_if_signalled()
+            summary = result.to_json()
+            claim.write((json.dumps(summary, indent=2) + "\n").encode())
+            if figure is not None:
+                from speclight.plot.period_figure import period_figure
+
+                figure.write(period_figure(result))
+        typer.echo(
+            f"rotation period {summary['period_s']:.6g} +- {summary['period_std_s']:.2g} s "
+            f"(photometric {summary['photometric_period_s']:.6g} s, false-alarm probability "
+            f"{summary['false_alarm_probability']:.2g})"
+        )
+        typer.echo(f"wrote {output}" + (f" and {plot_file}" if plot_file else ""))
+
+    _guarded(run)
+
+
+@app.command()
 def info() -> None:
     """Versions of speclight and its engines, render variants, and data coverage."""
 

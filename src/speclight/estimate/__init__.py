@@ -21,7 +21,9 @@ command line are built on them:
 * :mod:`.reflectivity_map` (with :mod:`.reflectivity_map_store`,
   :mod:`.reflectivity_map_render`): ``speclight reflectivity-map``, the target rendered
   over body-frame geometries into a Zarr store (read back by
-  :mod:`speclight.render.map_lookup`).
+  :mod:`speclight.render.map_lookup`);
+* :mod:`.period_io` (with :mod:`.periodogram`, :mod:`.period_fap`, :mod:`.period_decision`,
+  :mod:`.synodic`, :mod:`.period_geometry`): the ``speclight period`` command.
 """
 
 from speclight.estimate.accuracy import (
@@ -35,6 +37,7 @@ from speclight.estimate.endmembers import EndmemberResult, extract_endmembers
 from speclight.estimate.fit import fit_scales, shot_noise_sigma
 from speclight.estimate.ground_truth import fractions, material_signatures, true_contributions
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
+from speclight.estimate.period_io import PeriodResult, estimate_period
 from speclight.estimate.reflection_map import ReflectionMap, reflection_map
 from speclight.estimate.reflection_map_io import reflection_map_measured
 from speclight.estimate.reflectivity_map import MapRun, reflectivity_map
@@ -55,6 +58,7 @@ __all__ = [
     "FitResult",
     "MapRun",
     "MeasuredLightCurve",
+    "PeriodResult",
     "ReflectionMap",
     "UnmixResult",
     "UpsampledSpectrum",
@@ -62,6 +66,7 @@ __all__ = [
     "confusion_matrix",
     "endmembers_from_files",
     "endmembers_from_scenario",
+    "estimate_period",
     "extract_endmembers",
     "fit_roughness",
     "fit_scales",

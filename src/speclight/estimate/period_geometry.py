@@ -1,0 +1,73 @@
+"""The phase-angle bisector in GCRS and the spin axis for the synodic correction of
+``speclight period`` (see :mod:`.synodic`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from speclight.estimate.measured import MeasuredLightCurve
+from speclight.estimate.periodogram import F64
+from speclight.scenario import LoadedScenario
+
+
+def _dataset_bisector(path: Path) -> tuple[np.ndarray, F64] | None:
+    """(time, PAB in GCRS) from a speclight dataset, if it has attitude and phase vector."""
+    import xarray as xr
+
+    from speclight.attitude.quaternion import quat_rotate
+
+    with xr.open_dataset(path, engine="h5netcdf") as ds:
+        if "attitude_quaternion" not in ds or "phase_vector_body" not in ds:
+            return None
+        q = ds["attitude_quaternion"].transpose("time", "wxyz").values.astype(float)
+        pv = ds["phase_vector_body"].transpose("time", "xyz").values.astype(float)
+        t = ds["time"].values.astype("datetime64[ns]")
+    return t, quat_rotate(q, pv)
+
+
+def _at(t_out: np.ndarray, t_in: np.ndarray, v: F64) -> F64:
+    ok = np.all(np.isfinite(v), axis=1)
+    x_in = (t_in[ok] - t_in[0]) / np.timedelta64(1, "s")
+    x_out = (t_out - t_in[0]) / np.timedelta64(1, "s")
+    out = np.stack([np.interp(x_out, x_in, v[ok, k]) for k in range(3)], axis=1)
+    return np.asarray(out / np.linalg.norm(out, axis=1, keepdims=True), dtype=np.float64)
+
+
+def spin_axis_gcrs(loaded: LoadedScenario | None) -> F64 | None:
+    """The spin axis of a scenario with ``attitude.model: spin`` (GCRS unit vector)."""
+    from speclight.attitude.quaternion import unit_vector_from_radec
+    from speclight.scenario.sections_geometry import SpinAttitude
+
+    if loaded is None or not isinstance(loaded.scenario.attitude, SpinAttitude):
+        return None
+    a = loaded.scenario.attitude
+    return np.asarray(unit_vector_from_radec(a.spin_axis_ra_deg, a.spin_axis_dec_deg))
+
+
+def pass_geometry(
+    measured: str | Path, lc: MeasuredLightCurve, loaded: LoadedScenario | None
+) -> tuple[F64, F64 | None] | None:
+    """(PAB in GCRS at the light curve's epochs (N, 3), spin axis or None), or None when
+    the geometry is unknown (a CSV without a scenario).
+
+    The PAB comes from the dataset (``attitude_quaternion`` and ``phase_vector_body``,
+    interpolated to binned epochs) or else from the scenario's geometry at the epochs.
+    """
+    path = Path(measured)
+    found = None
+    if path.suffix.lower() in (".nc", ".nc4", ".netcdf", ".h5"):
+        found = _dataset_bisector(path)
+    if found is not None:
+        pab = _at(lc.time_utc, *found)
+    elif loaded is not None:
+        from speclight.attitude.quaternion import quat_rotate
+        from speclight.simulate.geometry_stage import scenario_geometry
+
+        geo = scenario_geometry(loaded, lc.time_utc)
+        gcrs = quat_rotate(geo.quaternion_body_to_gcrs, geo.phase_vector_body)
+        pab = _at(lc.time_utc, lc.time_utc, gcrs)
+    else:
+        return None
+    return pab, spin_axis_gcrs(loaded)

@@ -1,0 +1,310 @@
+"""``speclight period``: rotation period of a measured or simulated pass (PERIOD.json).
+
+Steps (``docs/period.md``):
+
+1. the count rates of the chosen bands become magnitudes ``-2.5 log10(rate)`` with
+   ``sigma_mag = 2.5 / ln 10 * sigma / rate`` (the measured sigmas, else the shot noise
+   ``sqrt(rate / t)`` with ``t`` the scenario's exposure or the median epoch spacing); points
+   with ``rate <= 2 sigma`` are left out; a weighted polynomial in time (degree 3) is
+   subtracted per band: the slow change of range, phase angle and airmass over the pass;
+2. the multi-band multi-harmonic periodogram (:mod:`.periodogram`) on a regular frequency
+   grid from ``1/max_period_s`` (default: a third of the span: a light curve that changes
+   over the pass is fitted by a few harmonics of any period longer than that, so at least 3
+   cycles are asked for) to ``1/min_period_s`` (default:
+   ``2 K dt``, so that the K-th harmonic stays below the Nyquist frequency of the median
+   spacing ``dt``), 5 samples per peak width ``1/span``; the best peak refined;
+3. false-alarm probability by permutation bootstrap (:mod:`.period_fap`);
+4. photometric or rotation period (:mod:`.period_decision`);
+5. synodic correction where the geometry is known (:mod:`.synodic`): from the dataset's
+   ``attitude_quaternion`` and ``phase_vector_body`` or the scenario's geometry at the
+   measured epochs; the spin axis from a scenario with ``attitude.model: spin``. Reported
+   by default, applied to ``period_s`` with ``synodic="bisector"``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+
+from speclight.errors import InputError
+from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
+from speclight.estimate.period_decision import (
+    ALPHA,
+    MIN_CYCLES,
+    IfSymmetric,
+    RotationDecision,
+    rotation_period,
+)
+from speclight.estimate.period_fap import DRAWS, BootstrapMaxima, bootstrap_maxima
+from speclight.estimate.periodogram import (
+    F64,
+    BandSeries,
+    Peak,
+    frequency_grid,
+    local_maxima,
+    multiband_power,
+    refine_peak,
+)
+from speclight.estimate.synodic import SynodicCorrection, sidereal_period
+from speclight.scenario import LoadedScenario
+
+SynodicMode = Literal["report", "bisector"]
+
+#: Fewest epochs accepted, and the polynomial degree of the trend removed per band.
+MIN_EPOCHS = 20
+DETREND_DEGREE = 3
+N_CANDIDATES = 5
+SAMPLES_PER_PEAK = 5
+LN10 = float(np.log(10.0))
+
+
+def magnitude_series(
+    lc: MeasuredLightCurve, exposure_s: float | None = None
+) -> tuple[BandSeries, F64, F64]:
+    """Detrended magnitudes of all bands (module docstring, step 1).
+
+    Returns
+    -------
+    series
+        The finite points, flattened.
+    t_s
+        (N,) time of each epoch since the first [s].
+    weight
+        (N,) information of each epoch, ``sum_b 1/sigma_mag^2`` (0 where none is usable).
+    """
+    t_s = (lc.time_utc - lc.time_utc[0]) / np.timedelta64(1, "s")
+    rate = lc.rate_per_s
+    if lc.sigma_per_s is not None:
+        sigma = lc.sigma_per_s
+    else:
+        t_exp = exposure_s if exposure_s else float(np.median(np.diff(t_s)))
+        sigma = np.sqrt(np.abs(rate) / (t_exp * lc.n_samples[:, None]))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ok = np.isfinite(rate) & np.isfinite(sigma) & (sigma > 0) & (rate > 2 * sigma)
+        mag = np.where(ok, -2.5 * np.log10(np.where(ok, rate, 1.0)), np.nan)
+        dmag = np.where(ok, 2.5 / LN10 * sigma / np.where(ok, rate, 1.0), np.nan)
+    span = max(float(t_s[-1]), 1e-9)
+    for b in range(rate.shape[1]):
+        m = ok[:, b]
+        if m.sum() > DETREND_DEGREE + 1:
+            x = t_s[m] / span
+            c = np.polynomial.polynomial.polyfit(x, mag[m, b], DETREND_DEGREE, w=1 / dmag[m, b])
+            mag[m, b] -= np.polynomial.polynomial.polyval(x, c)
+    tt = np.broadcast_to(t_s[:, None], rate.shape)
+    bb = np.broadcast_to(np.arange(rate.shape[1])[None, :], rate.shape)
+    series = BandSeries(
+        t_s=tt[ok].astype(float),
+        y=mag[ok],
+        dy=dmag[ok],
+        band=bb[ok].astype(np.int64),
+        n_bands=rate.shape[1],
+    )
+    weight = np.where(ok, 1.0 / np.where(ok, dmag, 1.0) ** 2, 0.0).sum(axis=1)
+    return series, t_s, weight
+
+
+@dataclass
+class PeriodResult:
+    """Everything ``speclight period`` found (``to_json`` gives PERIOD.json)."""
+
+    series: BandSeries
+    band_names: list[str]
+    frequency_hz: F64
+    power: F64
+    candidates: list[tuple[float, float]]
+    peak: Peak
+    harmonics: int
+    bootstrap: BootstrapMaxima
+    decision: RotationDecision
+    synodic: SynodicCorrection | None
+    n_epochs: int
+    source: str
+
+    @property
+    def period_s(self) -> float:
+        """The rotation period: sidereal where corrected, else synodic."""
+        if self.synodic is not None and self.synodic.sidereal_period_s is not None:
+            return self.synodic.sidereal_period_s
+        return self.decision.rotation_period_s
+
+    @property
+    def period_std_s(self) -> float:
+        """Standard deviation of the rotation period, ``factor P^2 sigma_f`` [s] (the
+        sidereal fit's where applied)."""
+        if self.synodic is not None and self.synodic.sidereal_std_s is not None:
+            return self.synodic.sidereal_std_s
+        f = self.peak.frequency_hz
+        return float(self.decision.factor * self.peak.frequency_std_hz / f**2)
+
+    def to_json(self) -> dict[str, Any]:
+        """PERIOD.json (SPEC section 5, keys documented in docs/period.md)."""
+        best_power = float(np.max(self.power))
+        fap = self.bootstrap.false_alarm_probability(best_power)
+        perm, upper = self.bootstrap.permutation_p_value(best_power)
+        syn = self.synodic
+        return {
+            "period_s": self.period_s,
+            "period_std_s": self.period_std_s,
+            "false_alarm_probability": fap,
+            "permutation_p_value": perm,
+            "permutation_p_value_is_upper_bound": upper,
+            "method": (
+                "multi-band Lomb-Scargle (astropy LombScargle per band, nterms = "
+                f"{self.harmonics}, chi2-weighted sum; VanderPlas & Ivezic 2015) on detrended "
+                f"magnitudes; FAP from a Gumbel law fitted to the maximum powers of "
+                f"{self.bootstrap.draws} permutation draws (seed {self.bootstrap.seed}; the "
+                "(value, sigma) pairs shuffled among the epochs of each band, same grid; "
+                "Suveges 2014); period_std_s from "
+                "the curvature of chi2(f) at its minimum (harmonics and a cubic trend per "
+                "band), delta chi2 = 1 after scaling by "
+                "the reduced chi2, times sqrt((1 + rho) / (1 - rho)) for the lag-1 "
+                f"correlation rho = {self.peak.residual_correlation:.3f} of the residuals"
+            ),
+            "candidates": [{"period_s": p, "power": w} for p, w in self.candidates],
+            "photometric_period_s": self.decision.photometric_period_s,
+            "synodic_period_s": self.decision.rotation_period_s,
+            "decision": self.decision.decision,
+            "halves_tests": [
+                {
+                    "fold_period_s": t.period_s,
+                    "f_statistic": t.f_statistic,
+                    "p_value": t.p_value,
+                    "halves_differ": t.differ,
+                }
+                for t in self.decision.tests
+            ],
+            "alpha": ALPHA,
+            "synodic_correction_s": None if syn is None else syn.correction_s,
+            "synodic_bound_s": None if syn is None else syn.bound_s,
+            "synodic_linear_period_s": None if syn is None else syn.linear_period_s,
+            "bisector_fit_period_s": None if syn is None else syn.bisector_fit_period_s,
+            "bisector_rate_rad_s": None if syn is None else syn.bisector_rate_rad_s,
+            "synodic_method": (
+                "geometry unknown (a CSV without --scenario): no correction"
+                if syn is None
+                else syn.method
+            ),
+            "best_power": best_power,
+            "power_at_fap_1_percent": self.bootstrap.power_at(0.01),
+            "harmonics": self.harmonics,
+            "frequency_grid_hz": {
+                "min": float(self.frequency_hz[0]),
+                "max": float(self.frequency_hz[-1]),
+                "n": int(self.frequency_hz.size),
+            },
+            "n_epochs": self.n_epochs,
+            "bands": self.band_names,
+            "source": self.source,
+        }
+
+
+def _check_periods(min_p: float | None, max_p: float | None, harmonics: int) -> None:
+    if harmonics < 1 or harmonics > 20:
+        raise InputError(f"--harmonics = {harmonics} must be 1..20", field="--harmonics")
+    for name, v in (("--min-period-s", min_p), ("--max-period-s", max_p)):
+        if v is not None and not (np.isfinite(v) and v > 0):
+            raise InputError(f"{name} = {v!r} must be a duration > 0 s", field=name)
+    if min_p is not None and max_p is not None and min_p >= max_p:
+        raise InputError(
+            f"--min-period-s = {min_p:g} must be below --max-period-s = {max_p:g}",
+            field="--min-period-s",
+        )
+
+
+def estimate_period(
+    measured: str | Path,
+    loaded: LoadedScenario | None = None,
+    bands: list[str] | None = None,
+    min_period_s: float | None = None,
+    max_period_s: float | None = None,
+    harmonics: int = 2,
+    bin_s: float | None = None,
+    draws: int = DRAWS,
+    seed: int = 0,
+    if_symmetric: IfSymmetric = "auto",
+    synodic: SynodicMode = "report",
+) -> PeriodResult:
+    """Rotation period of the light curves in ``measured`` (module docstring)."""
+    from speclight.estimate.period_geometry import pass_geometry
+
+    _check_periods(min_period_s, max_period_s, harmonics)
+    if draws < 1:
+        raise InputError(f"--draws = {draws} must be >= 1", field="--draws")
+    lc = read_measured(measured)
+    if bands:
+        lc = lc.select_bands(list(bands))
+    if bin_s is not None:
+        lc = bin_light_curve(lc, bin_s)
+    loaded = loaded if loaded is not None else _carried_scenario(measured)
+    exposure = loaded.scenario.instrument.exposure_s if loaded is not None else None
+    series, t_s, weight = magnitude_series(lc, exposure)
+    n_epochs = int(np.sum(weight > 0))
+    if n_epochs < MIN_EPOCHS:
+        raise InputError(
+            f"{n_epochs} epochs with a usable rate (> 2 sigma); at least {MIN_EPOCHS} are "
+            "needed for a period",
+            source=lc.source,
+            field="MEASURED",
+        )
+    span = series.span_s
+    dt = float(np.median(np.diff(np.unique(series.t_s))))
+    min_p = min_period_s if min_period_s is not None else 2 * harmonics * dt
+    max_p = max_period_s if max_period_s is not None else span / MIN_CYCLES
+    if min_p >= max_p:
+        raise InputError(
+            f"the period range {min_p:g} .. {max_p:g} s is empty (span {span:g} s, spacing "
+            f"{dt:g} s, {harmonics} harmonics): give --min-period-s below --max-period-s",
+            field="--min-period-s",
+        )
+    freq = frequency_grid(span, min_p, max_p, SAMPLES_PER_PEAK)
+    power = multiband_power(series, freq, harmonics)
+    top = local_maxima(power, N_CANDIDATES)
+    candidates = [(float(1 / freq[k]), float(power[k])) for k in top]
+    peak = refine_peak(series, float(freq[top[0]]), list(range(1, harmonics + 1)))
+    decision = rotation_period(series, 1 / peak.frequency_hz, harmonics, min_p, if_symmetric)
+    boot = bootstrap_maxima(series, freq, harmonics, draws, seed)
+    correction = None
+    geometry = pass_geometry(measured, lc, loaded)
+    if geometry is not None:
+        pab, axis = geometry
+        correction = sidereal_period(
+            series,
+            decision.rotation_period_s,
+            harmonics,
+            t_s,
+            pab,
+            weight,
+            axis,
+            apply=synodic == "bisector",
+        )
+    return PeriodResult(
+        series,
+        list(lc.band_names),
+        freq,
+        power,
+        candidates,
+        peak,
+        harmonics,
+        boot,
+        decision,
+        correction,
+        n_epochs,
+        lc.source,
+    )
+
+
+def _carried_scenario(measured: str | Path) -> LoadedScenario | None:
+    if Path(measured).suffix.lower() not in (".nc", ".nc4", ".netcdf", ".h5"):
+        return None
+    import xarray as xr
+
+    from speclight.scenario import parse_scenario
+
+    with xr.open_dataset(measured, engine="h5netcdf") as ds:
+        text = ds.attrs.get("scenario_yaml")
+    if text is None:
+        return None
+    return parse_scenario(str(text), source=f"{measured} (scenario_yaml)")
