@@ -121,9 +121,10 @@ def grid_errors(
     for start in range(0, ra_all.size, chunk):
         sl = slice(start, start + chunk)
         p = predict_chunk(sfm, geo, axis_frames(ra_all[sl], dec_all[sl]), weights)
-        s1 = p.sum(axis=1, dtype=np.float64)
-        s2 = np.einsum("atbk,atbk->abk", p, p, dtype=np.float64)
-        sy = np.einsum("atbk,tb->abk", p, yn, dtype=np.float64)
+        # float32 sums (relative round-off ~1e-6 over hundreds of epochs; 3-5x faster)
+        s1 = p.sum(axis=1).transpose(0, 2, 1).astype(float)
+        s2 = np.einsum("atkb,atkb->abk", p, p).astype(float)
+        sy = np.einsum("atkb,tb->abk", p, yn).astype(float)
         out[sl] = misfit_from_sums(s1, s2, sy, yy, n_t)
         if progress is not None:
             progress(min(start + chunk, ra_all.size), ra_all.size)

@@ -60,8 +60,9 @@ class SpinFrameMap:
 
     ``values`` has shape (n_polar, m, P, R, 2 n_phases, B): polar cell ``i`` (centre
     ``(i + 0.5) * 180 / n_polar`` deg), azimuth cell ``c = q m + s`` (centre ``c * 360 /
-    (n_phases m)`` deg) stored at ``[s, ..., q]`` and again at ``q + n_phases`` (so every
-    window of ``n_phases`` is contiguous), the map's phase angles ``P`` and rolls ``R``.
+    (n_phases m)`` deg) stored at ``[i, s, ..., 2 n_phases - 1 - q]`` and again at
+    ``n_phases - 1 - q`` (so that the cells ``q, q - 1, ...`` of the phases ``0, 1, ...`` are
+    one contiguous window), the map's phase angles ``P`` and rolls ``R``.
     """
 
     values: F32
@@ -112,7 +113,8 @@ def spin_frame_map(
             out[:, :, j, k] = rate.reshape(n_polar, n_az, n_b)
     # (polar, q, s, P, R, B) -> (polar, s, P, R, q, B), doubled along q
     grid = out.reshape(n_polar, n_phases, m, angles.size, n_rolls, n_b).transpose(0, 2, 3, 4, 1, 5)
-    values = np.ascontiguousarray(np.concatenate([grid, grid], axis=4))
+    # stored reversed along q, so that the window of phases 0, 1, ... reads forwards
+    values = np.ascontiguousarray(np.concatenate([grid, grid], axis=4)[:, :, :, :, ::-1])
     return SpinFrameMap(values, n_phases, m, angles, n_rolls, spin_to_body)
 
 
@@ -155,7 +157,7 @@ def phase_angle_weights(stored_deg: F64, a_deg: F64) -> tuple[NDArray[np.int64],
 
 
 def predict_chunk(sfm: SpinFrameMap, geo: EpochGeometry, frames: F64, phase_weights: tuple) -> F32:
-    """Band rates (A, T, B, n_phases) of A axes x T epochs x the candidate phases.
+    """Band rates (A, T, n_phases, B) of A axes x T epochs x the candidate phases.
 
     ``frames``: (A, 3, 3) from :func:`axis_frames`; phase ``k`` is ``360 k / n_phases`` deg
     at ``t_s = 0``.
@@ -180,7 +182,7 @@ def predict_chunk(sfm: SpinFrameMap, geo: EpochGeometry, frames: F64, phase_weig
     v = sfm.values.reshape(-1, 2 * sfm.n_phases, sfm.values.shape[-1])
     windows = np.lib.stride_tricks.sliding_window_view(v, sfm.n_phases, axis=1)
     base = ((i_polar * sfm.m + s_sub) * n_p) * n_r
-    start = q + 1
+    start = (sfm.n_phases - 1 - q) % sfm.n_phases  # element k of the window: cell q - k
     out: F32 | None = None
     for jj in range(2 if n_p > 1 else 1):
         jt = np.tile(j_idx[jj], n_ax)
@@ -188,11 +190,11 @@ def predict_chunk(sfm: SpinFrameMap, geo: EpochGeometry, frames: F64, phase_weig
         for rr in range(2 if n_r > 1 else 1):
             r_idx = (r_lo + rr) % n_r
             w = (wj * (w_r if rr else 1.0 - w_r) if n_r > 1 else wj).astype(np.float32)
-            term = windows[base + jt * n_r + r_idx, start] * w[:, None, None]
+            # the gathered windows are laid out (n, phase, band) in memory: keep that order
+            term = windows[base + jt * n_r + r_idx, start].transpose(0, 2, 1) * w[:, None, None]
             out = term if out is None else out + term
     assert out is not None
     bad = ~np.isfinite(polar)
     if np.any(bad):
         out[bad] = np.nan
-    # windows run over q+1..q+n: phase k sits at q - k, i.e. reversed
-    return out[:, :, ::-1].reshape(n_ax, n_t, -1, sfm.n_phases)
+    return out.reshape(n_ax, n_t, sfm.n_phases, -1)
