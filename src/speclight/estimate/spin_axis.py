@@ -132,18 +132,21 @@ def grid_errors(
 
 
 def local_minima(error: F64) -> NDArray[np.int64]:
-    """Flat indices of cells of ``error`` (dec, ra) no larger than their 8 neighbours (RA
-    periodic, Dec not), sorted by error."""
+    """Flat indices of cells of ``error`` (dec, ra) no larger than their 8 neighbours and
+    smaller than one of them (RA periodic, Dec not), sorted by error."""
     e = np.where(np.isfinite(error), error, np.inf)
-    padded = np.pad(e, ((1, 1), (0, 0)), constant_values=np.inf)
+    padded = np.pad(e, ((1, 1), (0, 0)), constant_values=np.nan)  # beyond the poles: none
     ok = np.ones(e.shape, dtype=bool)
+    below_one = np.zeros(e.shape, dtype=bool)  # a plateau is no minimum
     for di in (-1, 0, 1):
         for dj in (-1, 0, 1):
             if di == 0 and dj == 0:
                 continue
             shifted = np.roll(padded, (-di, -dj), axis=(0, 1))[1:-1]
-            ok &= e <= shifted
-    idx = np.flatnonzero(ok & np.isfinite(e))
+            with np.errstate(invalid="ignore"):
+                ok &= ~(shifted < e)
+                below_one |= e < shifted
+    idx = np.flatnonzero(ok & below_one & np.isfinite(e))
     return idx[np.argsort(e.ravel()[idx], kind="stable")]
 
 
