@@ -56,7 +56,7 @@ def load_band_map(path: str | Path) -> ReflectivityMap:
 
 @dataclass(frozen=True)
 class SpinFrameMap:
-    """Band rates on the spin-frame grid.
+    """Band rates on the spin-frame grid, each band divided by its mean over the grid.
 
     ``values`` has shape (n_polar, m, P, R, 2 n_phases, B): polar cell ``i`` (centre
     ``(i + 0.5) * 180 / n_polar`` deg), azimuth cell ``c = q m + s`` (centre ``c * 360 /
@@ -111,6 +111,11 @@ def spin_frame_map(
             s, o = sun_observer(p, a, r)
             rate = bmap.intensity_1au(s @ spin_to_body.T, o @ spin_to_body.T)
             out[:, :, j, k] = rate.reshape(n_polar, n_az, n_b)
+    # Each band divided by its mean over the grid: the search divides every light curve by
+    # its mean anyway, and rates of ~1e20 s-1 (1 m, 1 m2) would overflow float32 squares.
+    with np.errstate(invalid="ignore", divide="ignore"):
+        scale = np.nanmean(out.reshape(-1, n_b).astype(float), axis=0)
+        out /= np.where(scale > 0, scale, 1.0).astype(np.float32)
     # (polar, q, s, P, R, B) -> (polar, s, P, R, q, B), doubled along q
     grid = out.reshape(n_polar, n_phases, m, angles.size, n_rolls, n_b).transpose(0, 2, 3, 4, 1, 5)
     # stored reversed along q, so that the window of phases 0, 1, ... reads forwards
