@@ -130,6 +130,7 @@ def test_synthetic_map_gives_the_axis_it_was_made_with(ra, dec, phase0) -> None:
     # at nside 16), and a misfit at least 10x below the best cell's
     r_ra, r_dec, r_phase, r_err = res.refined
     assert angular_distance_deg(r_ra, r_dec, ra, dec) < 3.7
+    assert abs(np.angle(np.exp(1j * np.radians(r_phase - phase0)), deg=True)) < 3.7
     assert r_err < best_err / 10
     # the error surface is saved on the grid, its minimum where the best cell is
     i, j = np.unravel_index(np.argmin(res.error), res.error.shape)
