@@ -16,7 +16,9 @@ command line are built on them:
   ``speclight upsample`` and ``speclight unmix`` commands;
 * :mod:`.reflectivity_map` (with :mod:`.reflectivity_map_store`): ``speclight
   reflectivity-map``, the target rendered over body-frame geometries into a Zarr store
-  (read back by :mod:`speclight.render.map_lookup`).
+  (read back by :mod:`speclight.render.map_lookup`);
+* :mod:`.spin_axis` (with :mod:`.spin_axis_lookup`, :mod:`.spin_axis_io`): ``speclight
+  spin-axis``, the grid search of the spin axis and phase against a reflectivity map.
 """
 
 from speclight.estimate.accuracy import (
@@ -31,6 +33,8 @@ from speclight.estimate.ground_truth import fractions, material_signatures, true
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
 from speclight.estimate.reflectivity_map import MapRun, reflectivity_map
 from speclight.estimate.scenario_bands import BandResponses, scenario_band_responses
+from speclight.estimate.spin_axis import SpinAxisResult, spin_axis_search
+from speclight.estimate.spin_axis_io import spin_axis_measured
 from speclight.estimate.unmix_inputs import read_reflectance_factors
 from speclight.estimate.unmix_io import unmix_measured
 from speclight.estimate.unmixing import UNMIX_METHODS, UnmixResult, unmix
@@ -44,6 +48,7 @@ __all__ = [
     "EndmemberResult",
     "MapRun",
     "MeasuredLightCurve",
+    "SpinAxisResult",
     "UnmixResult",
     "UpsampledSpectrum",
     "bin_light_curve",
@@ -61,6 +66,8 @@ __all__ = [
     "reflectivity_map",
     "scenario_band_responses",
     "spectral_angle_rad",
+    "spin_axis_measured",
+    "spin_axis_search",
     "true_contributions",
     "unmix",
     "unmix_measured",
