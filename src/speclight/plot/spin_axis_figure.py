@@ -48,7 +48,13 @@ def spin_axis_figure(ds: xr.Dataset) -> Any:
     ax_e.legend(loc="lower left", fontsize=7, framealpha=0.6)
     ax_e.set_title("misfit over the spin axis (min over phase)")
     mesh_p = ax_p.pcolormesh(
-        ra, dec, ds["best_phase"].transpose("dec", "ra").values, shading="nearest", cmap="twilight"
+        ra,
+        dec,
+        ds["best_phase"].transpose("dec", "ra").values,
+        shading="nearest",
+        cmap="twilight",
+        vmin=0.0,
+        vmax=360.0,
     )
     fig.colorbar(mesh_p, ax=ax_p, label="best phase at the start [deg]")
     _mark(ax_p, ds)
