@@ -115,6 +115,11 @@ def test_cli_run_and_bad_input(folder) -> None:
         assert np.isnan(ds.attrs["refined_ra_deg"])  # --no-refine
         assert ds.attrs["scenario_ra_deg"] == 30.0
         assert ds.attrs["period_s"] == 120.0
+        # the true track is the simulation's own phase vector in the body frame
+        with xr.open_dataset(measured, engine="h5netcdf") as sim:
+            p = sim["phase_vector_body"].transpose("time", ...).values
+        lat = ds["track_lat"].sel(solution="scenario").values
+        np.testing.assert_allclose(lat, np.degrees(np.arcsin(p[:, 2])), atol=1e-9)
     assert (folder / "axis.png").stat().st_size > 0
     _one_line_error(runner.invoke(app, args), "exists")
     new = ["-o", str(folder / "new.nc")]

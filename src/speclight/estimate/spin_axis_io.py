@@ -51,6 +51,35 @@ class SpinAxisRun:
     n_phases: int
     seconds: float
     source: str
+    time_utc: NDArray[np.datetime64] | None = None
+    tracks: dict[str, tuple[F64, F64]] = dataclasses.field(default_factory=dict)
+
+
+def phase_vector_track(
+    epochs: EpochGeometry,
+    spin_body_axis: list[float],
+    ra_deg: float,
+    dec_deg: float,
+    phase_deg: float,
+) -> tuple[F64, F64]:
+    """Body-frame longitude and latitude [deg] of the phase vector at every epoch for one
+    spin axis and phase (the observation track of the reference's Figure 18)."""
+    from speclight.attitude.quaternion import quat_to_matrix
+    from speclight.attitude.spin import spin_attitude
+    from speclight.render.map_geometry import lonlat_deg, map_coordinates
+
+    if not (np.isfinite(ra_deg) and np.isfinite(dec_deg) and np.isfinite(phase_deg)):
+        nan = np.full(epochs.t_s.size, np.nan)
+        return nan, nan.copy()
+    q = spin_attitude(epochs.t_s, ra_deg, dec_deg, epochs.period_s, phase_deg, spin_body_axis)
+    r = quat_to_matrix(q)
+    s = np.einsum("tji,tj->ti", r, epochs.sun_gcrs)
+    o = np.einsum("tji,tj->ti", r, epochs.observer_gcrs)
+    p, _, _ = map_coordinates(s, o)
+    lon, lat = lonlat_deg(np.nan_to_num(p))
+    bad = ~np.all(np.isfinite(p), axis=1)
+    lon[bad], lat[bad] = np.nan, np.nan
+    return lon, lat
 
 
 def _with_map_render(loaded: LoadedScenario, map_path: Path) -> LoadedScenario:
@@ -137,9 +166,21 @@ def spin_axis_measured(
     result = spin_axis_search(
         sub, sfm, epochs, y, chosen, grid_deg, body_axis, chunk, progress, refine
     )
-    truth = (spin.spin_axis_ra_deg % 360.0, spin.spin_axis_dec_deg) if spin else None
+    seconds = time.perf_counter() - t0
+    tracks = {
+        "best": phase_vector_track(epochs, body_axis, *result.best[:3]),
+        "refined": phase_vector_track(epochs, body_axis, *result.refined[:3]),
+    }
+    truth = None
+    if spin is not None:
+        truth = (spin.spin_axis_ra_deg % 360.0, spin.spin_axis_dec_deg)
+        tracks["scenario"] = (
+            np.degrees(np.arctan2(geo.phase_vector_body[:, 1], geo.phase_vector_body[:, 0]))
+            % 360.0,
+            np.degrees(np.arcsin(np.clip(geo.phase_vector_body[:, 2], -1.0, 1.0))),
+        )
     return SpinAxisRun(
-        result, period, body_axis, truth, n_phases, time.perf_counter() - t0, rf.source
+        result, period, body_axis, truth, n_phases, seconds, rf.source, rf.time_utc, tracks
     )
 
 
@@ -153,6 +194,15 @@ def axis_dataset(run: SpinAxisRun, map_path: str, scenario_source: str) -> xr.Da
         },
         coords={"ra": r.ra_deg, "dec": r.dec_deg, "band": r.band_names},
     )
+    if run.time_utc is not None and run.tracks:
+        names = list(run.tracks)
+        ds = ds.assign_coords(time=run.time_utc, solution=names)
+        lon = np.stack([run.tracks[n][0] for n in names], axis=1)
+        lat = np.stack([run.tracks[n][1] for n in names], axis=1)
+        ds["track_lon"] = (("time", "solution"), lon, {"units": "deg"})
+        ds["track_lat"] = (("time", "solution"), lat, {"units": "deg"})
+        ds["track_lon"].attrs["long_name"] = "body-frame longitude of the phase vector"
+        ds["track_lat"].attrs["long_name"] = "body-frame latitude of the phase vector"
     ds["ra"].attrs["units"] = "deg"
     ds["dec"].attrs["units"] = "deg"
     ds["best_phase"].attrs.update(

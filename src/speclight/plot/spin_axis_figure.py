@@ -1,8 +1,10 @@
 """Figure of ``speclight spin-axis`` from its AXIS.nc (the reference paper's Figure 18).
 
-Left: the misfit surface ``error(ra, dec)`` (minimised over the phase), log colour scale, on
+Top left: the misfit surface ``error(ra, dec)`` (minimised over the phase), log colour scale, on
 an RA/Dec plate carree, with the best cell, the mirror minimum, the refined axis and the
-scenario's own axis (the truth of a simulated pass) marked. Right: the best phase per cell.
+scenario's own axis (the truth of a simulated pass) marked. Top right: the best phase per
+cell. Bottom: the observation tracks (the phase vector in the body frame, longitude and
+latitude) of the scenario's attitude (the true track), the best cell and the refined axis.
 """
 
 from __future__ import annotations
@@ -36,8 +38,10 @@ def spin_axis_figure(ds: xr.Dataset) -> Any:
     """The misfit surface and the best phase of an AXIS.nc dataset."""
     from matplotlib.colors import LogNorm
 
-    fig = new_figure(4.2, 11.0)
-    ax_e, ax_p = fig.subplots(1, 2)
+    tracks = "track_lon" in ds
+    fig = new_figure(8.0 if tracks else 4.2, 11.0)
+    axes = fig.subplots(2, 2) if tracks else fig.subplots(1, 2)[None, :]
+    ax_e, ax_p = axes[0]
     ra, dec = ds["ra"].values, ds["dec"].values
     e = ds["error"].transpose("dec", "ra").values
     finite = e[np.isfinite(e) & (e > 0)]
@@ -64,4 +68,23 @@ def spin_axis_figure(ds: xr.Dataset) -> Any:
         ax.set_ylim(-90, 90)
         ax.set_xlabel("spin axis RA (GCRS) [deg]")
         ax.set_ylabel("spin axis Dec [deg]")
+    if tracks:
+        _tracks(axes[1, 0], ds)
+        axes[1, 1].set_visible(False)
     return fig
+
+
+def _tracks(ax: Any, ds: xr.Dataset) -> None:
+    styles = {"scenario": ("k", "true track (scenario)"), "best": ("C0", "best cell")}
+    styles["refined"] = ("C3", "refined")
+    for name in ds["solution"].values:
+        colour, label = styles.get(str(name), ("C2", str(name)))
+        lon = ds["track_lon"].sel(solution=name).values
+        lat = ds["track_lat"].sel(solution=name).values
+        ax.plot(lon, lat, ".", ms=2, color=colour, label=label)
+    ax.set_xlim(0, 360)
+    ax.set_ylim(-90, 90)
+    ax.set_xlabel("body-frame longitude of the phase vector [deg]")
+    ax.set_ylabel("latitude [deg]")
+    ax.set_title("observation tracks in the body frame")
+    ax.legend(loc="lower left", fontsize=7, markerscale=4)
