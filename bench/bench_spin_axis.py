@@ -24,7 +24,6 @@ import tempfile
 import time
 from pathlib import Path
 
-
 from speclight.attitude.quaternion import quat_rotate
 from speclight.estimate.reflectivity_map import reflectivity_map
 from speclight.estimate.spin_axis import grid_errors, radec_grid, spin_axis_search
