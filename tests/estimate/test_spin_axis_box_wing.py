@@ -121,6 +121,21 @@ def test_cli_run_and_bad_input(folder) -> None:
         lat = ds["track_lat"].sel(solution="scenario").values
         np.testing.assert_allclose(lat, np.degrees(np.arcsin(p[:, 2])), atol=1e-9)
     assert (folder / "axis.png").stat().st_size > 0
+    # the same noisy rates as a CSV (eq. 5 applied to them with the scenario's geometry, the
+    # scenario run on the map): the same misfits, to the CSV's 7 significant digits
+    with xr.open_dataset(measured, engine="h5netcdf") as sim:
+        rate = sim["count_rate_measured"].transpose("time", "band").values
+        rows = [f"time,{','.join(str(b) for b in sim['band'].values)}"]
+        for t, r in zip(sim["time"].values, rate, strict=True):
+            rows.append(
+                f"{np.datetime_as_string(t, unit='ms')}Z," + ",".join(f"{x:.7g}" for x in r)
+            )
+    (folder / "pass.csv").write_text("\n".join(rows) + "\n")
+    csv_args = [base[0], str(scenario), str(folder / "pass.csv"), *base[3:]]
+    csv_run = runner.invoke(app, [*csv_args, *args[7:], "-o", str(folder / "csv.nc")])
+    assert csv_run.exit_code == 0, csv_run.output
+    with xr.open_dataset(out, engine="h5netcdf") as a, xr.open_dataset(folder / "csv.nc") as b:
+        np.testing.assert_allclose(b["error"].values, a["error"].values, rtol=1e-5)
     _one_line_error(runner.invoke(app, args), "exists")
     new = ["-o", str(folder / "new.nc")]
     _one_line_error(runner.invoke(app, [*base, *new, "--grid-deg", "0"]), "--grid-deg")
