@@ -653,6 +653,86 @@ def reflectivity_map(
     _guarded(run)
 
 
+@app.command("spin-axis")
+def spin_axis(
+    scenario: Annotated[
+        Path, typer.Argument(help="Scenario YAML: orbit, observer, bands, spin body axis, period.")
+    ],
+    measured: Annotated[
+        Path, typer.Argument(help="MEASURED: a speclight NetCDF or a CSV of band count rates.")
+    ],
+    map_file: Annotated[
+        Path, typer.Option("--map", metavar="MAP.zarr", help="Reflectivity map of the target.")
+    ],
+    output: Annotated[
+        str, typer.Option("--output", "-o", metavar="FILE", help="Output NetCDF (AXIS.nc).")
+    ] = "axis.nc",
+    period_s: Annotated[
+        float | None,
+        typer.Option("--period-s", help="Rotation period [s] (default: the scenario's)."),
+    ] = None,
+    grid_deg: Annotated[float, typer.Option("--grid-deg", help="RA/Dec grid step [deg].")] = 2.0,
+    phases: Annotated[int, typer.Option("--phases", help="Rotation phases tried per axis.")] = 72,
+    bands: Annotated[
+        str | None, typer.Option("--bands", metavar="LIST", help="Comma-separated band names.")
+    ] = None,
+    no_refine: Annotated[
+        bool, typer.Option("--no-refine", help="Skip the local refinement.")
+    ] = False,
+    plot_file: Annotated[
+        str | None, typer.Option("--plot", metavar="FIG", help="Figure (.png, .pdf, .svg).")
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite existing outputs.")] = False,
+) -> None:
+    """Grid search of the spin axis (RA, Dec in GCRS) and the rotation phase at the scenario
+    start: every candidate's band light curves are predicted from the reflectivity map and
+    compared with the measured ones (each divided by its mean); then the mirror minimum and
+    a local refinement (Nelder-Mead). Writes AXIS.nc: error(ra, dec), best_phase(ra, dec)
+    and the best, mirror and refined axes in its attributes.
+
+    Example: speclight spin-axis pass.yaml pass.nc --map map.zarr -o axis.nc --plot axis.png
+    """
+
+    def run() -> None:
+        from speclight.estimate.spin_axis import check_search_options
+        from speclight.estimate.spin_axis_io import axis_dataset, spin_axis_measured
+        from speclight.io.netcdf import dataset_bytes
+        from speclight.plot.figure_output import claim_outputs
+        from speclight.scenario import load_scenario
+
+        check_search_options(grid_deg, phases)
+        if period_s is not None and not (period_s > 0 and period_s < float("inf")):
+            raise InputError(
+                f"--period-s = {period_s} must be a number > 0 [s]", field="--period-s"
+            )
+        names = [b.strip() for b in bands.split(",") if b.strip()] if bands else None
+        inputs = {"scenario file": scenario, "measured file": measured, "map": map_file}
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+            loaded = load_scenario(scenario)
+            result = spin_axis_measured(
+                loaded, measured, map_file, period_s, grid_deg, phases, names, not no_refine
+            )
+            ds = axis_dataset(result, str(map_file), str(scenario))
+            _raise_if_signalled()
+            claim.write(dataset_bytes(ds))
+            if figure is not None:
+                from speclight.plot.spin_axis_figure import spin_axis_figure
+
+                figure.write(spin_axis_figure(ds))
+        a = ds.attrs
+        typer.echo(
+            f"best axis RA {a['best_ra_deg']:.1f} Dec {a['best_dec_deg']:.1f} deg, phase "
+            f"{a['best_phase_deg']:.1f} deg (misfit {a['best_error']:.4g}); mirror RA "
+            f"{a['mirror_ra_deg']:.1f} Dec {a['mirror_dec_deg']:.1f} (misfit "
+            f"{a['mirror_error']:.4g}); refined RA {a['refined_ra_deg']:.2f} Dec "
+            f"{a['refined_dec_deg']:.2f} phase {a['refined_phase_deg']:.1f} "
+            f"({result.result.n_epochs} epochs, {result.seconds:.1f} s)"
+        )
+        typer.echo(f"wrote {output}" + (f" and {plot_file}" if plot_file else ""))
+
+    _guarded(run)
+
+
 @app.command()
 def period(
     measured: Annotated[

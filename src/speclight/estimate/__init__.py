@@ -23,7 +23,9 @@ command line are built on them:
   over body-frame geometries into a Zarr store (read back by
   :mod:`speclight.render.map_lookup`);
 * :mod:`.period_io` (with :mod:`.periodogram`, :mod:`.period_fap`, :mod:`.period_decision`,
-  :mod:`.synodic`, :mod:`.period_geometry`): the ``speclight period`` command.
+  :mod:`.synodic`, :mod:`.period_geometry`): the ``speclight period`` command;
+* :mod:`.spin_axis` (with :mod:`.spin_axis_lookup`, :mod:`.spin_axis_io`): ``speclight
+  spin-axis``, the grid search of the spin axis and phase against a reflectivity map.
 """
 
 from speclight.estimate.accuracy import (
@@ -44,6 +46,8 @@ from speclight.estimate.reflectivity_map import MapRun, reflectivity_map
 from speclight.estimate.roughness_fit import fit_roughness
 from speclight.estimate.scenario_bands import BandResponses, scenario_band_responses
 from speclight.estimate.scenario_fit import FitResult, fit_scenario
+from speclight.estimate.spin_axis import SpinAxisResult, spin_axis_search
+from speclight.estimate.spin_axis_io import spin_axis_measured
 from speclight.estimate.unmix_inputs import read_reflectance_factors
 from speclight.estimate.unmix_io import unmix_measured
 from speclight.estimate.unmixing import UNMIX_METHODS, UnmixResult, unmix
@@ -60,6 +64,7 @@ __all__ = [
     "MeasuredLightCurve",
     "PeriodResult",
     "ReflectionMap",
+    "SpinAxisResult",
     "UnmixResult",
     "UpsampledSpectrum",
     "bin_light_curve",
@@ -84,6 +89,8 @@ __all__ = [
     "scenario_band_responses",
     "shot_noise_sigma",
     "spectral_angle_rad",
+    "spin_axis_measured",
+    "spin_axis_search",
     "true_contributions",
     "unmix",
     "unmix_measured",

@@ -178,6 +178,18 @@ class SpinAttitude(Strict):
     spin_axis_dec_deg: float = Field(ge=-90, le=90)
     period_s: float = Field(gt=0)
     initial_phase_deg: float = 0.0
+    spin_body_axis: Vector3 = Field(
+        default_factory=lambda: [0.0, 0.0, 1.0],
+        description="Body-frame axis the body spins about (normalised; default body z)",
+    )
+
+    @field_validator("spin_body_axis")
+    @classmethod
+    def _nonzero_axis(cls, value: Vector3) -> Vector3:
+        norm = sum(float(c) * float(c) for c in value) ** 0.5
+        if not 0.0 < norm < float("inf"):
+            raise ValueError(f"spin_body_axis {list(value)} must be a non-zero vector [x, y, z]")
+        return value
 
 
 class TorqueFreeAttitude(Strict):

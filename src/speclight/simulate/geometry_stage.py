@@ -112,7 +112,12 @@ def attitude_quaternions(
         return np.broadcast_to(_orientation(cfg), (t_s.size, 4)).copy()
     if isinstance(cfg, SpinAttitude):
         return att.spin_attitude(
-            t_s, cfg.spin_axis_ra_deg, cfg.spin_axis_dec_deg, cfg.period_s, cfg.initial_phase_deg
+            t_s,
+            cfg.spin_axis_ra_deg,
+            cfg.spin_axis_dec_deg,
+            cfg.period_s,
+            cfg.initial_phase_deg,
+            spin_body_axis=cfg.spin_body_axis,
         )
     q, _ = att.torque_free_attitude(
         t_s,

@@ -1,0 +1,205 @@
+"""Band count rates of a reflectivity map, looked up for many spin axes and phases at once.
+
+A spin about the body axis ``b`` turns the body frame about ``b``; in the **spin frame**
+(the body frame turned by ``m``, the smallest rotation taking ``b`` to z:
+:func:`speclight.attitude.spin.body_axis_to_z`) a change of the rotation phase is a shift
+of the azimuth about z and nothing else. So the map is resampled once onto a regular grid
+of the spin frame (polar angle x azimuth x the map's phase angles x rolls, the roll measured
+from the spin frame's own east/north axes, which a turn about z leaves unchanged) with the
+map's own interpolation (:meth:`speclight.render.map_lookup.ReflectivityMap.intensity_1au`,
+HEALPix bilinear, linear in phase angle and roll). The azimuth step divides the phase step
+``360 / n_phases`` by an integer ``m``, so the ``n_phases`` candidate phases of one
+(axis, epoch) read one contiguous run of the grid: a window of a sliding-window view, no
+Python loop per candidate. The polar angle and azimuth are looked up at the nearest grid
+cell (the grid is a few times finer than the map), the phase angle and roll linearly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from speclight.attitude.quaternion import quat_to_matrix
+from speclight.attitude.spin import body_axis_to_z
+from speclight.errors import InputError
+from speclight.render.map_geometry import map_coordinates, sun_observer
+from speclight.render.map_lookup import ReflectivityMap, read_header
+
+F64 = NDArray[np.float64]
+F32 = NDArray[np.float32]
+FIELD = "--map"
+
+
+def load_band_map(path: str | Path) -> ReflectivityMap:
+    """A complete map with its band count rates ``count_rate (D, P, R, B)`` [s-1] in place of
+    the intensity, so that :meth:`ReflectivityMap.intensity_1au` interpolates band rates."""
+    import zarr
+
+    header = read_header(path)
+    group: Any = zarr.open_group(str(path), mode="r")
+    if "count_rate" not in group or not header.band_names:
+        raise InputError(
+            f"the map {path} has no band count rates (it was made from a scenario without "
+            "instrument.bands); make it again with the scenario's bands",
+            field=FIELD,
+        )
+    return ReflectivityMap(
+        header=header,
+        direction_body=np.asarray(group["direction_body"][...], dtype=float),
+        intensity_W_sr_nm=np.asarray(group["count_rate"][...], dtype=np.float32),
+    )
+
+
+@dataclass(frozen=True)
+class SpinFrameMap:
+    """Band rates on the spin-frame grid, each band divided by its mean over the grid.
+
+    ``values`` has shape (n_polar, m, P, R, 2 n_phases, B): polar cell ``i`` (centre
+    ``(i + 0.5) * 180 / n_polar`` deg), azimuth cell ``c = q m + s`` (centre ``c * 360 /
+    (n_phases m)`` deg) stored at ``[i, s, ..., 2 n_phases - 1 - q]`` and again at
+    ``n_phases - 1 - q`` (so that the cells ``q, q - 1, ...`` of the phases ``0, 1, ...`` are
+    one contiguous window), the map's phase angles ``P`` and rolls ``R``.
+    """
+
+    values: F32
+    n_phases: int
+    m: int
+    phase_angle_deg: F64
+    n_rolls: int
+    spin_to_body: F64  # (3, 3): body vector = spin_to_body @ spin-frame vector
+
+    @property
+    def n_polar(self) -> int:
+        return int(self.values.shape[0])
+
+
+def cell_deg_for(nside: int) -> float:
+    """Grid cell of the spin frame [deg]: a third of the map's pixel spacing, 0.5..3 deg."""
+    spacing = np.degrees(np.sqrt(4 * np.pi / (12 * nside**2)))
+    return float(np.clip(spacing / 3, 0.5, 3.0))
+
+
+def spin_frame_map(
+    bmap: ReflectivityMap,
+    spin_body_axis: ArrayLike | None,
+    n_phases: int,
+    cell_deg: float | None = None,
+) -> SpinFrameMap:
+    """Resample a band map onto the spin frame of ``spin_body_axis`` (module docstring)."""
+    cell = cell_deg_for(bmap.header.nside) if cell_deg is None else float(cell_deg)
+    step = 360.0 / n_phases
+    m = max(1, int(np.ceil(step / cell)))
+    n_az = n_phases * m
+    n_polar = max(2, int(np.ceil(180.0 / cell)))
+    q_m = body_axis_to_z(spin_body_axis)
+    spin_to_body = np.eye(3) if q_m is None else quat_to_matrix(q_m).T
+    polar = np.radians((np.arange(n_polar) + 0.5) * 180.0 / n_polar)
+    az = np.radians(np.arange(n_az) * 360.0 / n_az)
+    pp, aa = np.meshgrid(polar, az, indexing="ij")
+    p = np.stack([np.sin(pp) * np.cos(aa), np.sin(pp) * np.sin(aa), np.cos(pp)], -1).reshape(-1, 3)
+    angles = bmap.header.phase_angle_deg
+    n_rolls = bmap.header.roll_deg.size
+    rolls = 2 * np.pi * np.arange(n_rolls) / n_rolls
+    n_b = bmap.intensity_W_sr_nm.shape[-1]
+    out = np.empty((n_polar, n_az, angles.size, n_rolls, n_b), dtype=np.float32)
+    for j, a in enumerate(np.radians(angles)):
+        for k, r in enumerate(rolls):
+            s, o = sun_observer(p, a, r)
+            rate = bmap.intensity_1au(s @ spin_to_body.T, o @ spin_to_body.T)
+            out[:, :, j, k] = rate.reshape(n_polar, n_az, n_b)
+    # Each band divided by its mean over the grid: the search divides every light curve by
+    # its mean anyway, and rates of ~1e20 s-1 (1 m, 1 m2) would overflow float32 squares.
+    with np.errstate(invalid="ignore", divide="ignore"):
+        scale = np.nanmean(out.reshape(-1, n_b).astype(float), axis=0)
+        out /= np.where(scale > 0, scale, 1.0).astype(np.float32)
+    # (polar, q, s, P, R, B) -> (polar, s, P, R, q, B), doubled along q
+    grid = out.reshape(n_polar, n_phases, m, angles.size, n_rolls, n_b).transpose(0, 2, 3, 4, 1, 5)
+    # stored reversed along q, so that the window of phases 0, 1, ... reads forwards
+    values = np.ascontiguousarray(np.concatenate([grid, grid], axis=4)[:, :, :, :, ::-1])
+    return SpinFrameMap(values, n_phases, m, angles, n_rolls, spin_to_body)
+
+
+def axis_frames(ra_deg: ArrayLike, dec_deg: ArrayLike) -> F64:
+    """Body-to-GCRS matrices (A, 3, 3) of the spin reference frames at phase 0 (columns x, y,
+    z; z on the axis, x on the ascending node; :func:`speclight.attitude.spin_reference_frame`)."""
+    ra = np.radians(np.asarray(ra_deg, dtype=float).ravel())
+    dec = np.radians(np.asarray(dec_deg, dtype=float).ravel())
+    z = np.stack([np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra), np.sin(dec)], -1)
+    x = np.cross([0.0, 0.0, 1.0], z)
+    norm = np.linalg.norm(x, axis=1)
+    polar = norm < 1e-9
+    x[polar] = [1.0, 0.0, 0.0]
+    x -= np.sum(x * z, axis=1)[:, None] * z
+    x /= np.linalg.norm(x, axis=1)[:, None]
+    return np.stack([x, np.cross(z, x), z], axis=-1)
+
+
+@dataclass(frozen=True)
+class EpochGeometry:
+    """Inertial directions of the measured epochs (unit vectors from the target, GCRS)."""
+
+    sun_gcrs: F64  # (T, 3)
+    observer_gcrs: F64  # (T, 3)
+    t_s: F64  # (T,) seconds since the scenario start
+    period_s: float
+
+
+def phase_angle_weights(stored_deg: F64, a_deg: F64) -> tuple[NDArray[np.int64], F64]:
+    """Indices and weights (2, T) of linear interpolation in phase angle, clamped (as the
+    map's own lookup does)."""
+    if stored_deg.size == 1:
+        zero = np.zeros(a_deg.size, dtype=np.int64)
+        return np.stack([zero, zero]), np.stack([np.ones(a_deg.size), np.zeros(a_deg.size)])
+    x = np.clip(a_deg, stored_deg[0], stored_deg[-1])
+    hi = np.clip(np.searchsorted(stored_deg, x, side="right"), 1, stored_deg.size - 1)
+    lo = hi - 1
+    t = (x - stored_deg[lo]) / (stored_deg[hi] - stored_deg[lo])
+    return np.stack([lo, hi]), np.stack([1.0 - t, t])
+
+
+def predict_chunk(sfm: SpinFrameMap, geo: EpochGeometry, frames: F64, phase_weights: tuple) -> F32:
+    """Band rates (A, T, n_phases, B) of A axes x T epochs x the candidate phases.
+
+    ``frames``: (A, 3, 3) from :func:`axis_frames`; phase ``k`` is ``360 k / n_phases`` deg
+    at ``t_s = 0``.
+    """
+    n_ax, n_t = frames.shape[0], geo.t_s.size
+    # spin-frame directions at phase 0: frame^T v
+    s = np.einsum("aij,ti->atj", frames, geo.sun_gcrs).reshape(-1, 3)
+    o = np.einsum("aij,ti->atj", frames, geo.observer_gcrs).reshape(-1, 3)
+    p, _, roll = map_coordinates(s, o)
+    polar = np.arccos(np.clip(p[:, 2], -1.0, 1.0))
+    spin_turn = 2 * np.pi * np.mod(geo.t_s / geo.period_s, 1.0)
+    az = np.arctan2(p[:, 1], p[:, 0]).reshape(n_ax, n_t) - spin_turn
+    n_az = sfm.n_phases * sfm.m
+    c = np.rint(np.mod(az.ravel(), 2 * np.pi) / (2 * np.pi) * n_az).astype(np.int64) % n_az
+    i_polar = np.clip((polar / np.pi * sfm.n_polar).astype(np.int64), 0, sfm.n_polar - 1)
+    q, s_sub = c // sfm.m, c % sfm.m
+    f = np.mod(np.nan_to_num(roll), 2 * np.pi) / (2 * np.pi / sfm.n_rolls)
+    r_lo = np.floor(f).astype(np.int64) % sfm.n_rolls
+    w_r = f - np.floor(f)
+    j_idx, w_j = phase_weights
+    n_p, n_r = sfm.phase_angle_deg.size, sfm.n_rolls
+    v = sfm.values.reshape(-1, 2 * sfm.n_phases, sfm.values.shape[-1])
+    windows = np.lib.stride_tricks.sliding_window_view(v, sfm.n_phases, axis=1)
+    base = ((i_polar * sfm.m + s_sub) * n_p) * n_r
+    start = (sfm.n_phases - 1 - q) % sfm.n_phases  # element k of the window: cell q - k
+    out: F32 | None = None
+    for jj in range(2 if n_p > 1 else 1):
+        jt = np.tile(j_idx[jj], n_ax)
+        wj = np.tile(w_j[jj], n_ax)
+        for rr in range(2 if n_r > 1 else 1):
+            r_idx = (r_lo + rr) % n_r
+            w = (wj * (w_r if rr else 1.0 - w_r) if n_r > 1 else wj).astype(np.float32)
+            # the gathered windows are laid out (n, phase, band) in memory: keep that order
+            term = windows[base + jt * n_r + r_idx, start].transpose(0, 2, 1) * w[:, None, None]
+            out = term if out is None else out + term
+    assert out is not None
+    bad = ~np.isfinite(polar)
+    if np.any(bad):
+        out[bad] = np.nan
+    return out.reshape(n_ax, n_t, sfm.n_phases, -1)
