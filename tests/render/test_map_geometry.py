@@ -13,7 +13,7 @@ from speclight.render.map_geometry import (
     nside_for,
     sun_observer,
 )
-from speclight.render.map_lookup import _phase_weights, _roll_weights
+from speclight.render.map_lookup import _roll_weights, phase_angle_weights
 
 
 @pytest.mark.parametrize(("n", "nside"), [(12, 1), (13, 2), (48, 2), (10_000, 32), (12_288, 32)])
@@ -69,7 +69,7 @@ def test_opposite_sun_and_observer_have_no_coordinates():
 
 def test_phase_weights_linear_and_clamped():
     stored = np.array([0.0, 30.0, 60.0, 90.0])
-    idx, w = _phase_weights(stored, np.array([45.0, 0.0, 100.0, 30.0]))
+    idx, w = phase_angle_weights(stored, np.array([45.0, 0.0, 100.0, 30.0]))
     # 45: halfway 30..60; 0: first; 100: clamped to 90; 30: exactly the stored angle
     value = np.sum(stored[idx] * w, axis=0)
     np.testing.assert_allclose(value, [45.0, 0.0, 90.0, 30.0])

@@ -36,10 +36,9 @@ from speclight.estimate.spin_axis_lookup import (
     EpochGeometry,
     SpinFrameMap,
     axis_frames,
-    phase_angle_weights,
     predict_chunk,
 )
-from speclight.render.map_lookup import ReflectivityMap
+from speclight.render.map_lookup import ReflectivityMap, phase_angle_weights
 
 F64 = NDArray[np.float64]
 #: Axes per chunk of the grid search (memory ~ chunk x epochs x bands x phases x 4 B x 3).

@@ -148,19 +148,6 @@ class EpochGeometry:
     period_s: float
 
 
-def phase_angle_weights(stored_deg: F64, a_deg: F64) -> tuple[NDArray[np.int64], F64]:
-    """Indices and weights (2, T) of linear interpolation in phase angle, clamped (as the
-    map's own lookup does)."""
-    if stored_deg.size == 1:
-        zero = np.zeros(a_deg.size, dtype=np.int64)
-        return np.stack([zero, zero]), np.stack([np.ones(a_deg.size), np.zeros(a_deg.size)])
-    x = np.clip(a_deg, stored_deg[0], stored_deg[-1])
-    hi = np.clip(np.searchsorted(stored_deg, x, side="right"), 1, stored_deg.size - 1)
-    lo = hi - 1
-    t = (x - stored_deg[lo]) / (stored_deg[hi] - stored_deg[lo])
-    return np.stack([lo, hi]), np.stack([1.0 - t, t])
-
-
 def predict_chunk(sfm: SpinFrameMap, geo: EpochGeometry, frames: F64, phase_weights: tuple) -> F32:
     """Band rates (A, T, n_phases, B) of A axes x T epochs x the candidate phases.
 

@@ -137,7 +137,7 @@ class ReflectivityMap:
         pix, w_pix = bilinear_interpolation_weights(
             lon * u.deg, lat * u.deg, self.header.nside, order="ring"
         )
-        j, w_phase = _phase_weights(self.header.phase_angle_deg, np.degrees(a[ok]))
+        j, w_phase = phase_angle_weights(self.header.phase_angle_deg, np.degrees(a[ok]))
         u = _plane_axis(sun_body, observer_body)[ok]
         acc = np.zeros((int(ok.sum()), out.shape[1]))
         for i in range(4):
@@ -165,8 +165,9 @@ def _plane_axis(sun: ArrayLike, observer: ArrayLike) -> F64:
     return np.where((n > 1e-12)[:, None], d / np.where(n > 1e-12, n, 1.0)[:, None], [1.0, 0, 0])
 
 
-def _phase_weights(stored_deg: F64, a_deg: F64) -> tuple[NDArray[np.int64], F64]:
-    """Indices (2, N) and weights (2, N) of linear interpolation in phase angle, clamped."""
+def phase_angle_weights(stored_deg: F64, a_deg: F64) -> tuple[NDArray[np.int64], F64]:
+    """Indices (2, N) and weights (2, N) of linear interpolation in phase angle, clamped
+    (also used by the spin-axis search)."""
     if stored_deg.size == 1:
         zero = np.zeros(a_deg.size, dtype=np.int64)
         return np.stack([zero, zero]), np.stack([np.ones(a_deg.size), np.zeros(a_deg.size)])
