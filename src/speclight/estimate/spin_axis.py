@@ -145,7 +145,14 @@ def grid_terms(
     for start in range(0, ra_all.size, chunk):
         sl = slice(start, start + chunk)
         frames = axis_frames(ra_all[sl], dec_all[sl])
-        p = predict_chunk(sfm, geo, frames, weights)
+        pr = None
+        if ranging is not None and ranging.shares_rates:
+            from speclight.estimate.spin_axis_ranging import predict_channels
+
+            pr = predict_channels(ranging, geo, frames)
+            p = pr[..., : y.shape[1]]  # the laser rates: the scale drops out in the misfit
+        else:
+            p = predict_chunk(sfm, geo, frames, weights)
         # float32 sums (relative round-off ~1e-6 over hundreds of epochs; 3-5x faster)
         s1 = p.sum(axis=1).transpose(0, 2, 1).astype(float)
         s2 = np.einsum("atkb,atkb->abk", p, p).astype(float)
@@ -154,7 +161,7 @@ def grid_terms(
         if ranging is not None and e_r is not None:
             from speclight.estimate.spin_axis_ranging import grid_term
 
-            e_r[sl] = grid_term(ranging, geo, frames)
+            e_r[sl] = grid_term(ranging, geo, frames, pr)
         if progress is not None:
             progress(min(start + chunk, ra_all.size), ra_all.size)
     return out, e_r

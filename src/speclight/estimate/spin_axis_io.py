@@ -195,7 +195,11 @@ def spin_axis_measured(
         from speclight.estimate.spin_axis_ranging import RangingTerm
 
         ranging = RangingTerm(
-            laser, spin_frame_map(laser, body_axis, n_phases), offsets[:, cols], weight
+            laser,
+            spin_frame_map(laser, body_axis, n_phases),
+            offsets[:, cols],
+            weight,
+            shares_rates=rf.light == "laser",
         )
     sfm = spin_frame_map(sub, body_axis, n_phases)
     result = spin_axis_search(

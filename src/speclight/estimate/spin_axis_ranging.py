@@ -111,6 +111,8 @@ class RangingTerm:
     sfm: SpinFrameMap  # its spin-frame resampling
     offset_m: F64  # (T, B) measured, NaN where none
     weight: float | None  # None: balanced over the grid (resolve_weight)
+    #: the intensity is the laser light of the same map (one lookup serves both terms)
+    shares_rates: bool = False
 
     def select(self, ok: NDArray[np.bool_]) -> RangingTerm:
         """Only the epochs ``ok``."""
@@ -141,13 +143,33 @@ def term_from_offsets(pred: NDArray, meas: F64) -> NDArray:
     return np.asarray(np.sum(d**2, axis=(-2, -1)) / (ok.sum() * norm))
 
 
-def grid_term(term: RangingTerm, geo: EpochGeometry, frames: F64) -> F64:
-    """The ranging term (A, n_phases) of a chunk of axes."""
-    cg = coaxial(geo)
+def predict_channels(term: RangingTerm, geo: EpochGeometry, frames: F64) -> NDArray:
+    """Channels ``[R..., M...]`` (A, T, n_phases, 2B) of a chunk of axes (coaxial light)."""
     w = phase_angle_weights(term.sfm.phase_angle_deg, np.zeros(geo.t_s.size))
-    p = predict_chunk(term.sfm, cg, frames, w)  # (A, T, K, 2B)
-    off = offsets_from_channels(p, term.sfm.scale, term.n_bands).transpose(0, 2, 1, 3)
-    return term_from_offsets(off, term.offset_m).astype(float)
+    return predict_chunk(term.sfm, coaxial(geo), frames, w)
+
+
+def grid_term(term: RangingTerm, geo: EpochGeometry, frames: F64, p: NDArray | None = None) -> F64:
+    """The ranging term (A, n_phases) of a chunk of axes (float32 arithmetic); ``p``: the
+    chunk's :func:`predict_channels` where already computed."""
+    if p is None:
+        p = predict_channels(term, geo, frames)  # (A, T, K, 2B)
+    n_b = term.n_bands
+    s = np.ones(2 * n_b) if term.sfm.scale is None else np.asarray(term.sfm.scale, dtype=float)
+    meas = term.offset_m
+    ok = np.isfinite(meas)
+    norm = float(np.mean(meas[ok] ** 2)) if ok.any() else 0.0
+    if norm <= 0:
+        return np.zeros((p.shape[0], p.shape[2]))
+    r, m = p[..., :n_b], p[..., n_b:]
+    off = np.zeros(r.shape, dtype=np.float32)
+    np.divide(m, r, out=off, where=r > 0)
+    off *= (s[n_b:] / s[:n_b]).astype(np.float32)  # undo the spin-frame map's scaling
+    # offsets where R <= 0 stay 0 (the centre of mass); unmeasured epochs and bands weigh 0
+    off -= np.where(ok, meas, 0.0).astype(np.float32)[None, :, None, :]
+    if not ok.all():
+        off *= ok.astype(np.float32)[None, :, None, :]
+    return np.einsum("atkb,atkb->ak", off, off).astype(float) / (ok.sum() * norm)
 
 
 def exact_term(term: RangingTerm, observer_body: F64) -> float:
