@@ -40,6 +40,11 @@ from speclight.estimate.spin_axis_lookup import (
     load_band_map,
     spin_frame_map,
 )
+from speclight.estimate.spin_axis_ranging import (
+    check_ranging_weight,
+    map_has_offsets,
+    measured_offsets,
+)
 from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
@@ -168,10 +173,10 @@ def spin_axis_measured(
     )
     lit = geo.sunlit_fraction > 0 if rf.light == "sun" else np.ones(y.shape[0], dtype=bool)
     y = np.where(geo.observable[:, None] & lit[:, None], y, np.nan)
-    offsets = None if is_csv else _measured_offsets(measured, rf.time_utc.size)
-    if ranging_weight is None and not _map_has_offsets(map_path):
+    offsets = None if is_csv else measured_offsets(measured, rf.time_utc.size)
+    if ranging_weight is None and not map_has_offsets(map_path):
         offsets = None  # automatic: ranging only where the map has offsets too
-    weight = _ranging_weight(ranging_weight, offsets)
+    weight = check_ranging_weight(ranging_weight, offsets)
     t0 = time.perf_counter()
     laser = None
     ranged = weight is None or weight > 0
@@ -231,41 +236,6 @@ def spin_axis_measured(
         rf.time_utc,
         tracks,
     )
-
-
-def _measured_offsets(measured: str | Path, n_t: int) -> F64 | None:
-    """``range_offset(time, band)`` [m] of a simulate NetCDF, or None where it has none."""
-    with xr.open_dataset(measured, engine="h5netcdf") as ds:
-        if "range_offset" not in ds:
-            return None
-        off = ds["range_offset"].transpose("time", "band").values.astype(float)
-    if off.shape[0] != n_t or not np.any(np.isfinite(off)):
-        return None
-    return np.asarray(off)
-
-
-def _map_has_offsets(map_path: Path) -> bool:
-    import zarr
-
-    return "range_offset" in zarr.open_group(str(map_path), mode="r")
-
-
-def _ranging_weight(weight: float | None, offsets: F64 | None) -> float | None:
-    """The ranging term's weight: None (balanced over the grid) where there are offsets and
-    none was given, 0 where there are none."""
-    if weight is None:
-        return None if offsets is not None else 0.0
-    if not (np.isfinite(weight) and weight >= 0):
-        raise InputError(
-            f"--ranging-weight = {weight} must be a number >= 0", field="--ranging-weight"
-        )
-    if weight > 0 and offsets is None:
-        raise InputError(
-            f"--ranging-weight = {weight} but MEASURED has no range_offset(time, band) (a "
-            "simulate NetCDF of a pass with lasers has it; a CSV never)",
-            field="--ranging-weight",
-        )
-    return float(weight)
 
 
 def axis_dataset(run: SpinAxisRun, map_path: str, scenario_source: str) -> xr.Dataset:

@@ -36,6 +36,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import xarray as xr
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
@@ -188,3 +189,39 @@ def resolve_weight(term: RangingTerm, e_i: F64, e_r: F64) -> RangingTerm:
     med_r = float(np.median(e_r[ok])) if ok.any() else 0.0
     weight = float(np.median(e_i[ok])) / med_r if med_r > 0 else 0.0
     return dataclasses.replace(term, weight=weight)
+
+
+def measured_offsets(measured: str | Path, n_t: int) -> F64 | None:
+    """``range_offset(time, band)`` [m] of a simulate NetCDF, or None where it has none."""
+    with xr.open_dataset(measured, engine="h5netcdf") as ds:
+        if "range_offset" not in ds:
+            return None
+        off = ds["range_offset"].transpose("time", "band").values.astype(float)
+    if off.shape[0] != n_t or not np.any(np.isfinite(off)):
+        return None
+    return np.asarray(off)
+
+
+def map_has_offsets(map_path: str | Path) -> bool:
+    """Whether the map stores ``range_offset``."""
+    import zarr
+
+    return "range_offset" in zarr.open_group(str(map_path), mode="r")
+
+
+def check_ranging_weight(weight: float | None, offsets: F64 | None) -> float | None:
+    """The ranging term's weight: None (balanced over the grid) where there are offsets and
+    none was given, 0 where there are none."""
+    if weight is None:
+        return None if offsets is not None else 0.0
+    if not (np.isfinite(weight) and weight >= 0):
+        raise InputError(
+            f"--ranging-weight = {weight} must be a number >= 0", field="--ranging-weight"
+        )
+    if weight > 0 and offsets is None:
+        raise InputError(
+            f"--ranging-weight = {weight} but MEASURED has no range_offset(time, band) (a "
+            "simulate NetCDF of a pass with lasers has it; a CSV never)",
+            field="--ranging-weight",
+        )
+    return float(weight)
