@@ -90,6 +90,11 @@ def test_cli_laser_run_and_bad_input(folder) -> None:
     assert ok.exit_code == 0, ok.output
     with xr.open_dataset(f / "axis.nc", engine="h5netcdf") as ds:
         assert ds.attrs["light"] == "laser" and ds.attrs["ranging_weight"] == 2.0
+        # coaxial light: the true track is the simulation's observer direction in the body
+        lat = ds["track_lat"].sel(solution="scenario").values
+    with xr.open_dataset(f / "laser.nc", engine="h5netcdf") as sim:
+        o = sim["observer_direction_body"].transpose("time", ...).values
+    np.testing.assert_allclose(lat, np.degrees(np.arcsin(o[:, 2])), atol=1e-9)
     new = ["-o", str(f / "new.nc"), *opts]
     # a solar pass has no laser factors
     sun_pass = ["spin-axis", str(f / "sun.yaml"), str(f / "sun.nc"), "--map", str(f / "sun.zarr")]

@@ -218,10 +218,11 @@ def spin_axis_measured(
     truth = None
     if spin is not None:
         truth = (spin.spin_axis_ra_deg % 360.0, spin.spin_axis_dec_deg)
+        # coaxial lasers: the phase vector is the observer direction
+        pv = geo.phase_vector_body if rf.light == "sun" else geo.observer_direction_body
         tracks["scenario"] = (
-            np.degrees(np.arctan2(geo.phase_vector_body[:, 1], geo.phase_vector_body[:, 0]))
-            % 360.0,
-            np.degrees(np.arcsin(np.clip(geo.phase_vector_body[:, 2], -1.0, 1.0))),
+            np.degrees(np.arctan2(pv[:, 1], pv[:, 0])) % 360.0,
+            np.degrees(np.arcsin(np.clip(pv[:, 2], -1.0, 1.0))),
         )
     return SpinAxisRun(
         result,
