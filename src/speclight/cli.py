@@ -679,6 +679,22 @@ def spin_axis(
     no_refine: Annotated[
         bool, typer.Option("--no-refine", help="Skip the local refinement.")
     ] = False,
+    source: Annotated[
+        str | None,
+        typer.Option(
+            "--source",
+            help="Light: sun or laser (coaxial, the map's phase-0 slice); default: what "
+            "MEASURED has.",
+        ),
+    ] = None,
+    ranging_weight: Annotated[
+        float | None,
+        typer.Option(
+            "--ranging-weight",
+            help="Weight of the range-offset term (0: off); default 1 where MEASURED and "
+            "the map have range offsets.",
+        ),
+    ] = None,
     plot_file: Annotated[
         str | None, typer.Option("--plot", metavar="FIG", help="Figure (.png, .pdf, .svg).")
     ] = None,
@@ -694,6 +710,7 @@ def spin_axis(
     """
 
     def run() -> None:
+        from speclight.estimate.source_spectrum import check_light
         from speclight.estimate.spin_axis import check_search_options
         from speclight.estimate.spin_axis_io import axis_dataset, spin_axis_measured
         from speclight.io.netcdf import dataset_bytes
@@ -701,6 +718,7 @@ def spin_axis(
         from speclight.scenario import load_scenario
 
         check_search_options(grid_deg, phases)
+        check_light(source)
         if period_s is not None and not (period_s > 0 and period_s < float("inf")):
             raise InputError(
                 f"--period-s = {period_s} must be a number > 0 [s]", field="--period-s"
@@ -710,7 +728,16 @@ def spin_axis(
         with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
             loaded = load_scenario(scenario)
             result = spin_axis_measured(
-                loaded, measured, map_file, period_s, grid_deg, phases, names, not no_refine
+                loaded,
+                measured,
+                map_file,
+                period_s,
+                grid_deg,
+                phases,
+                names,
+                not no_refine,
+                light=source,
+                ranging_weight=ranging_weight,
             )
             ds = axis_dataset(result, str(map_file), str(scenario))
             _raise_if_signalled()
@@ -726,7 +753,8 @@ def spin_axis(
             f"{a['mirror_ra_deg']:.1f} Dec {a['mirror_dec_deg']:.1f} (misfit "
             f"{a['mirror_error']:.4g}); refined RA {a['refined_ra_deg']:.2f} Dec "
             f"{a['refined_dec_deg']:.2f} phase {a['refined_phase_deg']:.1f} "
-            f"({result.result.n_epochs} epochs, {result.seconds:.1f} s)"
+            f"({result.result.n_epochs} epochs, {result.light}, ranging weight "
+            f"{result.ranging_weight:g}, {result.seconds:.1f} s)"
         )
         typer.echo(f"wrote {output}" + (f" and {plot_file}" if plot_file else ""))
 

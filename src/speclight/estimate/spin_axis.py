@@ -12,7 +12,8 @@ bands weigh alike. The measured light curves are band reflectance factors (eq. 5
 reference), which the range, the atmosphere and the Sun's distance do not change; the map's
 band rates are proportional to them. **Misfit**: the mean over epochs and bands of the
 squared difference of the normalised curves; ``error(ra, dec)`` is its minimum over the
-phase. Epochs where a band is not measured (NaN) are left out.
+phase. Epochs where a band is not measured (NaN) are left out. With ranging returns
+(:mod:`.spin_axis_ranging`) the misfit adds ``weight x`` the ranging term.
 
 The **mirror** solution is the lowest local minimum of ``error`` (8 neighbours, RA
 periodic) farther than ``mirror_sep_deg`` from the best cell: for a body symmetric about
@@ -25,6 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -39,6 +41,9 @@ from speclight.estimate.spin_axis_lookup import (
     predict_chunk,
 )
 from speclight.render.map_lookup import ReflectivityMap, phase_angle_weights
+
+if TYPE_CHECKING:
+    from speclight.estimate.spin_axis_ranging import RangingTerm
 
 F64 = NDArray[np.float64]
 #: Axes per chunk of the grid search (memory ~ chunk x epochs x bands x phases x 4 B x 3).
@@ -61,6 +66,7 @@ class SpinAxisResult:
     refined: tuple[float, float, float, float]
     n_epochs: int
     band_names: list[str]
+    ranging_weight: float = 0.0  # the weight used (0: no ranging term)
 
 
 def check_search_options(grid_deg: float, n_phases: int) -> None:
@@ -105,8 +111,25 @@ def grid_errors(
     dec_deg: F64,
     chunk: int = DEFAULT_AXIS_CHUNK,
     progress: Callable[[int, int], None] | None = None,
+    ranging: RangingTerm | None = None,
 ) -> tuple[F64, NDArray[np.int64]]:
     """Misfit (A, n_phases) of every axis of the RA x Dec grid (A = n_ra n_dec, RA fastest)."""
+    e_i, e_r = grid_terms(sfm, geo, y, ra_deg, dec_deg, chunk, progress, ranging)
+    out = e_i if e_r is None or ranging is None else e_i + float(ranging.weight or 0.0) * e_r
+    return out, np.argmin(out, axis=1)
+
+
+def grid_terms(
+    sfm: SpinFrameMap,
+    geo: EpochGeometry,
+    y: F64,
+    ra_deg: F64,
+    dec_deg: F64,
+    chunk: int = DEFAULT_AXIS_CHUNK,
+    progress: Callable[[int, int], None] | None = None,
+    ranging: RangingTerm | None = None,
+) -> tuple[F64, F64 | None]:
+    """Intensity term (A, n_phases) and ranging term (or None) of every grid candidate."""
     yn = normalised(y).astype(np.float32)
     yy = np.sum(yn.astype(float) ** 2, axis=0)
     a_deg = np.degrees(
@@ -117,17 +140,30 @@ def grid_errors(
     ra_all, dec_all = rr.ravel(), dd.ravel()
     n_t = y.shape[0]
     out = np.empty((ra_all.size, sfm.n_phases))
+    e_r = None if ranging is None else np.empty_like(out)
     for start in range(0, ra_all.size, chunk):
         sl = slice(start, start + chunk)
-        p = predict_chunk(sfm, geo, axis_frames(ra_all[sl], dec_all[sl]), weights)
+        frames = axis_frames(ra_all[sl], dec_all[sl])
+        pr = None
+        if ranging is not None and ranging.shares_rates:
+            from speclight.estimate.spin_axis_ranging import predict_channels
+
+            pr = predict_channels(ranging, geo, frames)
+            p = pr[..., : y.shape[1]]  # the laser rates: the scale drops out in the misfit
+        else:
+            p = predict_chunk(sfm, geo, frames, weights)
         # float32 sums (relative round-off ~1e-6 over hundreds of epochs; 3-5x faster)
         s1 = p.sum(axis=1).transpose(0, 2, 1).astype(float)
         s2 = np.einsum("atkb,atkb->abk", p, p).astype(float)
         sy = np.einsum("atkb,tb->abk", p, yn).astype(float)
         out[sl] = misfit_from_sums(s1, s2, sy, yy, n_t)
+        if ranging is not None and e_r is not None:
+            from speclight.estimate.spin_axis_ranging import grid_term
+
+            e_r[sl] = grid_term(ranging, geo, frames, pr)
         if progress is not None:
             progress(min(start + chunk, ra_all.size), ra_all.size)
-    return out, np.argmin(out, axis=1)
+    return out, e_r
 
 
 def local_minima(error: F64) -> NDArray[np.int64]:
@@ -164,6 +200,7 @@ def exact_misfit(
     ra_deg: float,
     dec_deg: float,
     phase_deg: float,
+    ranging: RangingTerm | None = None,
 ) -> float:
     """The misfit of one candidate with the map's own interpolation (no spin-frame grid)."""
     if not -90.0 <= dec_deg <= 90.0:
@@ -177,7 +214,12 @@ def exact_misfit(
     if not np.all(np.isfinite(p)):
         return float("inf")
     s1, s2, sy = p.sum(0)[:, None], (p**2).sum(0)[:, None], (p * yn).sum(0)[:, None]
-    return float(misfit_from_sums(s1, s2, sy, np.sum(yn**2, axis=0), y.shape[0])[0])
+    e = float(misfit_from_sums(s1, s2, sy, np.sum(yn**2, axis=0), y.shape[0])[0])
+    if ranging is not None and ranging.weight:
+        from speclight.estimate.spin_axis_ranging import exact_term
+
+        e += ranging.weight * exact_term(ranging, o)
+    return e
 
 
 def refine(
@@ -210,6 +252,7 @@ def spin_axis_search(
     chunk: int = DEFAULT_AXIS_CHUNK,
     progress: Callable[[int, int], None] | None = None,
     do_refine: bool = True,
+    ranging: RangingTerm | None = None,
 ) -> SpinAxisResult:
     """Grid search, mirror and refinement (module docstring).
 
@@ -224,6 +267,8 @@ def spin_axis_search(
         Inertial Sun and observer directions of the epochs, their times and the period.
     y
         (T, B) measured band reflectance factors (or rates free of range and atmosphere).
+    ranging
+        Measured range offsets (T, B) with their map and weight, or None.
     grid_deg
         RA/Dec grid step [deg], in (0, 90].
     """
@@ -238,8 +283,15 @@ def spin_axis_search(
         )
     geo = EpochGeometry(geo.sun_gcrs[ok], geo.observer_gcrs[ok], geo.t_s[ok], geo.period_s)
     y = np.asarray(y, dtype=float)[ok]
+    ranging = ranging.select(ok) if ranging is not None else None
     ra, dec = radec_grid(grid_deg)
-    flat, best_k = grid_errors(sfm, geo, y, ra, dec, chunk, progress)
+    flat, e_r = grid_terms(sfm, geo, y, ra, dec, chunk, progress, ranging)
+    if ranging is not None and e_r is not None:
+        from speclight.estimate.spin_axis_ranging import resolve_weight
+
+        ranging = resolve_weight(ranging, flat, e_r)
+        flat = flat + float(ranging.weight or 0.0) * e_r
+    best_k = np.argmin(flat, axis=1)
     phase = np.arange(sfm.n_phases) * 360.0 / sfm.n_phases
     error = flat.min(axis=1).reshape(dec.size, ra.size)
     best_phase = phase[best_k].reshape(dec.size, ra.size)
@@ -258,7 +310,7 @@ def spin_axis_search(
     if do_refine:
 
         def fun(a: float, d: float, p: float) -> float:
-            return exact_misfit(bmap, geo, y, spin_body_axis, a, d, p)
+            return exact_misfit(bmap, geo, y, spin_body_axis, a, d, p, ranging)
 
         step = max(grid_deg, 360.0 / sfm.n_phases) / 2
         starts = [best] + ([mirror] if far.size else [])
@@ -275,4 +327,5 @@ def spin_axis_search(
         refined,
         int(ok.sum()),
         list(band_names),
+        0.0 if ranging is None else float(ranging.weight or 0.0),
     )

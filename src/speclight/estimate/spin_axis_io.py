@@ -6,7 +6,12 @@ needed), and its own axis, which is marked as the "scenario axis" (the truth of 
 pass). The measured light curves are band reflectance factors
 (:func:`speclight.estimate.unmix_inputs.read_reflectance_factors`: a simulate NetCDF's, or a
 CSV's count rates turned into factors with the scenario's geometry; for a CSV the scenario is
-run with ``render: {mode: map}`` on the given map, so nothing is rendered).
+run with ``render: {mode: map}`` on the given map, so nothing is rendered). Under the Sun
+(``source="sun"``) the map's band count rates are compared; under coaxial lasers
+(``"laser"``, the laser reflectance factors) the band rates of its phase-0 slice under the
+lasers' lines (:mod:`.spin_axis_ranging`). Where the NetCDF has ``range_offset(time, band)``
+and the map ``range_offset``, the ranging term is added (``ranging_weight``; None: balanced
+over the grid where both have them, else 0).
 """
 
 from __future__ import annotations
@@ -35,6 +40,11 @@ from speclight.estimate.spin_axis_lookup import (
     load_band_map,
     spin_frame_map,
 )
+from speclight.estimate.spin_axis_ranging import (
+    check_ranging_weight,
+    map_has_offsets,
+    measured_offsets,
+)
 from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
@@ -51,6 +61,8 @@ class SpinAxisRun:
     n_phases: int
     seconds: float
     source: str
+    light: str = "sun"
+    ranging_weight: float = 0.0
     time_utc: NDArray[np.datetime64] | None = None
     tracks: dict[str, tuple[F64, F64]] = dataclasses.field(default_factory=dict)
 
@@ -118,6 +130,8 @@ def spin_axis_measured(
     refine: bool = True,
     chunk: int = DEFAULT_AXIS_CHUNK,
     progress: Callable[[int, int], None] | None = None,
+    light: str | None = None,
+    ranging_weight: float | None = None,
 ) -> SpinAxisRun:
     """Search the spin axis of a measured pass against a reflectivity map (module doc)."""
     from speclight.estimate.unmix_inputs import read_reflectance_factors
@@ -140,7 +154,7 @@ def spin_axis_measured(
             )
     is_csv = Path(measured).suffix.lower() not in (".nc", ".nc4", ".netcdf", ".h5")
     rf = read_reflectance_factors(
-        measured, _with_map_render(loaded, map_path) if is_csv else loaded, light="sun"
+        measured, _with_map_render(loaded, map_path) if is_csv else loaded, light=light
     )
     if rf.bands.band_names != names:
         raise InputError(
@@ -157,14 +171,44 @@ def spin_axis_measured(
         geo.t_s,
         period,
     )
-    y = np.where(geo.observable[:, None] & (geo.sunlit_fraction[:, None] > 0), y, np.nan)
-    sub = dataclasses.replace(
-        bmap, intensity_W_sr_nm=np.ascontiguousarray(bmap.intensity_W_sr_nm[..., cols])
-    )
+    lit = geo.sunlit_fraction > 0 if rf.light == "sun" else np.ones(y.shape[0], dtype=bool)
+    y = np.where(geo.observable[:, None] & lit[:, None], y, np.nan)
+    offsets = None if is_csv else measured_offsets(measured, rf.time_utc.size)
+    if ranging_weight is None and not map_has_offsets(map_path):
+        offsets = None  # automatic: ranging only where the map has offsets too
+    weight = check_ranging_weight(ranging_weight, offsets)
     t0 = time.perf_counter()
+    laser = None
+    ranged = weight is None or weight > 0
+    if rf.light == "laser" or ranged:
+        from speclight.estimate.spin_axis_ranging import laser_band_map, laser_kernel
+
+        kernel = laser_kernel(rf.bands.response[cols], rf.bands.wavelength_nm, rf.source_W_m2_nm)
+        laser = laser_band_map(map_path, kernel, need_offsets=ranged)
+    if rf.light == "laser":
+        from speclight.estimate.spin_axis_ranging import coaxial
+
+        assert laser is not None
+        epochs = coaxial(epochs)
+        rates = laser.intensity_W_sr_nm[..., : len(cols)]
+        sub = dataclasses.replace(laser, intensity_W_sr_nm=np.ascontiguousarray(rates))
+    else:
+        rates = bmap.intensity_W_sr_nm[..., cols]
+        sub = dataclasses.replace(bmap, intensity_W_sr_nm=np.ascontiguousarray(rates))
+    ranging = None
+    if ranged and laser is not None and offsets is not None:
+        from speclight.estimate.spin_axis_ranging import RangingTerm
+
+        ranging = RangingTerm(
+            laser,
+            spin_frame_map(laser, body_axis, n_phases),
+            offsets[:, cols],
+            weight,
+            shares_rates=rf.light == "laser",
+        )
     sfm = spin_frame_map(sub, body_axis, n_phases)
     result = spin_axis_search(
-        sub, sfm, epochs, y, chosen, grid_deg, body_axis, chunk, progress, refine
+        sub, sfm, epochs, y, chosen, grid_deg, body_axis, chunk, progress, refine, ranging
     )
     seconds = time.perf_counter() - t0
     tracks = {
@@ -174,13 +218,24 @@ def spin_axis_measured(
     truth = None
     if spin is not None:
         truth = (spin.spin_axis_ra_deg % 360.0, spin.spin_axis_dec_deg)
+        # coaxial lasers: the phase vector is the observer direction
+        pv = geo.phase_vector_body if rf.light == "sun" else geo.observer_direction_body
         tracks["scenario"] = (
-            np.degrees(np.arctan2(geo.phase_vector_body[:, 1], geo.phase_vector_body[:, 0]))
-            % 360.0,
-            np.degrees(np.arcsin(np.clip(geo.phase_vector_body[:, 2], -1.0, 1.0))),
+            np.degrees(np.arctan2(pv[:, 1], pv[:, 0])) % 360.0,
+            np.degrees(np.arcsin(np.clip(pv[:, 2], -1.0, 1.0))),
         )
     return SpinAxisRun(
-        result, period, body_axis, truth, n_phases, seconds, rf.source, rf.time_utc, tracks
+        result,
+        period,
+        body_axis,
+        truth,
+        n_phases,
+        seconds,
+        rf.source,
+        rf.light,
+        result.ranging_weight,
+        rf.time_utc,
+        tracks,
     )
 
 
@@ -230,6 +285,8 @@ def axis_dataset(run: SpinAxisRun, map_path: str, scenario_source: str) -> xr.Da
         phase_convention="phase of the rotation about spin_body_axis at the scenario start, "
         "from the ascending node of the spin plane (attitude model spin)",
         measured_source=run.source,
+        light=run.light,
+        ranging_weight=run.ranging_weight,
         map_file=map_path,
         scenario_source=scenario_source,
         seconds=run.seconds,

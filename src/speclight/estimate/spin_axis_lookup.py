@@ -71,6 +71,7 @@ class SpinFrameMap:
     phase_angle_deg: F64
     n_rolls: int
     spin_to_body: F64  # (3, 3): body vector = spin_to_body @ spin-frame vector
+    scale: F64 | None = None  # (B,) what each band was divided by (None: ones)
 
     @property
     def n_polar(self) -> int:
@@ -115,12 +116,13 @@ def spin_frame_map(
     # its mean anyway, and rates of ~1e20 s-1 (1 m, 1 m2) would overflow float32 squares.
     with np.errstate(invalid="ignore", divide="ignore"):
         scale = np.nanmean(out.reshape(-1, n_b).astype(float), axis=0)
-        out /= np.where(scale > 0, scale, 1.0).astype(np.float32)
+        scale = np.where(scale > 0, scale, 1.0)
+        out /= scale.astype(np.float32)
     # (polar, q, s, P, R, B) -> (polar, s, P, R, q, B), doubled along q
     grid = out.reshape(n_polar, n_phases, m, angles.size, n_rolls, n_b).transpose(0, 2, 3, 4, 1, 5)
     # stored reversed along q, so that the window of phases 0, 1, ... reads forwards
     values = np.ascontiguousarray(np.concatenate([grid, grid], axis=4)[:, :, :, :, ::-1])
-    return SpinFrameMap(values, n_phases, m, angles, n_rolls, spin_to_body)
+    return SpinFrameMap(values, n_phases, m, angles, n_rolls, spin_to_body, scale)
 
 
 def axis_frames(ra_deg: ArrayLike, dec_deg: ArrayLike) -> F64:
