@@ -24,7 +24,8 @@ from numpy.typing import NDArray
 
 from speclight.errors import InputError
 from speclight.estimate import reflectivity_map_store as store
-from speclight.estimate.reflectivity_map_render import coaxial_range_offset_m, render_chunk
+from speclight.estimate.reflectivity_map_render import coaxial_returns, render_chunk
+from speclight.ranging.bins import range_bin_edges_m
 from speclight.render.map_geometry import healpix_directions, nside_for
 from speclight.scenario import LoadedScenario
 
@@ -160,6 +161,8 @@ def reflectivity_map(
         "scenario_sha256": hashlib.sha256(loaded.yaml_text.encode()).hexdigest(),
     }
     ranging = bool(sc.illumination.lasers) and 0.0 in angles
+    # single-bounce bins about the body origin (the map's centre of mass), as in simulate
+    edges = range_bin_edges_m(target, np.zeros(3))
     shapes = {
         "ranging": int(ranging),
         "direction": len(dirs),
@@ -167,6 +170,7 @@ def reflectivity_map(
         "roll": n_rolls,
         "wavelength": wl.size,
         "band": len(band_names),
+        "range_bin": len(edges) - 1,
     }
     started = time.perf_counter()
     with store.store_lock(path):
@@ -181,6 +185,14 @@ def reflectivity_map(
                     "wavelength": wl,
                 },
             )
+            if ranging and band_names:
+                store.write_coordinates(
+                    group,
+                    {
+                        "range_bin": 0.5 * (edges[1:] + edges[:-1]),
+                        "range_bin_bounds": np.stack([edges[:-1], edges[1:]], axis=1),
+                    },
+                )
             group.attrs.update(_metadata(loaded, band_names, nside, session.variant))
             group.attrs["engine_versions"] = engine_versions()
         from speclight.illumination import solar_irradiance_W_m2_nm
@@ -203,8 +215,12 @@ def reflectivity_map(
                 if band_names:
                     group["count_rate"][lo:hi] = rate.astype(np.float32)
                 if ranging:
-                    offset = coaxial_range_offset_m(target, session, dirs[lo:hi], wl, loaded)
+                    offset, hist = coaxial_returns(
+                        target, session, dirs[lo:hi], wl, loaded, kernel, edges
+                    )
                     group["range_offset"][lo:hi] = offset.astype(np.float32)
+                    if band_names:
+                        group["range_histogram"][lo:hi] = hist.astype(np.float32)
                 store.mark(group, k, store.DONE)
             except Exception as exc:  # recorded, the run goes on
                 store.mark(group, k, store.FAILED, f"{type(exc).__name__}: {exc}")
@@ -242,6 +258,8 @@ def _metadata(
             "intensity": "W sr-1 nm-1",
             "count_rate": "s-1",
             "range_offset": "m",
+            "range_histogram": "s-1 per range bin",
+            "range_bin": "m",
             "wavelength": "nm",
             "phase_angle_deg": "deg",
             "roll_deg": "deg",
@@ -250,6 +268,11 @@ def _metadata(
         "no Earth shadow",
         "count_rate_conditions": "range 1 m, aperture area 1 m2, no atmosphere "
         "(transmission 1); the scenario's optics transmission, detector QE and bands",
+        "range_histogram_conditions": "phase angle 0: a coaxial laser of spectral "
+        "irradiance 1 W m-2 nm-1 on every wavelength bin, single scattering; range 1 m, "
+        "aperture area 1 m2, no atmosphere (transmission 1); the scenario's optics "
+        "transmission, detector QE and bands; range offsets one-way from the body origin "
+        "(the centre of mass), negative = in front",
         "conventions": "phase vector p = HEALPix RING pixel centre (body frame); roll r about "
         "p from e_lon = normalize(z x p) toward e_lat = p x e_lon; sun = cos(a/2) p + "
         "sin(a/2) u, observer = cos(a/2) p - sin(a/2) u, u = cos r e_lon + sin r e_lat",

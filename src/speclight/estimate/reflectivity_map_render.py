@@ -72,29 +72,53 @@ def render_chunk(
     return inten, rate.reshape(n, shapes["phase"], shapes["roll"], -1)
 
 
-def coaxial_range_offset_m(
-    target: Any, session: Any, dirs: F64, wl: F64, loaded: LoadedScenario
-) -> F64:
-    """Mean one-way range offset (n, L) [m] of a coaxial laser's return per wavelength bin.
+def coaxial_returns(
+    target: Any,
+    session: Any,
+    dirs: F64,
+    wl: F64,
+    loaded: LoadedScenario,
+    kernel: Any,
+    edges_m: F64,
+) -> tuple[F64, F64]:
+    """A coaxial laser's returns: mean offsets (n, L) [m] and band histograms (n, B, bins).
 
     ``speclight.render.laser_returns`` (single scattering, the centre of mass at the body
-    origin as in ``simulate``): the intensity-weighted mean of each pixel's offset
-    ``-(p - c) . o`` (negative: in front of the centre of mass), per bin, so that a laser
-    line at any wavelength of the grid reads its bin. NaN where nothing returns.
+    origin as in ``simulate``) for a laser of spectral irradiance 1 W m-2 nm-1 on every
+    wavelength bin along each direction:
+
+    * the mean one-way range offset per wavelength bin, the intensity-weighted mean of each
+      pixel's offset ``-(p - c) . o`` (negative: in front of the centre of mass; exact, from
+      the first moment, not from the bins), so that a laser line at any wavelength of the grid
+      reads its bin; NaN where nothing returns;
+    * the histogram over the range bins ``edges_m`` of the detected photo-electrons per
+      second per band, carried to the bands as ``simulate`` does
+      (:func:`speclight.ranging.link.downlink_conversion` and ``band_histograms``) for a
+      range of 1 m, an aperture of 1 m^2 and no atmosphere (transmission 1), with the
+      scenario's optics, QE and bands; (n, 0, bins) without bands.
     """
+    from speclight.instrument.photometry import photon_kernel
+    from speclight.ranging import link
     from speclight.render.laser_returns import LaserLight, render_laser_returns
 
-    light = LaserLight(dirs, np.arange(wl.size), np.ones((len(dirs), wl.size)))
-    edges = np.array([-1e9, 1e9])  # one bin: the first moment is exact, histograms not kept
+    n = len(dirs)
+    light = LaserLight(dirs, np.arange(wl.size), np.ones((n, wl.size)))
     returns = render_laser_returns(
         target,
         dirs,
         [light],
         wl,
         resolution_px=loaded.scenario.render.resolution_px,
-        bin_edges_m=edges,
+        bin_edges_m=edges_m,
         session=session,
     )
     total = returns.intensity_W_sr_nm(0)
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(total > 0, returns.moment_m[0] / total, np.nan)
+        offset = np.where(total > 0, returns.moment_m[0] / total, np.nan)
+    if not kernel.band_names:
+        return offset, np.zeros((n, 0, len(edges_m) - 1))
+    photons = photon_kernel(wl, kernel.optics, np.ones(wl.size), kernel.band_response * kernel.qe)
+    conversion = link.downlink_conversion(
+        np.ones((n, wl.size)), np.ones(n, dtype=bool), np.ones(n), 1.0, photons
+    )
+    return offset, link.band_histograms(returns.histogram[0], conversion)

@@ -10,7 +10,13 @@ Layout (Zarr format 3, a folder ``MAP.zarr``):
   optics, QE and bands;
 * ``range_offset(direction, wavelength)`` float32 [m], only for a scenario with lasers and
   phase angle 0 among the map's: a coaxial laser's mean one-way range offset from the
-  centre of mass per wavelength bin (single scattering; range histograms are not stored);
+  centre of mass per wavelength bin (single scattering);
+* ``range_histogram(direction, band, range_bin)`` float32 [s-1 per bin], with ``range_offset``
+  where the scenario has bands: photo-electrons per second per range bin of a coaxial laser
+  of spectral irradiance 1 W m-2 nm-1 on every wavelength bin, range 1 m, aperture 1 m^2,
+  no atmosphere (the ``count_rate`` conditions), single scattering; ``range_bin(range_bin)``
+  (bin centres) and ``range_bin_bounds(range_bin, nv)`` [m] as in the ``simulate`` output
+  (:func:`speclight.ranging.bins.range_bin_edges_m`, single-bounce span);
 * ``direction_body(direction, xyz)``, ``phase_angle_deg(phase)``, ``roll_deg(roll)``,
   ``wavelength(wavelength)`` [nm];
 * ``chunk_state(chunk)`` uint8: 0 to do, 1 done, 2 failed (each written after its chunk's
@@ -153,6 +159,15 @@ def open_or_create(
         group.create_array(
             "range_offset", shape=(d, n_wl), chunks=(chunk, n_wl), dtype="f4", fill_value=np.nan
         )
+        if n_band:
+            n_bins = shapes["range_bin"]
+            group.create_array(
+                "range_histogram",
+                shape=(d, n_band, n_bins),
+                chunks=(chunk, n_band, n_bins),
+                dtype="f4",
+                fill_value=np.nan,
+            )
     group.create_array(
         "chunk_state", shape=(n_chunks,), chunks=(n_chunks,), dtype="u1", fill_value=0
     )

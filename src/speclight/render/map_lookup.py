@@ -112,11 +112,15 @@ def check_map_matches(header: MapHeader, wavelength_nm: ArrayLike, band_names: l
 
 @dataclass(frozen=True)
 class ReflectivityMap:
-    """A map loaded in memory: its header and ``intensity`` (D, P, R, L) [W sr-1 nm-1]."""
+    """A map loaded in memory: its header, ``intensity`` (D, P, R, L) [W sr-1 nm-1] and,
+    where the map has them, the coaxial ``range_histogram`` (D, B, bins) [s-1 per bin] and
+    its bin edges (bins + 1,) [m]."""
 
     header: MapHeader
     direction_body: F64
     intensity_W_sr_nm: NDArray[np.float32]
+    range_histogram_per_s: NDArray[np.float32] | None = None
+    range_bin_edges_m: F64 | None = None
 
     def intensity_1au(self, sun_body: ArrayLike, observer_body: ArrayLike) -> F64:
         """Interpolated intensity (N, L) [W sr-1 nm-1] under the Sun at 1 AU.
@@ -150,6 +154,41 @@ class ReflectivityMap:
                 for kk in range(2):
                     w = w_pix[i] * w_phase[jj] * w_roll[kk]
                     acc += w[:, None] * self.intensity_W_sr_nm[pix[i], j[jj], k[kk]]
+        out[ok] = acc
+        return out
+
+    def coaxial_range_histogram(self, observer_body: ArrayLike) -> F64:
+        """Interpolated coaxial range histogram (N, B, bins) [s-1 per bin] at phase angle 0.
+
+        ``observer_body``: (N, 3) directions from the target to the receiver (and the
+        coaxial laser), body frame; bilinear on the HEALPix sphere as :meth:`intensity_1au`.
+        The map's conditions: a laser of 1 W m-2 nm-1 on every wavelength bin, range 1 m,
+        aperture 1 m^2, no atmosphere. NaN rows for NaN or zero directions.
+        """
+        from astropy import units as u
+        from astropy_healpix import bilinear_interpolation_weights
+
+        hist = self.range_histogram_per_s
+        if hist is None:
+            raise InputError(
+                f"the map {self.header.path} has no range_histogram (made from a scenario "
+                "without lasers or bands, or without phase angle 0)",
+                field=FIELD,
+            )
+        o = np.atleast_2d(np.asarray(observer_body, dtype=float))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            norm = np.linalg.norm(o, axis=1)
+            ok = np.isfinite(norm) & (norm > 0)
+        out = np.full((len(o), *hist.shape[1:]), np.nan)
+        if not np.any(ok):
+            return out
+        lon, lat = lonlat_deg(o[ok] / norm[ok, None])
+        pix, w_pix = bilinear_interpolation_weights(
+            lon * u.deg, lat * u.deg, self.header.nside, order="ring"
+        )
+        acc = np.zeros((int(ok.sum()), *hist.shape[1:]))
+        for i in range(4):
+            acc += w_pix[i][:, None, None] * hist[pix[i]]
         out[ok] = acc
         return out
 
@@ -197,8 +236,15 @@ def load_map(path: str | Path) -> ReflectivityMap:
 def _load(path: Path, stamp: int) -> ReflectivityMap:
     header = read_header(path)
     group = _open_group(path)
+    hist, edges = None, None
+    if "range_histogram" in group:
+        hist = np.asarray(group["range_histogram"][...], dtype=np.float32)
+        bounds = np.asarray(group["range_bin_bounds"][...], dtype=float)
+        edges = np.append(bounds[:, 0], bounds[-1, 1])
     return ReflectivityMap(
         header=header,
         direction_body=np.asarray(group["direction_body"][...], dtype=float),
         intensity_W_sr_nm=np.asarray(group["intensity"][...], dtype=np.float32),
+        range_histogram_per_s=hist,
+        range_bin_edges_m=edges,
     )
