@@ -24,10 +24,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from speclight.attitude.quaternion import quat_rotate
 from speclight.estimate.reflectivity_map import reflectivity_map
 from speclight.estimate.spin_axis import grid_errors, radec_grid, spin_axis_search
-from speclight.estimate.spin_axis_lookup import EpochGeometry, load_band_map, spin_frame_map
+from speclight.estimate.spin_axis_io import inertial_epochs
+from speclight.estimate.spin_axis_lookup import load_band_map, spin_frame_map
 from speclight.estimate.unmix_inputs import read_reflectance_factors
 from speclight.io.netcdf import dataset_bytes
 from speclight.scenario import example_text, load_scenario
@@ -72,14 +72,7 @@ def main() -> None:
         ds = simulate(load_scenario(folder / "pass.yaml")).dataset
         (folder / "pass.nc").write_bytes(dataset_bytes(ds))
         rf = read_reflectance_factors(folder / "pass.nc", loaded, light="sun")
-        geo = scenario_geometry(loaded, rf.time_utc)
-        q = geo.quaternion_body_to_gcrs
-        epochs = EpochGeometry(
-            quat_rotate(q, geo.sun_direction_body),
-            quat_rotate(q, geo.observer_direction_body),
-            geo.t_s,
-            120.0,
-        )
+        epochs = inertial_epochs(scenario_geometry(loaded, rf.time_utc), 120.0)
         y = rf.factor
         ra, dec = radec_grid(args.grid_deg)
         n_axes = ra.size * dec.size

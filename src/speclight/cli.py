@@ -235,6 +235,27 @@ def plot(
     _guarded(run)
 
 
+def _measured_inputs(
+    measured: Path, scenario: Path | None, endmembers: list[str] | None = None
+) -> dict[str, Path | str]:
+    """The input files of an estimation command, named for the output claim's checks."""
+    inputs: dict[str, Path | str] = {"measured file": measured}
+    if scenario is not None:
+        inputs["scenario file"] = scenario
+    for i, path in enumerate(endmembers or []):
+        inputs[f"endmember file {i + 1}"] = path
+    return inputs
+
+
+def _optional_scenario(scenario: Path | None) -> Any:
+    """The loaded scenario of an optional ``--scenario``, or None."""
+    if scenario is None:
+        return None
+    from speclight.scenario import load_scenario
+
+    return load_scenario(scenario)
+
+
 @app.command()
 def fit(
     scenario: Annotated[Path, typer.Argument(help="Scenario YAML file (the fit's start).")],
@@ -427,17 +448,9 @@ def unmix(
 
         members = _endmember_files(measured, endmembers)
         check_unmix_options(members, extract, n, method, source)
-        inputs: dict[str, Path | str] = {"measured file": measured[0]}
-        if scenario is not None:
-            inputs["scenario file"] = scenario
-        for i, path in enumerate(members or []):
-            inputs[f"endmember file {i + 1}"] = path
+        inputs = _measured_inputs(measured[0], scenario, members)
         with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
-            loaded = None
-            if scenario is not None:
-                from speclight.scenario import load_scenario
-
-                loaded = load_scenario(scenario)
+            loaded = _optional_scenario(scenario)
             ds = unmix_measured(
                 measured[0],
                 endmembers=members,
@@ -540,17 +553,9 @@ def reflection_map_cmd(
         members = _endmember_files(measured, endmembers)
         check_nside(nside)
         check_light(source)
-        inputs: dict[str, Path | str] = {"measured file": measured[0]}
-        if scenario is not None:
-            inputs["scenario file"] = scenario
-        for i, path in enumerate(members or []):
-            inputs[f"endmember file {i + 1}"] = path
+        inputs = _measured_inputs(measured[0], scenario, members)
         with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
-            loaded = None
-            if scenario is not None:
-                from speclight.scenario import load_scenario
-
-                loaded = load_scenario(scenario)
+            loaded = _optional_scenario(scenario)
             ds = reflection_map_measured(
                 measured[0],
                 nside=nside,
@@ -847,15 +852,9 @@ def period(
         rule: IfSymmetric = (
             "double" if if_symmetric == "double" else "keep" if if_symmetric == "keep" else "auto"
         )
-        inputs: dict[str, Path | str] = {"measured file": measured}
-        if scenario is not None:
-            inputs["scenario file"] = scenario
+        inputs = _measured_inputs(measured, scenario)
         with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
-            loaded = None
-            if scenario is not None:
-                from speclight.scenario import load_scenario
-
-                loaded = load_scenario(scenario)
+            loaded = _optional_scenario(scenario)
             result = estimate_period(
                 measured,
                 loaded=loaded,

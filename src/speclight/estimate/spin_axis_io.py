@@ -94,6 +94,19 @@ def phase_vector_track(
     return lon, lat
 
 
+def inertial_epochs(geo: Any, period_s: float) -> EpochGeometry:
+    """The Sun and observer directions in GCRS of a pass's geometry (a
+    :class:`~speclight.simulate.geometry_stage.Geometry`: they do not depend on the candidate
+    spin axis), with the spin period [s]."""
+    q = geo.quaternion_body_to_gcrs
+    return EpochGeometry(
+        quat_rotate(q, geo.sun_direction_body),
+        quat_rotate(q, geo.observer_direction_body),
+        geo.t_s,
+        period_s,
+    )
+
+
 def _with_map_render(loaded: LoadedScenario, map_path: Path) -> LoadedScenario:
     sc = loaded.scenario
     render = sc.render.model_copy(update={"mode": "map", "map_file": str(map_path.resolve())})
@@ -164,13 +177,7 @@ def spin_axis_measured(
     cols = [names.index(b) for b in chosen]
     y = rf.factor[:, cols]
     geo = scenario_geometry(loaded, rf.time_utc)
-    q = geo.quaternion_body_to_gcrs
-    epochs = EpochGeometry(
-        quat_rotate(q, geo.sun_direction_body),
-        quat_rotate(q, geo.observer_direction_body),
-        geo.t_s,
-        period,
-    )
+    epochs = inertial_epochs(geo, period)
     lit = geo.sunlit_fraction > 0 if rf.light == "sun" else np.ones(y.shape[0], dtype=bool)
     y = np.where(geo.observable[:, None] & lit[:, None], y, np.nan)
     offsets = None if is_csv else measured_offsets(measured, rf.time_utc.size)
