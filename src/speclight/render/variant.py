@@ -102,6 +102,9 @@ def _backends() -> tuple[bool, bool]:
                 import drjit  # noqa: F401
     import drjit as dr
 
+    threads = os.environ.get("SPECLIGHT_RENDER_THREADS", "")
+    if threads.isdigit() and int(threads) > 0:  # a Dask worker's share of the cores
+        dr.set_thread_count(int(threads))
     cuda = bool(dr.has_backend(dr.JitBackend.CUDA))
     llvm = bool(llvm_path) and bool(dr.has_backend(dr.JitBackend.LLVM))
     return cuda, llvm
