@@ -817,10 +817,19 @@ def period(
         str,
         typer.Option(
             "--synodic",
-            help="report (default) or bisector: apply the synodic correction in the "
-            "phase-angle bisector's frame to the period (see docs/period.md).",
+            help="auto, report or bisector: the synodic correction in the phase-angle "
+            "bisector's frame: applied to the period (bisector), only reported (report), or "
+            "applied where the median phase angle is at most 30 deg (auto; see "
+            "docs/period.md).",
         ),
-    ] = "report",
+    ] = "auto",
+    source: Annotated[
+        str,
+        typer.Option(
+            "--source",
+            help="sun (the count rates) or laser (a NetCDF's laser return rates, phase angle 0).",
+        ),
+    ] = "sun",
     plot_file: Annotated[
         str | None, typer.Option("--plot", metavar="FIG", help="Figure (.png, .pdf, .svg).")
     ] = None,
@@ -845,10 +854,6 @@ def period(
                 f"--if-symmetric = '{if_symmetric}' (choices: auto, double, keep)",
                 field="--if-symmetric",
             )
-        if synodic not in ("report", "bisector"):
-            raise InputError(
-                f"--synodic = '{synodic}' (choices: report, bisector)", field="--synodic"
-            )
         rule: IfSymmetric = (
             "double" if if_symmetric == "double" else "keep" if if_symmetric == "keep" else "auto"
         )
@@ -866,7 +871,8 @@ def period(
                 draws=draws,
                 seed=seed,
                 if_symmetric=rule,
-                synodic="bisector" if synodic == "bisector" else "report",
+                synodic=synodic,  # type: ignore[arg-type]  # checked by estimate_period
+                source=source,
             )
             _raise_if_signalled()
             summary = result.to_json()

@@ -5,7 +5,10 @@ offset or no offset), the others are count rates [s-1] named exactly as the scen
 bands, optionally with ``<band>_sigma`` columns (the rates' standard deviations [s-1]);
 lines starting with ``#`` are comments. NetCDF: a speclight dataset; its
 ``count_rate_measured`` is used where present, else ``count_rate``, and ``count_rate_sigma``
-where present.
+where present; with ``source="laser"`` its laser reflectance factors per band,
+``laser_reflectance_factor`` (the returns normalised by the range and the laser irradiance,
+which the returns fall with as ``range^-4``; the Sun's light left out, as a range-gated
+detector sees it), with the shot noise of ``return_rate`` over one epoch spacing as sigma.
 
 What is refused (an :class:`~speclight.errors.InputError` naming the file and line or
 column) and what is kept:
@@ -90,11 +93,23 @@ class MeasuredLightCurve:
         )
 
 
-def read_measured(path: str | Path) -> MeasuredLightCurve:
-    """Read measured light curves from a CSV or a speclight NetCDF file (module doc)."""
+def read_measured(path: str | Path, source: str = "sun") -> MeasuredLightCurve:
+    """Read measured light curves from a CSV or a speclight NetCDF file (module doc).
+
+    ``source``: ``"sun"`` (the count rates) or ``"laser"`` (a NetCDF's laser return rates).
+    """
     p = Path(path)
+    if source not in ("sun", "laser"):
+        raise InputError(f"--source = '{source}' (choices: sun, laser)", field="--source")
     if p.suffix.lower() in (".nc", ".nc4", ".netcdf", ".h5"):
-        return _read_netcdf(p)
+        return _read_netcdf(p, source)
+    if source == "laser":
+        raise InputError(
+            "--source laser reads the laser return rates of a speclight NetCDF; a CSV holds "
+            "count rates only (use --source sun)",
+            source=str(p),
+            field="--source",
+        )
     return _read_csv(p)
 
 
@@ -226,7 +241,7 @@ def _check_sigma(sigma: F64, src: str) -> None:
         )
 
 
-def _read_netcdf(path: Path) -> MeasuredLightCurve:
+def _read_netcdf(path: Path, source: str = "sun") -> MeasuredLightCurve:
     import xarray as xr
 
     src = str(path)
@@ -236,6 +251,15 @@ def _read_netcdf(path: Path) -> MeasuredLightCurve:
         raise InputError(f"cannot read it as NetCDF: {exc}", source=src, field=FIELD) from None
     with ds:
         name = "count_rate_measured" if "count_rate_measured" in ds else "count_rate"
+        if source == "laser":
+            if "return_rate" not in ds:
+                raise InputError(
+                    "--source laser: no laser return rates (return_rate) in it: the scenario "
+                    "had no lasers (use --source sun)",
+                    source=src,
+                    field="--source",
+                )
+            name = "laser_reflectance_factor"
         if name not in ds or "band" not in ds.coords:
             raise InputError(
                 "not a speclight dataset with band count rates (count_rate_measured or "
@@ -247,11 +271,23 @@ def _read_netcdf(path: Path) -> MeasuredLightCurve:
         _check_order(t, list(range(1, t.size + 1)), src)
         rate = ds[name].transpose("time", "band").values.astype(float)
         sigma = None
-        if "count_rate_sigma" in ds:
+        if "count_rate_sigma" in ds and source == "sun":
             sigma = ds["count_rate_sigma"].transpose("time", "band").values.astype(float)
             _check_sigma(sigma, src)
+        if source == "laser":
+            sigma = _laser_sigma(rate, ds["return_rate"].transpose("time", "band").values, t)
         bands = [str(b) for b in ds["band"].values]
     return MeasuredLightCurve(t, bands, rate, sigma, np.ones(t.size, np.int64), src)
+
+
+def _laser_sigma(factor: F64, returns: F64, t: np.ndarray) -> F64:
+    """Shot-noise sigmas of laser reflectance factors: the factor times the relative shot
+    noise ``1 / sqrt(N)`` of the returns counted in one epoch spacing ``dt``
+    (``N = return_rate * dt``; the factor is the rate times geometric terms known exactly)."""
+    dt = float(np.median(np.diff(t) / np.timedelta64(1, "s"))) if t.size > 1 else 1.0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        counts = np.asarray(returns, dtype=float) * dt
+        return np.where(counts > 0, np.abs(factor) / np.sqrt(counts), np.nan)
 
 
 def bin_light_curve(lc: MeasuredLightCurve, bin_s: float) -> MeasuredLightCurve:

@@ -1,5 +1,10 @@
-"""The phase-angle bisector in GCRS and the spin axis for the synodic correction of
-``speclight period`` (see :mod:`.synodic`)."""
+"""The phase-angle bisector in GCRS, the phase angle and the spin axis for the synodic
+correction of ``speclight period`` (see :mod:`.synodic`).
+
+Under the Sun the bisector is the dataset's ``phase_vector_body`` turned to GCRS; under
+coaxial lasers (``source="laser"``: the light comes from the observer, phase angle 0) it is
+the observer direction.
+"""
 
 from __future__ import annotations
 
@@ -12,19 +17,27 @@ from speclight.estimate.periodogram import F64
 from speclight.scenario import LoadedScenario
 
 
-def _dataset_bisector(path: Path) -> tuple[np.ndarray, F64] | None:
-    """(time, PAB in GCRS) from a speclight dataset, if it has attitude and phase vector."""
+def _dataset_bisector(path: Path, source: str) -> tuple[np.ndarray, F64, F64] | None:
+    """(time, PAB in GCRS, phase angle [deg]) from a speclight dataset, if it has the
+    attitude and the phase vector (observer direction for lasers)."""
     import xarray as xr
 
     from speclight.attitude.quaternion import quat_rotate
 
+    vector = "observer_direction_body" if source == "laser" else "phase_vector_body"
     with xr.open_dataset(path, engine="h5netcdf") as ds:
-        if "attitude_quaternion" not in ds or "phase_vector_body" not in ds:
+        if "attitude_quaternion" not in ds or vector not in ds:
             return None
         q = ds["attitude_quaternion"].transpose("time", "wxyz").values.astype(float)
-        pv = ds["phase_vector_body"].transpose("time", "xyz").values.astype(float)
+        pv = ds[vector].transpose("time", "xyz").values.astype(float)
         t = ds["time"].values.astype("datetime64[ns]")
-    return t, quat_rotate(q, pv)
+        if source == "laser":
+            phase = np.zeros(t.size)
+        elif "phase_angle" in ds:
+            phase = ds["phase_angle"].values.astype(float)
+        else:
+            return None
+    return t, quat_rotate(q, pv), phase
 
 
 def _at(t_out: np.ndarray, t_in: np.ndarray, v: F64) -> F64:
@@ -47,27 +60,38 @@ def spin_axis_gcrs(loaded: LoadedScenario | None) -> F64 | None:
 
 
 def pass_geometry(
-    measured: str | Path, lc: MeasuredLightCurve, loaded: LoadedScenario | None
-) -> tuple[F64, F64 | None] | None:
-    """(PAB in GCRS at the light curve's epochs (N, 3), spin axis or None), or None when
-    the geometry is unknown (a CSV without a scenario).
+    measured: str | Path,
+    lc: MeasuredLightCurve,
+    loaded: LoadedScenario | None,
+    source: str = "sun",
+) -> tuple[F64, F64 | None, F64] | None:
+    """(PAB in GCRS at the light curve's epochs (N, 3), spin axis or None, phase angle at
+    the epochs (N,) [deg]), or None when the geometry is unknown (a CSV without a scenario).
 
-    The PAB comes from the dataset (``attitude_quaternion`` and ``phase_vector_body``,
-    interpolated to binned epochs) or else from the scenario's geometry at the epochs.
+    The PAB comes from the dataset (``attitude_quaternion`` and ``phase_vector_body``, or
+    ``observer_direction_body`` for lasers, interpolated to binned epochs) or else from the
+    scenario's geometry at the epochs.
     """
     path = Path(measured)
     found = None
     if path.suffix.lower() in (".nc", ".nc4", ".netcdf", ".h5"):
-        found = _dataset_bisector(path)
+        found = _dataset_bisector(path, source)
     if found is not None:
-        pab = _at(lc.time_utc, *found)
+        t_in, gcrs, phase = found
     elif loaded is not None:
         from speclight.attitude.quaternion import quat_rotate
         from speclight.simulate.geometry_stage import scenario_geometry
 
         geo = scenario_geometry(loaded, lc.time_utc)
-        gcrs = quat_rotate(geo.quaternion_body_to_gcrs, geo.phase_vector_body)
-        pab = _at(lc.time_utc, lc.time_utc, gcrs)
+        vector = geo.observer_direction_body if source == "laser" else geo.phase_vector_body
+        gcrs = quat_rotate(geo.quaternion_body_to_gcrs, vector)
+        t_in = lc.time_utc
+        phase = np.zeros(t_in.size) if source == "laser" else geo.phase_angle_deg
     else:
         return None
-    return pab, spin_axis_gcrs(loaded)
+    pab = _at(lc.time_utc, t_in, gcrs)
+    x_in = (t_in - t_in[0]) / np.timedelta64(1, "s")
+    x_out = (lc.time_utc - t_in[0]) / np.timedelta64(1, "s")
+    ok = np.isfinite(phase)
+    phase_at = np.interp(x_out, x_in[ok], phase[ok]) if ok.any() else np.full(x_out.size, np.nan)
+    return pab, spin_axis_gcrs(loaded), np.asarray(phase_at, dtype=np.float64)

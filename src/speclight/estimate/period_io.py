@@ -17,8 +17,11 @@ Steps (``docs/period.md``):
 4. photometric or rotation period (:mod:`.period_decision`);
 5. synodic correction where the geometry is known (:mod:`.synodic`): from the dataset's
    ``attitude_quaternion`` and ``phase_vector_body`` or the scenario's geometry at the
-   measured epochs; the spin axis from a scenario with ``attitude.model: spin``. Reported
-   by default, applied to ``period_s`` with ``synodic="bisector"``.
+   measured epochs; the spin axis from a scenario with ``attitude.model: spin``. Applied
+   to ``period_s`` with ``synodic="bisector"``, reported only with ``"report"``, and by
+   default (``"auto"``) applied where the bisector stands for the geometry: when the
+   median phase angle of the pass is at most :data:`AUTO_MAX_PHASE_DEG` (always for
+   coaxial lasers, phase angle 0).
 """
 
 from __future__ import annotations
@@ -51,7 +54,14 @@ from speclight.estimate.periodogram import (
 from speclight.estimate.synodic import SynodicCorrection, sidereal_period
 from speclight.scenario import LoadedScenario
 
-SynodicMode = Literal["report", "bisector"]
+SynodicMode = Literal["auto", "report", "bisector"]
+#: ``synodic="auto"`` applies the correction up to this median phase angle [deg]. The
+#: light curve is a function of the phase-angle bisector's body-frame direction only in the
+#: limit of small phase angles (Harris et al. 1984, Icarus 57, 251, section II: the PAB
+#: approximation); at large ones a faceted body's light depends on the Sun's and the
+#: observer's directions separately, and the box-wing of docs/period.md (55-117 deg) shows
+#: the fit in the bisector's frame then does not help. 30 deg is speclight's choice.
+AUTO_MAX_PHASE_DEG = 30.0
 
 #: Fewest epochs accepted, and the polynomial degree of the trend removed per band.
 MIN_EPOCHS = 20
@@ -225,7 +235,8 @@ def estimate_period(
     draws: int = DRAWS,
     seed: int = 0,
     if_symmetric: IfSymmetric = "auto",
-    synodic: SynodicMode = "report",
+    synodic: SynodicMode = "auto",
+    source: str = "sun",
 ) -> PeriodResult:
     """Rotation period of the light curves in ``measured`` (module docstring)."""
     from speclight.estimate.period_geometry import pass_geometry
@@ -233,7 +244,11 @@ def estimate_period(
     _check_periods(min_period_s, max_period_s, harmonics)
     if draws < 1:
         raise InputError(f"--draws = {draws} must be >= 1", field="--draws")
-    lc = read_measured(measured)
+    if synodic not in ("auto", "report", "bisector"):
+        raise InputError(
+            f"--synodic = '{synodic}' (choices: auto, report, bisector)", field="--synodic"
+        )
+    lc = read_measured(measured, source)
     if bands:
         lc = lc.select_bands(list(bands))
     if bin_s is not None:
@@ -267,9 +282,10 @@ def estimate_period(
     decision = rotation_period(series, 1 / peak.frequency_hz, harmonics, min_p, if_symmetric)
     boot = bootstrap_maxima(series, freq, harmonics, draws, seed)
     correction = None
-    geometry = pass_geometry(measured, lc, loaded)
+    geometry = pass_geometry(measured, lc, loaded, source)
     if geometry is not None:
-        pab, axis = geometry
+        pab, axis, phase_deg = geometry
+        apply, why = _apply_synodic(synodic, phase_deg[weight > 0])
         correction = sidereal_period(
             series,
             decision.rotation_period_s,
@@ -278,7 +294,8 @@ def estimate_period(
             pab,
             weight,
             axis,
-            apply=synodic == "bisector",
+            apply=apply,
+            not_applied_why=why,
         )
     return PeriodResult(
         series,
@@ -293,6 +310,22 @@ def estimate_period(
         correction,
         n_epochs,
         lc.source,
+    )
+
+
+def _apply_synodic(mode: str, phase_deg: F64) -> tuple[bool, str]:
+    """Whether the bisector correction is applied, and why not where it is not."""
+    if mode == "bisector":
+        return True, ""
+    if mode == "report":
+        return False, "not asked for (--synodic report)"
+    median = float(np.nanmedian(phase_deg)) if np.isfinite(phase_deg).any() else np.nan
+    if median <= AUTO_MAX_PHASE_DEG:
+        return True, ""
+    return False, (
+        f"--synodic auto: the pass's median phase angle {median:.0f} deg is above "
+        f"{AUTO_MAX_PHASE_DEG:g} deg, where the light curve depends on the Sun's and the "
+        "observer's directions separately (--synodic bisector applies it anyway)"
     )
 
 

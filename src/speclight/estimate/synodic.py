@@ -133,9 +133,11 @@ def sidereal_period(
     weight: F64,
     axis_gcrs: F64 | None,
     apply: bool = True,
+    not_applied_why: str = "not asked for (--synodic bisector applies it)",
 ) -> SynodicCorrection:
     """The sidereal period by the bisector-phase fit (module docstring); without an axis,
-    only the bound; with ``apply=False`` the fit is reported but not applied."""
+    only the bound; with ``apply=False`` the fit is reported but not applied (with
+    ``not_applied_why`` in its ``method``)."""
     speed = bisector_angular_speed(t_s, pab_gcrs, weight)
     bound = float(synodic_period_s**2 * speed / (2 * np.pi))
     if axis_gcrs is None:
@@ -180,7 +182,7 @@ def sidereal_period(
             f"{plain.chi2:.6g}; {common}",
         )
     why = (
-        "not asked for (--synodic bisector applies it)"
+        not_applied_why
         if not apply
         else f"it fits worse than the plain fit (chi2 {plain.chi2:.6g})"
     )
