@@ -1,4 +1,4 @@
-"""The ``speclight`` command line (SPEC section 2).
+"""The ``speclight`` command line (README: the command table).
 
 Exit codes: 0 success, 2 bad input (the message names the file, the field and what is
 accepted), 1 internal error or an output the file system refused (full disk), 128 + N when
@@ -32,7 +32,31 @@ app = typer.Typer(
     no_args_is_help=True,
     help="Spectral light curves of satellites and space debris, as a ground telescope sees them.",
     pretty_exceptions_enable=False,
+    context_settings={"help_option_names": ["-h", "--help"]},
 )
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        from speclight import __version__
+
+        typer.echo(f"speclight {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version",
+            callback=_print_version,
+            is_eager=True,
+            help="Print the version and exit.",
+        ),
+    ] = False,
+) -> None:
+    """Spectral light curves of satellites and space debris, as a ground telescope sees them."""
 
 
 class Terminated(BaseException):
@@ -364,7 +388,7 @@ def upsample(
 
 
 def _endmember_files(arguments: list[Path], endmembers: list[str] | None) -> list[str] | None:
-    """``--endmembers E1.csv E2.csv ...`` (SPEC): the files after the first arrive as
+    """``--endmembers E1.csv E2.csv ...``: the files after the first arrive as
     positional arguments after MEASURED; ``-e`` may also be repeated."""
     extra = [str(p) for p in arguments[1:]]
     if extra and not endmembers:
@@ -920,7 +944,7 @@ def _one_line_notice(
 def main() -> None:
     """Console-script entry point."""
     warnings.formatwarning = _one_line_notice  # fallbacks are notices, not tracebacks
-    app()
+    app(prog_name="speclight")
 
 
 if __name__ == "__main__":

@@ -2,7 +2,7 @@
 
 Spectra come from CSV files (``wavelength_nm,reflectance``, one material per file, named by
 the file stem) or from the scenario's materials. Their band signatures are the averages the
-band reflectance factor is proportional to (SPEC section 5, eq. 5): over each band, weighted
+band reflectance factor is proportional to (eq. 5, docs/upsample-unmix.md): over each band, weighted
 by the detected photons **of the source at the aperture**,
 ``s_kj = sum rho_k E T R_j l dl / sum E T R_j l dl``
 (:func:`speclight.estimate.ground_truth.material_signatures`, with the source of

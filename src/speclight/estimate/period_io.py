@@ -150,7 +150,7 @@ class PeriodResult:
         return float(self.decision.factor * self.peak.frequency_std_hz / f**2)
 
     def to_json(self) -> dict[str, Any]:
-        """PERIOD.json (SPEC section 5, keys documented in docs/period.md)."""
+        """PERIOD.json (keys documented in docs/period.md)."""
         best_power = float(np.max(self.power))
         fap = self.bootstrap.false_alarm_probability(best_power)
         perm, upper = self.bootstrap.permutation_p_value(best_power)

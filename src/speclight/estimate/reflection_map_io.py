@@ -1,4 +1,4 @@
-"""``speclight reflection-map``: measured light curves in, RMAP.nc (SPEC section 5) out.
+"""``speclight reflection-map``: measured light curves in, RMAP.nc (docs/reflection-map.md) out.
 
 :func:`reflection_map_measured` reads the band reflectance factors as ``speclight unmix``
 does (:func:`.read_reflectance_factors`: a speclight NetCDF, or a CSV of count rates with a

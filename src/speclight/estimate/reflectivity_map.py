@@ -101,7 +101,7 @@ def reflectivity_map(
     progress: bool = False,
     max_chunks: int | None = None,
 ) -> MapRun:
-    """Render the scenario's target into a reflectivity map (SPEC section 5).
+    """Render the scenario's target into a reflectivity map (docs/reflectivity-map.md).
 
     Parameters
     ----------

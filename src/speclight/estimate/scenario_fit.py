@@ -1,4 +1,4 @@
-"""``speclight fit``: a scenario's simulation fitted to measured light curves (SPEC section 5).
+"""``speclight fit``: a scenario's simulation fitted to measured light curves (docs/fit.md).
 
 The scenario is simulated at the measured epochs (orbit and attitude once; with roughness
 free, reflection -> atmosphere -> instrument once per distinct roughness value on the same
@@ -35,6 +35,7 @@ from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve
 from speclight.estimate.roughness_fit import PROFILE_SIGMAS, fit_roughness
 from speclight.estimate.upsampling import band_albedo
 from speclight.scenario import LoadedScenario
+from speclight.scenario.overrides import replace_fields
 
 FREE_CHOICES = ("albedo", "roughness")
 ROUGH_BSDFS = ("beckmann", "ggx", "plastic")
@@ -70,7 +71,7 @@ class FitResult:
     extra: dict[str, Any] = field(default_factory=dict)
 
     def to_json(self) -> dict[str, Any]:
-        """FIT.json (SPEC section 5); NaN becomes ``null``."""
+        """FIT.json (docs/fit.md); NaN becomes ``null``."""
         bands = {
             name: {
                 "albedo": _num(self.albedo[j]),
@@ -121,19 +122,14 @@ def rough_materials(loaded: LoadedScenario) -> list[str]:
 
 
 def _with_roughness(loaded: LoadedScenario, values: dict[str, float]) -> LoadedScenario:
-    sc = loaded.scenario.model_copy(deep=True)
-    assert sc.target is not None
-    for name, value in values.items():
-        sc.target.materials[name].roughness = float(value)
-    return replace(loaded, scenario=sc)
+    return replace_fields(
+        loaded, {f"target.materials.{name}.roughness": float(v) for name, v in values.items()}
+    )
 
 
 def _for_fitting(loaded: LoadedScenario) -> LoadedScenario:
     """The scenario without what a fit does not use (noise draws, saved images)."""
-    sc = loaded.scenario.model_copy(deep=True)
-    sc.instrument.noise = None
-    sc.render.save_images_at = []
-    return replace(loaded, scenario=sc)
+    return replace_fields(loaded, {"instrument.noise": None, "render.save_images_at": []})
 
 
 def fit_scenario(

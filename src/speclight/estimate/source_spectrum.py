@@ -1,6 +1,6 @@
 """The source spectrum at the aperture, which weights the band signatures of materials.
 
-The band reflectance factor (SPEC section 5; eq. 5 of Nussbaum et al. 2022,
+The band reflectance factor (eq. 5 of Nussbaum et al. 2022,
 doi:10.3390/aerospace9040214) divides the band rate by the band-weighted source photon flux
 at the aperture, ``integral(E(l) T(l) R_j(l) l dl)``. A material of reflectance ``rho(l)``
 therefore enters the factor through its **source-weighted** band average
@@ -116,7 +116,7 @@ def sun_source_W_m2_nm(ds: xr.Dataset) -> F64:
     if missing:
         raise InputError(
             f"the dataset has no {' or '.join(missing)}(time, wavelength): the band "
-            "signatures need the source spectrum at the aperture (SPEC section 5, eq. 5)",
+            "signatures need the source spectrum at the aperture (eq. 5, docs/upsample-unmix.md)",
             field="MEASURED",
         )
     e = ds["solar_irradiance"].transpose("time", "wavelength").values.astype(float)

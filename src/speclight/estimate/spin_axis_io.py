@@ -247,7 +247,7 @@ def spin_axis_measured(
 
 
 def axis_dataset(run: SpinAxisRun, map_path: str, scenario_source: str) -> xr.Dataset:
-    """AXIS.nc (SPEC section 5): ``error(ra, dec)``, ``best_phase(ra, dec)`` and the answers."""
+    """AXIS.nc (docs/spin-axis.md): ``error(ra, dec)``, ``best_phase(ra, dec)`` and the answers."""
     r = run.result
     ds = xr.Dataset(
         {

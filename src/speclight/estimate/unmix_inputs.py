@@ -1,10 +1,10 @@
 """What ``speclight unmix`` reads: band reflectance factors and the source spectrum.
 
-Band reflectance factors (eq. 5 of the reference paper, SPEC section 5), from
+Band reflectance factors (eq. 5 of the reference paper), from
 
 * a speclight NetCDF. Under the Sun (``light="sun"``): its ``reflectance_factor(time,
-  band)``; where the dataset also has ``count_rate_measured`` (noisy, as SPEC's MEASURED
-  rule prefers), the factor of the measured rates, ``reflectance_factor x
+  band)``; where the dataset also has ``count_rate_measured`` (noisy, as read_measured
+  also prefers), the factor of the measured rates, ``reflectance_factor x
   count_rate_measured / count_rate`` (eq. 5 is linear in the rate; NaN where
   ``count_rate`` is 0). Under lasers (``light="laser"``): ``laser_reflectance_factor``.
   The default is the lasers where the dataset has laser factors and no finite solar ones

@@ -1,4 +1,4 @@
-"""``speclight unmix``: band reflectance factors in, ABUND.nc (SPEC section 5) out.
+"""``speclight unmix``: band reflectance factors in, ABUND.nc (docs/upsample-unmix.md) out.
 
 :func:`unmix_measured` reads the factors (:mod:`.unmix_inputs`), takes the endmembers from
 spectrum files, the scenario's materials or the data (:func:`.extract_endmembers`), unmixes
@@ -9,7 +9,7 @@ every epoch (:func:`.unmix`, eq. 6) and returns the dataset:
     reflectance factors themselves), [m2 sr-1] for ``ls`` and ``nnls`` with spectra;
 ``residual(time)`` [m2 sr-1], ``endmember_signature(endmember, band)``,
 ``reflectance_factor(time, band)`` [m2 sr-1]
-    as SPEC says; epochs with a NaN factor keep their row, with NaN abundances.
+    as documented; epochs with a NaN factor keep their row, with NaN abundances.
 
 Endmember spectra enter through their band signatures weighted by the source spectrum at
 the aperture (the Sun's or the lasers', :mod:`.endmember_spectra`), and every epoch is

@@ -1,7 +1,7 @@
 """Linear unmixing with band signatures that change with the epoch.
 
 The band reflectance factor weights a material's reflectance by the detected photons of
-the source at the aperture (SPEC section 5, eq. 5), and the atmosphere changes that source's
+the source at the aperture (eq. 5, docs/upsample-unmix.md), and the atmosphere changes that source's
 spectral shape along a pass, so the exact signatures differ from epoch to epoch
 (:mod:`speclight.estimate.endmember_spectra`). :func:`unmix_per_epoch` solves eq. 6 of
 each epoch with its own signatures by the solvers of :mod:`speclight.estimate.unmixing`

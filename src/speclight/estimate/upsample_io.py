@@ -1,7 +1,7 @@
 """``speclight upsample``: band albedos from a FIT.json, a spectrum on the scenario's grid.
 
 The albedos are read from ``bands.BAND.albedo`` of any JSON of that shape (``speclight fit``
-writes one; SPEC section 5). They are upsampled (:func:`speclight.estimate.upsample`, the
+writes one). They are upsampled (:func:`speclight.estimate.upsample`, the
 reference paper's eq. 3-4) through the scenario's band responses: band curve x optics
 transmission x detector QE (:func:`speclight.estimate.scenario_bands.scenario_band_responses`).
 """

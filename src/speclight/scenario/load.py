@@ -10,7 +10,7 @@ parser exhausts Python's stack).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, get_args
 
@@ -65,12 +65,25 @@ class _ScenarioLoader(yaml.SafeLoader):
 
 @dataclass(frozen=True)
 class LoadedScenario:
-    """A validated scenario, its YAML text and the folder relative paths refer to."""
+    """A validated scenario, its YAML text and the folder relative paths refer to.
+
+    ``yaml_text`` is always the scenario that runs: the text as read while the scenario is
+    the one read from it, else the scenario written out as YAML (a copy changed in code,
+    e.g. by :func:`~speclight.scenario.overrides.replace_fields`).
+    """
 
     scenario: Scenario
-    yaml_text: str
+    text_as_read: str
     source: str
     base_dir: Path
+    as_read: Scenario | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def yaml_text(self) -> str:
+        """YAML of the scenario that runs (recorded in every output)."""
+        if self.as_read is not None and self.scenario == self.as_read:
+            return self.text_as_read
+        return scenario_yaml(self.scenario)
 
     def resolve(self, path: str) -> Path:
         """Resolve a path written in the scenario relative to the scenario's folder."""
@@ -119,10 +132,17 @@ def parse_scenario(
     except ValidationError as exc:
         raise InputError(_describe(exc, data, root), source=source) from None
     check_engines(scenario, source)  # a missing engine is reported now, not after rendering
-    loaded = LoadedScenario(scenario, text, source, base_dir or Path.cwd())
+    loaded = LoadedScenario(
+        scenario, text, source, base_dir or Path.cwd(), as_read=scenario.model_copy(deep=True)
+    )
     if scenario.render.mode == "map":
         _check_map_file(loaded)
     return loaded
+
+
+def scenario_yaml(scenario: Scenario) -> str:
+    """A scenario written out as YAML that reads back to an equal scenario."""
+    return yaml.safe_dump(scenario.model_dump(mode="json"), sort_keys=False, allow_unicode=True)
 
 
 def _check_map_file(loaded: LoadedScenario) -> None:

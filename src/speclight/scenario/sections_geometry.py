@@ -1,4 +1,4 @@
-"""Pydantic models of the scenario file (SPEC section 3).
+"""Pydantic models of the scenario file (docs/scenario.md).
 
 Units are in the field names. Every model forbids unknown keys, so a misspelt key is an
 error (with a did-you-mean added by :mod:`speclight.scenario.load`). The models only
@@ -8,7 +8,7 @@ validate and convert; the physics lives in the stage subpackages.
 from __future__ import annotations
 
 from datetime import UTC, datetime, timedelta
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
@@ -35,13 +35,24 @@ LAST_EPOCH_UTC = _utc_of_jd(EPHEMERIS_SPAN_TDB_JD[1]) - EPHEMERIS_MARGIN
 
 
 class Strict(BaseModel):
-    """Base model: unknown keys are errors, values are validated on assignment, and no
-    number may be infinite or NaN (YAML's ``.inf`` and ``.nan``: no field has a meaning for
-    them, and they would pass a bound such as ``gt=0`` or slip through a range check)."""
+    """Base model: unknown keys are errors, no number may be infinite or NaN (YAML's ``.inf``
+    and ``.nan``: no field has a meaning for them, and they would pass a bound such as
+    ``gt=0`` or slip through a range check), and fields are read-only: a scenario changes
+    through :func:`speclight.scenario.overrides.with_overrides`, which validates the whole
+    scenario as a file is validated (an assignment could not check the rules between
+    sections, and would leave the YAML recorded in outputs behind)."""
 
-    model_config = ConfigDict(
-        extra="forbid", validate_assignment=True, frozen=False, allow_inf_nan=False
-    )
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name.startswith("_"):  # private state a validator derives (e.g. parsed tables)
+            super().__setattr__(name, value)
+            return
+        raise TypeError(
+            f"scenario fields are read-only ({type(self).__name__}.{name} = {value!r}): use "
+            "speclight.with_overrides(scenario, {'section.field': value}), which validates "
+            "the whole scenario as a file is"
+        )
 
 
 class TimeGrid(Strict):

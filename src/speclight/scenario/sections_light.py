@@ -1,6 +1,6 @@
 """Scenario models for the target, illumination, atmosphere, spectrum, render and instrument.
 
-These are the SPEC section 3 sections that later stages consume. They validate shapes,
+These are the scenario sections (docs/scenario.md) that later stages consume. They validate shapes,
 ranges and names here so that a scenario fails early, before any epoch is computed.
 """
 

@@ -1,4 +1,4 @@
-"""Assemble the output :class:`xarray.Dataset` (SPEC section 4) from the stage results."""
+"""Assemble the output :class:`xarray.Dataset` (docs/output.md) from the stage results."""
 
 from __future__ import annotations
 

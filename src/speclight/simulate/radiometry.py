@@ -69,7 +69,7 @@ def _bands(loaded: LoadedScenario) -> list[instrument.Band]:
 
 @dataclass
 class Radiometry:
-    """Instrument-side results (SPEC section 4) and the curves that produced them."""
+    """Instrument-side results (docs/output.md) and the curves that produced them."""
 
     band_names: list[str]
     spectral_flux_W_nm: F64

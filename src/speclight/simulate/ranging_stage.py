@@ -260,7 +260,7 @@ def laser_ranging(
         )
         per_pulse, total = returns.per_pulse, returns.rate_per_s
         hist, offset = returns.histogram_per_s, returns.offset_m
-        # eq. 5 with the lasers' line instead of the Sun (SPEC section 5): the same
+        # eq. 5 with the lasers' line instead of the Sun (docs/upsample-unmix.md): the same
         # reflectance factor as the Sun's, from the return rates and the lasers' irradiance
         illumination = laser_irradiance_W_m2_nm(setup, n_wl) * np.nan_to_num(transmission)
         factor = instrument.reflectance_factor_m2_sr(

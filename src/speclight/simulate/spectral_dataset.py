@@ -1,4 +1,4 @@
-"""Spectral, band and image variables of the output dataset (SPEC section 4)."""
+"""Spectral, band and image variables of the output dataset (docs/output.md)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """Build reflectances, materials and targets from plain scenario values (YAML-like dicts).
 
-Accepted forms (SPEC section 3): ``reflectance`` is a number, ``{file: path}``,
+Accepted forms (docs/scenario.md): ``reflectance`` is a number, ``{file: path}``,
 ``{wavelength_nm: [...], value: [...]}``, ``{conductor: Al}`` or ``{dielectric: SiO2}``;
 a material is ``{bsdf, reflectance, roughness?, diffuse_reflectance?, brdf_table?}``; a shape is
 ``{builtin: sphere|plate|cube|cylinder|box_wing, ...sizes}`` or ``{mesh_file: path}`` (or a

@@ -1,0 +1,68 @@
+"""Write docs/output.md from the output schema (speclight.schema), so that the page lists
+exactly the variables, dimensions, units and flag bits the code writes.
+
+    .venv/bin/python scripts/make_output_doc.py          # rewrite docs/output.md
+    .venv/bin/python scripts/make_output_doc.py --check  # exit 1 if the page is stale
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from speclight import schema
+
+PAGE = Path(__file__).resolve().parents[1] / "docs" / "output.md"
+
+HEAD = """\
+# The output dataset
+
+`speclight simulate` writes one NetCDF4 file (HDF5, readable with
+`xarray.open_dataset(path)`; `speclight.simulate(...)` returns the same dataset in memory).
+One row per epoch of the scenario's time grid: epochs where the target is below the
+horizon or unlit keep their row, with intensity 0 where unlit, NaN where not observable,
+and `flags` saying why. Units are CF / UDUNITS spellings; wavelengths are in nm.
+
+This page is generated from `src/speclight/schema.py` (the one place every variable is
+described) by `scripts/make_output_doc.py`; a test fails when the two disagree.
+
+Dimensions: `time` (UTC epochs), `wavelength` (nm, bin centres), `band` (the scenario's
+bands), `xyz` / `wxyz` (vector and quaternion components), and where present `laser`,
+`range_bin`, `material`, `image_time`, `y`, `x`.
+
+Global attributes: `scenario_yaml` (the scenario that ran, as YAML), `scenario_name`,
+`scenario_source`, `speclight_version`, `version_<package>` for every engine, the
+`render_mode` and `render_variant` used, `seed`, the observer site
+(`observer_latitude_deg`, `observer_longitude_deg`, `observer_altitude_m`,
+`min_elevation_deg`) and `atmosphere_model`.
+"""
+
+
+def page() -> str:
+    lines = [HEAD, "## Coordinates", "", "| name | units | meaning |", "|---|---|---|"]
+    for name, attrs in schema.COORDINATES.items():
+        lines.append(f"| `{name}` | {attrs.get('units', '')} | {attrs['long_name']} |")
+    lines += [
+        "",
+        "## Variables",
+        "",
+        "| name | dimensions | units | meaning |",
+        "|---|---|---|---|",
+    ]
+    for name, info in schema.VARIABLES.items():
+        dims = ", ".join(info.dims)
+        lines.append(f"| `{name}` | {dims} | {info.units} | {info.long_name} |")
+    for name, dims in schema.BOUNDS.items():
+        lines.append(f"| `{name}` | {', '.join(dims)} | (its coordinate's) | cell bounds |")
+    lines += ["", "## `flags` bits", "", "| bit | meaning |", "|---|---|"]
+    for bit, meaning in schema.FLAG_MEANINGS.items():
+        lines.append(f"| {bit} | `{meaning}` |")
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    text = page()
+    if "--check" in sys.argv:
+        sys.exit(0 if PAGE.read_text() == text else 1)
+    PAGE.write_text(text)
+    print(f"wrote {PAGE}")
