@@ -140,7 +140,7 @@ def _check_map_file(loaded: LoadedScenario) -> None:
         check_map_matches(header, grid, [band.name for band in sc.instrument.bands])
     except InputError as exc:
         raise InputError(exc.message, source=loaded.source, field=exc.field) from None
-    check_map_lasers(loaded, header)  # the coaxial returns, bistatic lasers' phase angles
+    check_map_lasers(sc, loaded.source, header)  # coaxial returns, bistatic phase angles
 
 
 def _at(mark: yaml.error.Mark) -> str:

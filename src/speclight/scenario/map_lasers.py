@@ -18,7 +18,7 @@ from speclight.errors import InputError
 
 if TYPE_CHECKING:
     from speclight.render.map_lookup import MapHeader
-    from speclight.scenario.load import LoadedScenario
+    from speclight.scenario.scenario_model import Scenario
 
 #: A laser within this distance of the observer is coaxial for a map: its phase angle is
 #: below 1 mrad (0.06 deg) for any target beyond 100 km, far below a map's direction spacing.
@@ -29,11 +29,10 @@ _REMAKE = (
 )
 
 
-def laser_baselines_m(loaded: LoadedScenario) -> list[float]:
+def laser_baselines_m(sc: Scenario) -> list[float]:
     """Distance [m] of each laser's site from the observer's (WGS84)."""
     from speclight.orbit import Site
 
-    sc = loaded.scenario
     obs = Site(sc.observer.latitude_deg, sc.observer.longitude_deg, sc.observer.altitude_m)
     here = obs.position_itrs_m
     return [
@@ -46,9 +45,10 @@ def laser_baselines_m(loaded: LoadedScenario) -> list[float]:
     ]
 
 
-def check_map_lasers(loaded: LoadedScenario, header: MapHeader) -> None:
-    """Refuse lasers the map cannot serve (module docstring); nothing without lasers."""
-    lasers = loaded.scenario.illumination.lasers
+def check_map_lasers(sc: Scenario, source: str, header: MapHeader) -> None:
+    """Refuse lasers the map cannot serve (module docstring); nothing without lasers.
+    ``source``: the scenario file, named in the messages."""
+    lasers = sc.illumination.lasers
     if not lasers:
         return
     angles = header.phase_angle_deg
@@ -57,7 +57,7 @@ def check_map_lasers(loaded: LoadedScenario, header: MapHeader) -> None:
         raise InputError(
             f"render.mode 'map' takes the lasers' returns from the map's phase angle 0; "
             f"{header.path} has phase angles {listed} deg only: {_REMAKE}",
-            source=loaded.source,
+            source=source,
             field="illumination.lasers",
         )
     missing = [a for a in ("range_offset", "range_histogram") if a not in header.arrays]
@@ -65,12 +65,12 @@ def check_map_lasers(loaded: LoadedScenario, header: MapHeader) -> None:
         raise InputError(
             f"render.mode 'map' takes the lasers' returns from the map; {header.path} has no "
             f"{' or '.join(missing)} (made from a scenario without lasers or bands): {_REMAKE}",
-            source=loaded.source,
+            source=source,
             field="illumination.lasers",
         )
     if np.max(angles) > 0:
         return  # bistatic lasers read the map at their phase angle
-    for k, base in enumerate(laser_baselines_m(loaded)):
+    for k, base in enumerate(laser_baselines_m(sc)):
         if base > COAXIAL_BASELINE_M:
             raise InputError(
                 f"laser '{lasers[k].name}' stands {base / 1e3:.3g} km from the observer "
@@ -79,6 +79,6 @@ def check_map_lasers(loaded: LoadedScenario, header: MapHeader) -> None:
                 f"in map mode: lasers within {COAXIAL_BASELINE_M:g} m of the observer); make "
                 "the map with --phase-angles-deg 0,A,... covering the laser's phase angles, "
                 "from a scenario with lasers",
-                source=loaded.source,
+                source=source,
                 field=f"illumination.lasers[{k}]",
             )
