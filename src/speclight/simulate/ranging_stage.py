@@ -20,7 +20,10 @@ its transmitter's horizon contributes nothing at that epoch and sets the flag bi
 run goes on. In ``render.mode: path``
 the interreflections are added at their full optical path length
 (:mod:`speclight.render.laser_multibounce`, Monte Carlo with ``render.samples_per_pixel`` and
-``render.seed``); single mode is single scattering, exact.
+``render.seed``); single mode is single scattering, exact. In ``render.mode: map`` nothing is
+rendered: the target's returns come from the reflectivity map
+(:mod:`speclight.simulate.map_ranging`, ``RangingSetup.map_returns``) and the rest of this
+stage is the same.
 
 The centre of mass is the body-frame origin.
 """
