@@ -14,6 +14,13 @@ process:
    ``--passive-chunks`` chunks of 512 directions (the rest extrapolated per chunk);
 4. ``render.mode: map``: the 600-epoch pass with the phase-0 map, the interpolation alone
    (map loaded) and the whole simulate run;
+4b. ``render.mode: map`` with lasers: the ``box-wing-laser`` example's 600-epoch pass (seven
+   coaxial lines and the bistatic Wettzell station) from a map of ``--laser-directions``
+   directions at phase angles 0, 15, 30 deg x 8 rolls, ``--laser-px`` px, 20 nm bins (the
+   lookup's cost does not depend on the resolution, and little on the directions): the
+   lasers' returns from the map alone (map loaded), the whole simulate run with the geometry
+   given, and the error against the same pass rendered (return photons per pulse per laser
+   and band, range offsets per band); ``--laser-only`` runs this step alone;
 5. the interpolation error of the phase-0 map against direct renders (``--error-samples``
    random directions, intensity summed over wavelength, ``|map / render - 1|``);
 6. peak resident memory (``ru_maxrss``) of the process.
@@ -41,11 +48,20 @@ from speclight.render.map_lookup import load_map
 from speclight.scenario import example_text, parse_scenario
 from speclight.simulate import simulate
 from speclight.simulate.radiometry import wavelength_grid_nm
+from speclight.simulate.ranging_stage import prepare_ranging
 from speclight.simulate.reflection import build_target
 
 
-def _scenario(px: int, render: str | None = None, folder: Path | None = None):  # type: ignore[no-untyped-def]
-    text = re.sub(r"resolution_px: \d+", f"resolution_px: {px}", example_text("box-wing"))
+def _scenario(
+    px: int,
+    render: str | None = None,
+    folder: Path | None = None,
+    example: str = "box-wing",
+    step_nm: int | None = None,
+):  # type: ignore[no-untyped-def]
+    text = re.sub(r"resolution_px: \d+", f"resolution_px: {px}", example_text(example))
+    if step_nm is not None:
+        text = re.sub(r"step_nm: \d+", f"step_nm: {step_nm}", text)
     if render is not None:
         text = re.sub(r"render: \{.*\}", render, text)
     return parse_scenario(text, source="box-wing (bench)", base_dir=folder)
@@ -61,9 +77,16 @@ def main() -> None:
     ap.add_argument("--px", type=int, default=128)
     ap.add_argument("--passive-chunks", type=int, default=1)
     ap.add_argument("--error-samples", type=int, default=300)
+    ap.add_argument("--laser-directions", type=int, default=3072)
+    ap.add_argument("--laser-px", type=int, default=32)
+    ap.add_argument("--laser-only", action="store_true")
     args = ap.parse_args()
     print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, {args.px} px")
     folder = Path(tempfile.mkdtemp(prefix="bench-refmap-"))
+    if args.laser_only:
+        laser_pass(args, folder)
+        print(f"peak RSS {_rss_gib():.2f} GiB")
+        return
     loaded = _scenario(args.px, folder=folder)
 
     t_s = np.datetime64("2019-08-30T02:20:00") + np.arange(10) * np.timedelta64(1, "s")
@@ -134,7 +157,67 @@ def main() -> None:
         f"interpolation error, phase 0, nside {the_map.header.nside}: median "
         f"{np.median(err):.4f}, 95th percentile {np.percentile(err, 95):.4f}"
     )
+    laser_pass(args, folder)
     print(f"peak RSS {_rss_gib():.2f} GiB")
+
+
+def laser_pass(args: argparse.Namespace, folder: Path) -> None:
+    """Step 4b of the module docstring."""
+    px, step = args.laser_px, 20
+    loaded = _scenario(px, None, folder, "box-wing-laser", step)
+    t0 = time.perf_counter()
+    run = reflectivity_map(
+        loaded,
+        folder / "laser.zarr",
+        directions=args.laser_directions,
+        phase_angles_deg=[0, 15, 30],
+        rolls=8,
+        force=True,
+    )
+    print(
+        f"laser map ({px} px, phase 0/15/30 x 8 rolls): {run.n_directions} directions in "
+        f"{time.perf_counter() - t0:.1f} s"
+    )
+    rendered = simulate(loaded).dataset
+    map_loaded = _scenario(
+        px, "render: {mode: map, map_file: laser.zarr}", folder, "box-wing-laser", step
+    )
+    with warnings.catch_warnings():  # the Sun's phase angles beyond 30 deg: known
+        warnings.simplefilter("ignore")
+        result = simulate(map_loaded)  # warm-up (and the geometry, reused below)
+        geo = result.geometry
+        wl = wavelength_grid_nm(map_loaded.scenario.spectrum)
+        setup = prepare_ranging(map_loaded, geo, wl, None, None)
+        assert setup is not None and setup.map_returns is not None
+        t0 = time.perf_counter()
+        setup.map_returns()
+        lookup_s = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        simulate(map_loaded, geometry=geo)
+        whole_s = time.perf_counter() - t0
+    n_las = len(map_loaded.scenario.illumination.lasers)
+    print(
+        f"render.mode map with {n_las} lasers, {geo.t_s.size} epochs: laser returns from the "
+        f"map {lookup_s * 1e3:.1f} ms, simulate with the geometry given {whole_s:.2f} s"
+    )
+    a, b = result.dataset, rendered
+    x, y = a["return_photons_per_pulse"].values, b["return_photons_per_pulse"].values
+    with np.errstate(invalid="ignore", divide="ignore"):
+        err = np.abs(x / y - 1)
+    names = list(a["laser"].values)
+    for kind in ("coaxial", "bistatic"):
+        k = [i for i, n in enumerate(names) if n.startswith("wettzell") == (kind == "bistatic")]
+        e = err[:, k][np.isfinite(err[:, k]) & (y[:, k] > 0)]
+        print(
+            f"laser error ({kind}), return photons per pulse: median {np.median(e):.4f}, "
+            f"95th percentile {np.percentile(e, 95):.4f}"
+        )
+    d = np.abs(a["range_offset"].values - b["range_offset"].values)
+    d = d[np.isfinite(d)]
+    print(
+        f"range offset error: median {np.median(d) * 1e3:.1f} mm, 95th percentile "
+        f"{np.percentile(d, 95) * 1e3:.1f} mm"
+    )
 
 
 if __name__ == "__main__":

@@ -45,6 +45,8 @@ class MapHeader:
     phase_angle_deg: F64
     roll_deg: F64
     attrs: dict[str, Any]
+    #: names of the store's arrays (``range_offset``, ``range_histogram`` where it has them)
+    arrays: frozenset[str] = frozenset()
 
 
 def _open_group(path: Path) -> Any:
@@ -87,6 +89,7 @@ def read_header(path: str | Path) -> MapHeader:
         phase_angle_deg=np.asarray(group["phase_angle_deg"][...], dtype=float),
         roll_deg=np.asarray(group["roll_deg"][...], dtype=float),
         attrs=attrs,
+        arrays=frozenset(str(k) for k in group.array_keys()),
     )
 
 
@@ -114,13 +117,14 @@ def check_map_matches(header: MapHeader, wavelength_nm: ArrayLike, band_names: l
 class ReflectivityMap:
     """A map loaded in memory: its header, ``intensity`` (D, P, R, L) [W sr-1 nm-1] and,
     where the map has them, the coaxial ``range_histogram`` (D, B, bins) [s-1 per bin] and
-    its bin edges (bins + 1,) [m]."""
+    its bin edges (bins + 1,) [m], and the coaxial ``range_offset`` (D, L) [m]."""
 
     header: MapHeader
     direction_body: F64
     intensity_W_sr_nm: NDArray[np.float32]
     range_histogram_per_s: NDArray[np.float32] | None = None
     range_bin_edges_m: F64 | None = None
+    range_offset_m: NDArray[np.float32] | None = None
 
     def intensity_1au(self, sun_body: ArrayLike, observer_body: ArrayLike) -> F64:
         """Interpolated intensity (N, L) [W sr-1 nm-1] under the Sun at 1 AU.
@@ -165,8 +169,6 @@ class ReflectivityMap:
         The map's conditions: a laser of 1 W m-2 nm-1 on every wavelength bin, range 1 m,
         aperture 1 m^2, no atmosphere. NaN rows for NaN or zero directions.
         """
-        from astropy import units as u
-        from astropy_healpix import bilinear_interpolation_weights
 
         hist = self.range_histogram_per_s
         if hist is None:
@@ -175,22 +177,34 @@ class ReflectivityMap:
                 "without lasers or bands, or without phase angle 0)",
                 field=FIELD,
             )
-        o = np.atleast_2d(np.asarray(observer_body, dtype=float))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            norm = np.linalg.norm(o, axis=1)
-            ok = np.isfinite(norm) & (norm > 0)
-        out = np.full((len(o), *hist.shape[1:]), np.nan)
+        ok, pix, w_pix = healpix_weights(self.header.nside, observer_body)
+        out = np.full((len(ok), *hist.shape[1:]), np.nan)
         if not np.any(ok):
             return out
-        lon, lat = lonlat_deg(o[ok] / norm[ok, None])
-        pix, w_pix = bilinear_interpolation_weights(
-            lon * u.deg, lat * u.deg, self.header.nside, order="ring"
-        )
         acc = np.zeros((int(ok.sum()), *hist.shape[1:]))
         for i in range(4):
             acc += w_pix[i][:, None, None] * hist[pix[i]]
         out[ok] = acc
         return out
+
+
+def healpix_weights(
+    nside: int, directions: ArrayLike
+) -> tuple[NDArray[np.bool_], NDArray[np.int64], F64]:
+    """Bilinear HEALPix interpolation (RING) at directions (N, 3), any length: ``ok`` (N,)
+    (finite, non-zero rows), pixel indices (4, n_ok) and weights (4, n_ok) of those rows."""
+    from astropy import units as u
+    from astropy_healpix import bilinear_interpolation_weights
+
+    d = np.atleast_2d(np.asarray(directions, dtype=float))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        norm = np.linalg.norm(d, axis=1)
+        ok = np.isfinite(norm) & (norm > 0)
+    if not np.any(ok):
+        return ok, np.zeros((4, 0), dtype=np.int64), np.zeros((4, 0))
+    lon, lat = lonlat_deg(d[ok] / norm[ok, None])
+    pix, w = bilinear_interpolation_weights(lon * u.deg, lat * u.deg, int(nside), order="ring")
+    return ok, np.asarray(pix, dtype=np.int64), np.asarray(w, dtype=float)
 
 
 def _plane_axis(sun: ArrayLike, observer: ArrayLike) -> F64:
@@ -236,7 +250,9 @@ def load_map(path: str | Path) -> ReflectivityMap:
 def _load(path: Path, stamp: int) -> ReflectivityMap:
     header = read_header(path)
     group = _open_group(path)
-    hist, edges = None, None
+    hist, edges, offset = None, None, None
+    if "range_offset" in group:
+        offset = np.asarray(group["range_offset"][...], dtype=np.float32)
     if "range_histogram" in group:
         hist = np.asarray(group["range_histogram"][...], dtype=np.float32)
         bounds = np.asarray(group["range_bin_bounds"][...], dtype=float)
@@ -247,4 +263,5 @@ def _load(path: Path, stamp: int) -> ReflectivityMap:
         intensity_W_sr_nm=np.asarray(group["intensity"][...], dtype=np.float32),
         range_histogram_per_s=hist,
         range_bin_edges_m=edges,
+        range_offset_m=offset,
     )

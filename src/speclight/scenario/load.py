@@ -146,17 +146,13 @@ def scenario_yaml(scenario: Scenario) -> str:
 
 
 def _check_map_file(loaded: LoadedScenario) -> None:
-    """``render.mode: map``: the map opens, is complete and matches the grid and bands."""
+    """``render.mode: map``: the map opens, is complete, matches the grid and bands, and
+    serves the lasers (:mod:`speclight.scenario.map_lasers`)."""
     from speclight.render.map_lookup import check_map_matches, read_header
+    from speclight.scenario.map_lasers import check_map_lasers
     from speclight.wavelength_grid import grid_from_range_nm
 
     sc = loaded.scenario
-    if sc.illumination.lasers:
-        raise InputError(
-            "render.mode 'map' interpolates the Sun's light only; lasers need mode single or path",
-            source=loaded.source,
-            field="illumination.lasers",
-        )
     assert sc.render.map_file is not None
     try:
         header = read_header(loaded.resolve(sc.render.map_file))
@@ -164,6 +160,7 @@ def _check_map_file(loaded: LoadedScenario) -> None:
         check_map_matches(header, grid, [band.name for band in sc.instrument.bands])
     except InputError as exc:
         raise InputError(exc.message, source=loaded.source, field=exc.field) from None
+    check_map_lasers(sc, loaded.source, header)  # coaxial returns, bistatic phase angles
 
 
 def _at(mark: yaml.error.Mark) -> str:

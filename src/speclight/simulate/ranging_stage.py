@@ -20,7 +20,10 @@ its transmitter's horizon contributes nothing at that epoch and sets the flag bi
 run goes on. In ``render.mode: path``
 the interreflections are added at their full optical path length
 (:mod:`speclight.render.laser_multibounce`, Monte Carlo with ``render.samples_per_pixel`` and
-``render.seed``); single mode is single scattering, exact.
+``render.seed``); single mode is single scattering, exact. In ``render.mode: map`` nothing is
+rendered: the target's returns come from the reflectivity map
+(:mod:`speclight.simulate.map_ranging`, ``RangingSetup.map_returns``) and the rest of this
+stage is the same.
 
 The centre of mass is the body-frame origin.
 """
@@ -41,11 +44,12 @@ from speclight.instrument.photometry import photon_kernel
 from speclight.orbit.timescale import time_from_utc
 from speclight.ranging import link, transmitter_geometry
 from speclight.ranging.bins import RANGE_BINS, range_bin_edges_m
-from speclight.render.laser_returns import LaserLight, LaserReturnAccumulator
+from speclight.render.laser_returns import LaserLight, LaserReturnAccumulator, LaserReturns
 from speclight.render.path_scene import MAX_DEPTH as PATH_MAX_DEPTH
 from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
 from speclight.simulate.geometry_stage import Geometry
+from speclight.simulate.map_ranging import scenario_map_returns
 from speclight.simulate.radiometry import Radiometry, atmosphere_params
 from speclight.simulate.ranging_dataset import RangingResult
 from speclight.target import Target
@@ -75,18 +79,24 @@ class LaserSetup:
 @dataclass
 class RangingSetup:
     """Lasers, the render accumulator and the render session of one run, and the flag bits
-    (N,) this stage sets (:data:`~speclight.schema.FLAG_LASER_BELOW_HORIZON`)."""
+    (N,) this stage sets (:data:`~speclight.schema.FLAG_LASER_BELOW_HORIZON`). In
+    ``render.mode: map`` there is no render: ``map_returns`` gives the returns instead
+    (:mod:`speclight.simulate.map_ranging`)."""
 
     lasers: list[LaserSetup]
-    accumulator: LaserReturnAccumulator
-    session: RenderSession
+    accumulator: LaserReturnAccumulator | None
+    session: RenderSession | None
     flags: NDArray[np.uint8]
+    wavelength_nm: F64
+    map_returns: Callable[[], LaserReturns] | None = None
 
     def on_hits_for(self, epochs: NDArray[np.int64]) -> Callable[..., None]:
         """``on_hits`` callback for a render of ``geo`` epochs ``epochs`` (in that order)."""
+        assert self.accumulator is not None
         index = np.asarray(epochs, dtype=np.int64)
 
         def call(local: NDArray[np.int64], *rest: Any) -> None:
+            assert self.accumulator is not None
             self.accumulator(index[local], *rest)
 
         return call
@@ -163,10 +173,12 @@ def prepare_ranging(
 ) -> RangingSetup | None:
     """Lasers' geometry and irradiance, and the accumulator; ``None`` without lasers/target.
 
-    ``target`` and ``session``: the run's target and render session (built once per run).
+    ``target`` and ``session``: the run's target and render session (built once per run);
+    in ``render.mode: map`` both are ``None`` and the returns come from the map.
     """
     sc = loaded.scenario
-    if not sc.illumination.lasers or target is None or session is None:
+    map_mode = sc.render.mode == "map"
+    if not sc.illumination.lasers or (not map_mode and (target is None or session is None)):
         return None
     t = time_from_utc(geo.time_utc)
     lasers = [_laser(loaded, geo, wavelength_nm, k, t) for k in range(len(sc.illumination.lasers))]
@@ -174,6 +186,14 @@ def prepare_ranging(
     for laser in lasers:
         flags[geo.orbit_ok & ~laser.above_horizon] |= schema.FLAG_LASER_BELOW_HORIZON
     obs = np.where(geo.observable[:, None], geo.observer_direction_body, np.nan)
+    if map_mode:
+
+        def from_map() -> LaserReturns:
+            lights = [la.light for la in lasers]
+            return scenario_map_returns(loaded, obs, lights, wavelength_nm)
+
+        return RangingSetup(lasers, None, None, flags, wavelength_nm, from_map)
+    assert target is not None and session is not None
     com = np.zeros(3)
     path = sc.render.mode == "path"
     acc = LaserReturnAccumulator(
@@ -187,7 +207,7 @@ def prepare_ranging(
         samples_per_pixel=sc.render.samples_per_pixel,
         seed=sc.render.seed,
     )
-    return RangingSetup(lasers, acc, session, flags)
+    return RangingSetup(lasers, acc, session, flags, wavelength_nm)
 
 
 def laser_irradiance_W_m2_nm(setup: RangingSetup, n_wavelengths: int) -> F64:
@@ -222,10 +242,14 @@ def laser_ranging(
     """
     sc = loaded.scenario
     acc = setup.accumulator
-    wavelength_nm = acc.wl
-    if np.any(acc.active & ~acc.rendered):
-        acc.finish(setup.session.caster(acc.target), sc.render.resolution_px)
-    rr = acc.result()
+    wavelength_nm = setup.wavelength_nm
+    if setup.map_returns is not None:  # render.mode map: the returns from the map
+        rr = setup.map_returns()
+    else:
+        assert acc is not None and setup.session is not None
+        if np.any(acc.active & ~acc.rendered):
+            acc.finish(setup.session.caster(acc.target), sc.render.resolution_px)
+        rr = acc.result()
     n, n_wl, k_las = geo.t_s.size, wavelength_nm.size, len(setup.lasers)
     obs = geo.observable
     intensity = np.zeros((n, n_wl))
@@ -291,9 +315,13 @@ def laser_ranging(
             f"laser(s) {', '.join(below)} below the transmitter's horizon at some observable "
             "epochs (flag laser_below_horizon): no return from them there"
         )
-    if sc.render.mode == "path" and any(
-        m.bsdf == "specular" or (m.bsdf == "plastic" and m.roughness is None)
-        for m in acc.target.materials
+    if (
+        acc is not None
+        and sc.render.mode == "path"
+        and any(
+            m.bsdf == "specular" or (m.bsdf == "plastic" and m.roughness is None)
+            for m in acc.target.materials
+        )
     ):
         notes.append(
             "laser ranging in render.mode 'path' does not follow the mirror reflection of "
