@@ -40,7 +40,7 @@ class NadirAttitude(Strict):
     """Body +z to nadir, +x toward the velocity (LVLH) or yaw-steered to the Sun."""
 
     model: Literal["nadir"]
-    nadir: Literal["geodetic", "geocentric"] = Field(
+    nadir_type: Literal["geodetic", "geocentric"] = Field(
         default="geodetic",
         description="geodetic: along minus the WGS84 ellipsoid normal; geocentric: to the "
         "Earth's centre",

@@ -35,8 +35,9 @@ from speclight.scenario.sections_attitude import (
 )
 
 #: Half the central-difference step of the velocity. SGP4 and the 10-point Lagrange tables
-#: are smooth over it: the truncation error h^2/6 |d3r/dt3| is < 1e-3 m/s in LEO (< 2e-7 rad
-#: of direction), and the positions' round-off (< 1e-5 m) adds < 1e-5 m/s.
+#: are smooth over it: the truncation error h^2/6 |d3r/dt3| ~ h^2 n^3 r / 6 is < 5e-4 m/s
+#: in LEO (< 1e-7 rad of the direction), and the positions' round-off (< 1e-5 m) adds
+#: < 1e-5 m/s.
 VELOCITY_STEP = np.timedelta64(500_000_000, "ns")
 
 Trajectory = Callable[[Any], tuple[NDArray[np.float64], NDArray[np.bool_]]]
@@ -128,7 +129,7 @@ def profile_attitude(
         q, _ = slerp_table(table.times_utc, table.q_body_to_gcrs, emitted_utc)
         return q
     if isinstance(cfg, NadirAttitude):
-        nadir = vec.geodetic_nadir() if cfg.nadir == "geodetic" else -r_target_gcrs_m
+        nadir = vec.geodetic_nadir() if cfg.nadir_type == "geodetic" else -r_target_gcrs_m
         return nadir_attitude(
             nadir,
             vec.velocity(),
