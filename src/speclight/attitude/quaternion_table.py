@@ -169,7 +169,7 @@ def slerp_table(
     Parameters
     ----------
     times_utc
-        (M,) knot epochs, strictly increasing, ``datetime64``.
+        (M,) knot epochs, M >= 2, strictly increasing, ``datetime64``.
     q_knots
         (M, 4) unit quaternions at the knots, scalar first.
     at_utc
