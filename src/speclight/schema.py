@@ -164,6 +164,9 @@ FLAG_IN_SHADOW = 4
 FLAG_PENUMBRA = 8
 FLAG_RENDER_FAILED = 16
 FLAG_LASER_BELOW_HORIZON = 32
+#: The attitude model gives no attitude: an epoch outside an attitude table, or a pointing
+#: profile whose two directions are parallel there.
+FLAG_ATTITUDE_UNDEFINED = 64
 
 FLAG_MEANINGS = {
     FLAG_ORBIT_FAILED: "orbit_failed",
@@ -172,9 +175,16 @@ FLAG_MEANINGS = {
     FLAG_PENUMBRA: "in_penumbra",
     FLAG_RENDER_FAILED: "render_failed",
     FLAG_LASER_BELOW_HORIZON: "laser_below_horizon",
+    FLAG_ATTITUDE_UNDEFINED: "attitude_undefined",
 }
 #: Epochs with any of these bits have no measurement of the Sun's reflection.
-NOT_OBSERVABLE = FLAG_ORBIT_FAILED | FLAG_BELOW_MIN_ELEVATION | FLAG_IN_SHADOW | FLAG_RENDER_FAILED
+NOT_OBSERVABLE = (
+    FLAG_ORBIT_FAILED
+    | FLAG_BELOW_MIN_ELEVATION
+    | FLAG_IN_SHADOW
+    | FLAG_RENDER_FAILED
+    | FLAG_ATTITUDE_UNDEFINED
+)
 
 
 def attrs(name: str) -> dict[str, str]:

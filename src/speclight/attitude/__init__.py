@@ -1,4 +1,4 @@
-"""Attitude of the target: fixed, uniform spin, torque-free rigid body.
+"""Attitude of the target: fixed, uniform spin, torque-free rigid body, operational profiles.
 
 Conventions
 -----------
@@ -24,6 +24,15 @@ Models
     integrated to ``atol`` [rad]; falls back to ``"ivp"`` within 1e-9 of the
     separatrix) or ``method="ivp"`` (DOP853 at ``rtol``/``atol``, the reference).
 
+:func:`nadir_attitude`
+    Nadir pointing: body z to the geodetic (:func:`geodetic_up_itrs`) or geocentric nadir,
+    x toward the velocity (LVLH) or yaw-steered to keep the Sun in the body x-z plane.
+:func:`align_constrain`
+    One body axis on a direction, a second as close as possible to another (Sun, inertial
+    and ground-target pointing).
+:func:`read_attitude_table`, :func:`slerp_table`
+    Tabulated quaternions (CSV), slerped between rows, NaN outside the table.
+
 :func:`body_directions` turns GCRS Sun and observer directions into the body-frame
 unit vectors of the output dataset (``sun_direction_body``, ``observer_direction_body``,
 ``phase_vector_body``); the phase vector is the bisector ``normalize(sun + observer)``
@@ -37,6 +46,8 @@ zero vectors) come back as NaN rows instead.
 from speclight.attitude.body_frame import body_directions, to_body
 from speclight.attitude.fixed import fixed_attitude
 from speclight.attitude.inertia import PrincipalFrame, principal_frame
+from speclight.attitude.nadir import geodetic_up_itrs, nadir_attitude
+from speclight.attitude.pointing import align_constrain
 from speclight.attitude.quaternion import (
     frame_from_axes,
     frame_from_axes_radec,
@@ -51,16 +62,25 @@ from speclight.attitude.quaternion import (
     radec_from_unit_vector,
     unit_vector_from_radec,
 )
+from speclight.attitude.quaternion_table import (
+    AttitudeTable,
+    read_attitude_table,
+    slerp_table,
+)
 from speclight.attitude.spin import spin_attitude
 from speclight.attitude.torque_free import TorqueFreeMethod, torque_free_attitude
 
 __all__ = [
+    "AttitudeTable",
     "PrincipalFrame",
     "TorqueFreeMethod",
+    "align_constrain",
     "body_directions",
     "fixed_attitude",
     "frame_from_axes",
     "frame_from_axes_radec",
+    "geodetic_up_itrs",
+    "nadir_attitude",
     "principal_frame",
     "quat_conjugate",
     "quat_from_axis_angle",
@@ -71,6 +91,8 @@ __all__ = [
     "quat_to_axis_angle",
     "quat_to_matrix",
     "radec_from_unit_vector",
+    "read_attitude_table",
+    "slerp_table",
     "spin_attitude",
     "to_body",
     "torque_free_attitude",

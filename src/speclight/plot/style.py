@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 
 from speclight.errors import InputError
 from speclight.schema import (  # the dataset's flag bits (CF flag_masks)
+    FLAG_ATTITUDE_UNDEFINED,
     FLAG_BELOW_MIN_ELEVATION,
     FLAG_IN_SHADOW,
     FLAG_ORBIT_FAILED,
@@ -28,7 +29,11 @@ WIDTH_IN = 10.0
 
 # Shading of epochs along time axes: (flag bits, face colour, legend label).
 _SHADES = (
-    (FLAG_ORBIT_FAILED | FLAG_BELOW_MIN_ELEVATION | FLAG_RENDER_FAILED, "0.85", "not observable"),
+    (
+        FLAG_ORBIT_FAILED | FLAG_BELOW_MIN_ELEVATION | FLAG_RENDER_FAILED | FLAG_ATTITUDE_UNDEFINED,
+        "0.85",
+        "not observable",
+    ),
     (FLAG_IN_SHADOW, "#9aa7c7", "Earth shadow"),
     (FLAG_PENUMBRA, "#f3d9a4", "penumbra"),
 )

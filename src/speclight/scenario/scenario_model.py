@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pydantic import Field
 
+from speclight.scenario.sections_attitude import Attitude
 from speclight.scenario.sections_geometry import (
-    Attitude,
     Observer,
     Orbit,
     Strict,

@@ -227,8 +227,3 @@ class TorqueFreeAttitude(Strict):
         if not (ok_vector or ok_matrix):
             raise ValueError(f"{value} is neither 3 principal moments nor a 3x3 tensor [kg m^2]")
         return value
-
-
-Attitude = Annotated[
-    FixedAttitude | SpinAttitude | TorqueFreeAttitude, Field(discriminator="model")
-]

@@ -16,6 +16,13 @@ from speclight.constants import C_M_S
 from speclight.errors import InputError
 from speclight.orbit.timescale import time_from_utc
 from speclight.scenario import LoadedScenario
+from speclight.scenario.sections_attitude import (
+    InertialPointingAttitude,
+    NadirAttitude,
+    SunPointingAttitude,
+    TableAttitude,
+    TargetPointingAttitude,
+)
 from speclight.scenario.sections_geometry import (
     AxesOrientation,
     FixedAttitude,
@@ -23,6 +30,7 @@ from speclight.scenario.sections_geometry import (
     TimeGrid,
     TorqueFreeAttitude,
 )
+from speclight.simulate.attitude_stage import profile_attitude
 
 
 @dataclass
@@ -47,8 +55,9 @@ class Geometry:
 
     @property
     def observable(self) -> NDArray[np.bool_]:
-        """Epochs whose target position is known and is above the minimum elevation."""
-        bad = v.FLAG_ORBIT_FAILED | v.FLAG_BELOW_MIN_ELEVATION
+        """Epochs whose target position and attitude are known and that are above the
+        minimum elevation."""
+        bad = v.FLAG_ORBIT_FAILED | v.FLAG_BELOW_MIN_ELEVATION | v.FLAG_ATTITUDE_UNDEFINED
         return (self.flags & bad) == 0
 
 
@@ -131,6 +140,15 @@ def attitude_quaternions(
     return q
 
 
+#: Attitude models whose quaternions need the orbit, the Sun or a table (attitude_stage.py).
+PROFILES = (
+    NadirAttitude,
+    SunPointingAttitude,
+    InertialPointingAttitude,
+    TargetPointingAttitude,
+    TableAttitude,
+)
+
 #: Fixed-point iterations of the light-time equation; each gains a factor v/c ~ 3e-5, so two
 #: leave < 1e-9 s (0.3 mm) for targets up to GEO.
 LIGHT_TIME_ITERATIONS = 2
@@ -198,12 +216,20 @@ def scenario_geometry(
             else standard_pressure_mbar(sc.observer.altitude_m)
         ),
     )
-    q = attitude_quaternions(sc.attitude, t_s - delay_s)  # as turned when the light left
+    # the attitude as it was when the light left the target
+    if isinstance(sc.attitude, PROFILES):
+        emitted = time_utc - np.rint(delay_s * 1e9).astype("timedelta64[ns]")
+        q = profile_attitude(
+            sc.attitude, loaded, trajectory, emitted, r_target, geo.sun_direction_gcrs
+        )
+    else:
+        q = attitude_quaternions(sc.attitude, t_s - delay_s)
     sun_b, obs_b, phase_b = att.body_directions(
         q, geo.sun_direction_gcrs, geo.observer_direction_gcrs
     )
     flags = np.zeros(t_s.size, dtype=np.uint8)
     flags[~ok] |= v.FLAG_ORBIT_FAILED
+    flags[ok & np.any(np.isnan(q), axis=1)] |= v.FLAG_ATTITUDE_UNDEFINED
     with np.errstate(invalid="ignore"):
         flags[~(geo.elevation_deg >= sc.observer.min_elevation_deg)] |= v.FLAG_BELOW_MIN_ELEVATION
         flags[geo.sunlit_fraction <= 0.0] |= v.FLAG_IN_SHADOW

@@ -58,6 +58,12 @@ def _visibility_notes(geo: Geometry) -> list[str]:
     failed = int(np.count_nonzero(geo.flags & v.FLAG_ORBIT_FAILED))
     if failed:
         notes.append(f"{failed} epochs have no target position (flag orbit_failed)")
+    no_attitude = int(np.count_nonzero(geo.flags & v.FLAG_ATTITUDE_UNDEFINED))
+    if no_attitude:
+        notes.append(
+            f"{no_attitude} epochs have no attitude (flag attitude_undefined: outside the "
+            "attitude table, or the pointing and constraint directions are parallel)"
+        )
     return notes
 
 
