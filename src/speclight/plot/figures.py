@@ -14,7 +14,7 @@ To add a figure, append a :class:`FigureKind` to :data:`FIGURES`.
 from __future__ import annotations
 
 import os
-import tempfile
+import secrets
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,6 +23,7 @@ from typing import Any
 import xarray as xr
 
 from speclight.errors import InputError, did_you_mean
+from speclight.io.output import create_new_file
 from speclight.plot.chain import chain_figure
 from speclight.plot.images import images_figure
 from speclight.plot.overview import overview_figure
@@ -228,12 +229,11 @@ def plot_files(
         for kind in todo:
             target = paths[kind.name]
             fig = kind.build(ds, choices)
-            fd, tmp = tempfile.mkstemp(
-                prefix=f".{target.name}.", suffix=target.suffix, dir=target.parent
-            )
-            os.close(fd)
-            temporaries.append((tmp, target))
-            fig.savefig(tmp, dpi=dpi)
+            tmp = target.with_name(f".{target.name}.{secrets.token_hex(4)}{target.suffix}")
+            fd = create_new_file(tmp)  # mode 0666 less the umask, like any new file
+            temporaries.append((str(tmp), target))
+            with os.fdopen(fd, "wb") as f:
+                fig.savefig(f, dpi=dpi, format=target.suffix.lstrip(".").lower())
         for tmp, target in temporaries:
             os.replace(tmp, target)
     finally:
