@@ -14,9 +14,10 @@ half-written, and an interrupted run leaves nothing behind):
 3. Holding the lock, the claim removes what killed runs left in the folder: temporary files
    ``.NAME.speclight-PID-XXXXXXXX.tmp`` of outputs whose lock nobody holds, and such locks.
 4. :meth:`OutputClaim.write` writes the bytes to a temporary file created by
-   :func:`create_new_file` (mode 0666 less the umask, as any new file) with ordinary file I/O, which fails cleanly on a full disk, flushes it to disk and moves
-   it into place: with ``os.link``, which fails if the output appeared meanwhile, unless
-   ``force`` allows replacing it. On any error or signal the temporary file is removed.
+   :func:`create_new_file` (mode 0666 less the umask, as any new file) with ordinary file
+   I/O, which fails cleanly on a full disk, flushes it to disk and moves it into place: with
+   ``os.link``, which fails if the output appeared meanwhile, unless ``force`` allows
+   replacing it. On any error or signal the temporary file is removed.
 
 The lock needs POSIX ``flock`` (Linux, macOS; NFS through the kernel's lock emulation).
 """
