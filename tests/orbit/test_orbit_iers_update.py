@@ -160,7 +160,7 @@ def test_nothing_is_downloaded_when_tables_are_loaded(
 def test_a_run_past_the_tables_with_an_old_tle_gives_one_notice_each(tmp_path: Path) -> None:
     scenario = yaml.safe_load(example_text("calsphere"))  # TLE epoch 2020-02-27
     scenario.pop("target")  # geometry only: quick
-    scenario["time"] = {"start": "2027-06-01T00:00:00Z", "stop": "2027-06-01T00:00:20Z",
+    scenario["time"] = {"start": "2035-06-01T00:00:00Z", "stop": "2035-06-01T00:00:20Z",
                         "step_s": 10.0}  # fmt: skip
     path = tmp_path / "late.yaml"
     path.write_text(yaml.safe_dump(scenario))
