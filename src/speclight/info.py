@@ -69,13 +69,17 @@ def run_variants() -> tuple[str, str]:
     ray casting (single mode) needs only ``*_rgb``; path mode, and RGL measured materials in
     either mode, need ``*_spectral``. A scenario's ``render.variant`` overrides the choice.
     """
+    import warnings
+
     from speclight.errors import InputError
     from speclight.render.session import RenderSession
 
     chosen = []
     for mode in ("single", "path"):
         try:
-            chosen.append(RenderSession.create(mode, None, ()).variant)
+            with warnings.catch_warnings():  # a fallback's notice: the report says it already
+                warnings.simplefilter("ignore")
+                chosen.append(RenderSession.create(mode, None, ()).variant)
         except InputError as exc:  # path mode without Mitsuba
             chosen.append(f"unavailable ({exc.message})")
     return chosen[0], chosen[1]
