@@ -10,19 +10,11 @@ cd "$(dirname "$0")/.."
 extras="all"
 [[ "${1:-}" == "--dev" ]] && extras="all,dev"
 
-# System libraries: libLLVM-19 for Mitsuba's fast LLVM backend, libgfortran5 for 6S.
-need=()
-ldconfig -p 2>/dev/null | grep -q 'libLLVM-19\.so' || need+=(libllvm19)
-ldconfig -p 2>/dev/null | grep -q 'libgfortran\.so\.5' || need+=(libgfortran5)
-if ((${#need[@]})); then
-    if [[ $(id -u) == 0 ]] && command -v apt-get >/dev/null; then
-        echo "setup: installing ${need[*]} with apt-get" >&2
-        { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${need[@]}"; } \
-            >/dev/null 2>&1 || echo "setup: notice: could not install ${need[*]}; speclight falls back (scalar rendering, SPECTRL2 instead of 6S)" >&2
-    else
-        echo "setup: notice: ${need[*]} missing and apt-get not usable here; speclight falls back (scalar rendering, SPECTRL2 instead of 6S)" >&2
-    fi
-fi
+# System libraries: libLLVM-19 for Mitsuba's fast LLVM backend, libgfortran5 for 6S; apt-get
+# runs only for what is missing (see scripts/system_libs.sh for how they are found).
+# shellcheck source=scripts/system_libs.sh
+source scripts/system_libs.sh
+install_system_libs
 
 python=${PYTHON:-python3}
 "$python" -c 'import sys; sys.exit(sys.version_info < (3, 11))' || {

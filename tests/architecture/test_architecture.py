@@ -89,8 +89,8 @@ def test_the_variant_is_chosen_in_one_place():
         for p in ROOT.rglob("*.py")
         if re.search(r"\bchoose_variant\(", p.read_text())
     ]
-    # variant.py defines it, session.py chooses the run's variant, info.py reports the default
-    assert sorted(callers) == ["info.py", "render/session.py", "render/variant.py"]
+    # variant.py defines it, session.py chooses the run's variant (info.py asks session.py)
+    assert sorted(callers) == ["render/session.py", "render/variant.py"]
 
 
 def test_module_file_names_are_unique():

@@ -113,7 +113,8 @@ def test_info_reports_versions_and_coverage() -> None:
     result = runner.invoke(app, ["info"])
     assert result.exit_code == 0, result.output
     assert "skyfield" in result.stdout and "eop_measured_until" in result.stdout
-    assert "default variant" in result.stdout and "gpu (CUDA)" in result.stdout
+    assert "variant in single mode" in result.stdout and "variant in path mode" in result.stdout
+    assert "gpu (CUDA)" in result.stdout
 
 
 def test_console_script_entry_point(tmp_path: Path) -> None:

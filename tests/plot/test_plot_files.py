@@ -157,3 +157,17 @@ def test_images_figure_shows_the_named_parts() -> None:
     fig = images_figure(ds, None)
     labels = [t.get_text() for ax in fig.axes for t in ax.get_yticklabels()]
     assert "bus" in labels and "wing" in labels
+
+
+def test_figures_get_the_mode_of_any_new_file(full_file: Path, tmp_path: Path):
+    # POSIX open(2): a new file's mode is the requested 0666 less the umask; with umask 027
+    # that is 0640 (a file from tempfile.mkstemp would stay 0600 whatever the umask).
+    import os
+
+    previous = os.umask(0o027)
+    try:
+        written = plot_files(full_file, tmp_path / "pass.png")
+    finally:
+        os.umask(previous)
+    assert len(written) == 2  # overview and chain
+    assert {p.stat().st_mode & 0o777 for p in written} == {0o640}

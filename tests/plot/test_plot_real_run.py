@@ -57,3 +57,16 @@ def test_chain_band_spectra_integrate_to_the_datasets_count_rate(tiny_run: Path)
         # peak (Gaussian bands >= 4 sigma inside 300-1240 nm) -> 1e-3 relative.
         rate = np.trapezoid(spectra, w, axis=1)
         np.testing.assert_allclose(rate, ds["count_rate"].values[i], rtol=1e-3)
+
+
+def test_info_names_the_variant_a_single_mode_run_records(tiny_run: Path):
+    # `speclight info` once named the path-mode variant (llvm_ad_spectral) as "the default"
+    # while single-mode runs record llvm_ad_rgb: the run itself is the reference here.
+    import xarray as xr
+
+    from speclight.info import info_report
+
+    ds = xr.load_dataset(tiny_run)
+    assert ds.attrs["render_mode"] == "single"
+    render = info_report()["render"]
+    assert render["variant in single mode"].split()[0] == ds.attrs["render_variant"]

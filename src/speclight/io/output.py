@@ -13,10 +13,11 @@ half-written, and an interrupted run leaves nothing behind):
    no guessing from PIDs, which are reused.
 3. Holding the lock, the claim removes what killed runs left in the folder: temporary files
    ``.NAME.speclight-PID-XXXXXXXX.tmp`` of outputs whose lock nobody holds, and such locks.
-4. :meth:`OutputClaim.write` writes the bytes to a temporary file (mode 0666 less the umask)
-   with ordinary file I/O, which fails cleanly on a full disk, flushes it to disk and moves
-   it into place: with ``os.link``, which fails if the output appeared meanwhile, unless
-   ``force`` allows replacing it. On any error or signal the temporary file is removed.
+4. :meth:`OutputClaim.write` writes the bytes to a temporary file created by
+   :func:`create_new_file` (mode 0666 less the umask, as any new file) with ordinary file
+   I/O, which fails cleanly on a full disk, flushes it to disk and moves it into place: with
+   ``os.link``, which fails if the output appeared meanwhile, unless ``force`` allows
+   replacing it. On any error or signal the temporary file is removed.
 
 The lock needs POSIX ``flock`` (Linux, macOS; NFS through the kernel's lock emulation).
 """
@@ -46,6 +47,24 @@ _NO_HARD_LINKS = {errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EMLINK, er
 
 class OutputWriteError(SpeclightError):
     """The output could not be written (full disk, I/O error...); nothing was left behind."""
+
+
+def create_new_file(path: str | os.PathLike[str]) -> int:
+    """Create ``path`` for writing (it must not exist yet) and return its descriptor.
+
+    The file gets the mode any new file gets, 0666 less the process's umask. Every output
+    file of speclight is written to such a file and then moved into place, which keeps the
+    mode: a temporary file from :mod:`tempfile` would make every output 0600, readable by its
+    owner only.
+
+    Raises
+    ------
+    FileExistsError
+        ``path`` exists.
+    OSError
+        The file system refused.
+    """
+    return os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o666)
 
 
 def lock_path(output: Path) -> Path:
@@ -226,7 +245,7 @@ class OutputClaim:
         temp = self.path.with_name(f".{self.path.name}.speclight-{os.getpid()}-{token}.tmp")
         with hold_signals() as held:
             try:
-                fd = os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o666)
+                fd = create_new_file(temp)
                 try:
                     _write_all(fd, view, held)
                 finally:

@@ -1,14 +1,15 @@
-"""Offline time scales and the JPL ephemeris, from the ``skyfield-data`` package.
+"""Offline time scales and the JPL ephemeris.
 
-Nothing here touches the network: the leap-second and Earth-orientation table
-(IERS ``finals2000A.all``) and the JPL DE421 ephemeris are the files shipped in
-``skyfield-data``. :func:`data_coverage` says how far they reach.
+Nothing here touches the network. The leap-second and Earth-orientation table (IERS
+``finals2000A.all``) is the one :func:`speclight.orbit.iers_files.finals_path` picks: the
+copy shipped in ``skyfield-data``, or a newer one installed by ``speclight update-data``.
+The JPL DE421 ephemeris is the file shipped in ``skyfield-data``. :func:`data_coverage`
+says how far they reach.
 """
 
 from __future__ import annotations
 
 import functools
-import warnings
 from typing import Any
 
 import numpy as np
@@ -17,37 +18,44 @@ from skyfield.api import Loader
 from skyfield.data import iers
 from skyfield.timelib import Time, Timescale
 
-
-@functools.cache
-def _data_path() -> str:
-    with warnings.catch_warnings():
-        # skyfield-data warns once its table's prediction horizon has passed; how far the
-        # tables reach is reported by ``speclight info`` (``data_coverage``) instead.
-        warnings.simplefilter("ignore", RuntimeWarning)
-        import skyfield_data
-
-        return str(skyfield_data.get_skyfield_data_path())
+from speclight.orbit.iers_files import (
+    finals_coverage,
+    finals_path,
+    installed_finals_path,
+    shipped_data_dir,
+)
 
 
 @functools.cache
 def _loader() -> Loader:
-    return Loader(_data_path(), verbose=False, expire=False)
+    return Loader(shipped_data_dir(), verbose=False, expire=False)
 
 
 @functools.cache
 def load_timescale() -> Timescale:
-    """Return the skyfield timescale built from the shipped IERS table (offline).
+    """Return the skyfield timescale built from the IERS table in use (offline).
 
-    The polar-motion table (x_p, y_p from the same ``finals2000A.all``) is installed, so
-    that skyfield's ``itrs`` frame and WGS84 positions include polar motion (a few tenths
-    of an arcsecond, i.e. ~10 m at the Earth's surface); see skyfield's "Polar motion"
-    documentation.
+    The table is the newest of the shipped and the installed ``finals2000A.all``
+    (:func:`speclight.orbit.iers_files.finals_path`); call :func:`reload_tables` after
+    installing one in a running process. The polar-motion table (x_p, y_p from the same
+    file) is installed, so that skyfield's ``itrs`` frame and WGS84 positions include polar
+    motion (a few tenths of an arcsecond, i.e. ~10 m at the Earth's surface); see skyfield's
+    "Polar motion" documentation.
     """
-    ts = _loader().timescale(builtin=False)
-    with _loader().open("finals2000A.all") as f:
+    path = finals_path()
+    # a Loader on the table's folder only opens the file that is there: it never downloads
+    loader = Loader(str(path.parent), verbose=False, expire=False)
+    ts = loader.timescale(builtin=False)
+    with loader.open(path.name) as f:
         finals = iers.parse_x_y_dut1_from_finals_all(f)
     iers.install_polar_motion_table(ts, finals)
     return ts
+
+
+def reload_tables() -> None:
+    """Forget the timescale built so far: the next :func:`load_timescale` reads the table
+    in use now (after ``speclight update-data`` in this process)."""
+    load_timescale.cache_clear()
 
 
 @functools.cache
@@ -68,30 +76,23 @@ def time_from_utc(times_utc: NDArray[np.datetime64]) -> Time:
 
 
 def data_coverage() -> dict[str, str]:
-    """How far the shipped Earth-orientation, leap-second and ephemeris tables reach.
+    """How far the Earth-orientation, leap-second and ephemeris tables in use reach.
 
     Returns
     -------
     dict
         ISO dates keyed by ``eop_measured_until``, ``eop_predicted_until``,
-        ``leap_seconds_until`` and ``ephemeris``.
+        ``leap_seconds_until`` and ``ephemeris``; ``eop_table``: the file in use.
     """
-    path = _data_path() + "/finals2000A.all"
-    last_measured = last_any = ""
-    with open(path) as f:
-        for line in f:
-            if len(line) < 68 or not line[7:15].strip():
-                continue
-            mjd = float(line[7:15])
-            flag = line[16]
-            date = str(np.datetime64("1858-11-17") + np.timedelta64(int(mjd), "D"))
-            if line[58:68].strip():
-                last_any = date
-                if flag == "I":
-                    last_measured = date
+    path = finals_path()
+    coverage = finals_coverage(path)
+    measured = str(coverage.measured_until) if coverage else ""
+    predicted = str(coverage.predicted_until) if coverage else ""
+    which = "updated" if path == installed_finals_path() else "shipped in skyfield-data"
     return {
-        "eop_measured_until": last_measured,
-        "eop_predicted_until": last_any,
-        "leap_seconds_until": last_any,
+        "eop_measured_until": measured,
+        "eop_predicted_until": predicted,
+        "leap_seconds_until": predicted,
+        "eop_table": f"{path} ({which}; `speclight update-data` refreshes it)",
         "ephemeris": "JPL DE421, 1899-07-29 to 2053-10-09",
     }

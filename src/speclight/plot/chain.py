@@ -8,8 +8,9 @@ import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
+from speclight import schema as v
 from speclight.constants import HC_J_M
-from speclight.plot.style import NOT_OBSERVABLE, band_styles, epoch_summary, flags, new_figure
+from speclight.plot.style import band_styles, epoch_summary, flags, new_figure
 
 # Planck constant x speed of light [J m] (CODATA 2018, exact), for photons per joule.
 
@@ -63,7 +64,8 @@ def chain_figure(ds: xr.Dataset, epoch: int, chosen: str = "") -> Any:
     axes[-1].set_xlim(w.min(), w.max())
     name = ds.attrs.get("scenario_name", "speclight dataset")
     why = f" ({chosen})" if chosen else ""
-    status = "" if (flags(ds)[epoch] & NOT_OBSERVABLE) == 0 else " [not observable]"
+    status = epoch_status(ds, epoch)
+    status = f" [{status}]" if status else ""
     fig.suptitle(
         f"{name}: one epoch through the chain{why}{status}\n{epoch_summary(ds, epoch)}",
         fontsize="medium",
@@ -71,15 +73,42 @@ def chain_figure(ds: xr.Dataset, epoch: int, chosen: str = "") -> Any:
     return fig
 
 
+def epoch_status(ds: xr.Dataset, i: int) -> str:
+    """Why epoch ``i`` is not (fully) observed, from its flags: "" when it is.
+
+    "eclipsed (in the Earth's shadow)", "in the penumbra (x % of the solar disk)", "below the
+    minimum elevation", "no orbit position", "render failed", joined by "; ".
+    """
+    bits = int(flags(ds)[i])
+    reasons = [
+        text
+        for bit, text in (
+            (v.FLAG_ORBIT_FAILED, "no orbit position"),
+            (v.FLAG_BELOW_MIN_ELEVATION, "below the minimum elevation"),
+            (v.FLAG_IN_SHADOW, "eclipsed (in the Earth's shadow)"),
+            (v.FLAG_RENDER_FAILED, "render failed"),
+        )
+        if bits & bit
+    ]
+    if bits & v.FLAG_PENUMBRA and not bits & v.FLAG_IN_SHADOW:
+        disk = f" ({100 * _sunlit(ds, i):.0f} % of the solar disk)" if "sunlit" in ds else ""
+        reasons.append(f"in the penumbra{disk}")
+    return "; ".join(reasons)
+
+
+def _sunlit(ds: xr.Dataset, i: int) -> float:
+    return float(ds["sunlit"].values[i]) if "sunlit" in ds else 1.0
+
+
 def _solar(ds: xr.Dataset, ax: Any, w: NDArray[np.float64], i: int) -> None:
-    sunlit = float(ds["sunlit"].values[i]) if "sunlit" in ds else 1.0
-    ax.plot(
-        w,
-        _row(ds, "solar_irradiance", i),
-        color="C1",
-        lw=1.2,
-        label=f"at the target\n(sunlit fraction {sunlit:.2f})",
-    )
+    # What the target receives: the Sun's spectrum times the visible fraction of its disk
+    # (0 in the Earth's shadow); ``solar_irradiance`` is the one before shadowing.
+    sunlit = _sunlit(ds, i)
+    unshadowed = _row(ds, "solar_irradiance", i)
+    where = "eclipsed" if sunlit <= 0 else f"sunlit fraction {sunlit:.2f}"
+    ax.plot(w, unshadowed * sunlit, color="C1", lw=1.2, label=f"received by the target\n({where})")
+    if sunlit < 1:
+        ax.plot(w, unshadowed, color="C1", lw=0.8, ls="--", alpha=0.6, label="outside the shadow")
     ax.set_ylabel("solar irradiance\n[W m$^{-2}$ nm$^{-1}$]")
     ax.set_title("1. Sun", loc="left", fontsize="medium")
 

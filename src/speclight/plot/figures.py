@@ -14,7 +14,7 @@ To add a figure, append a :class:`FigureKind` to :data:`FIGURES`.
 from __future__ import annotations
 
 import os
-import tempfile
+import secrets
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,6 +23,7 @@ from typing import Any
 import xarray as xr
 
 from speclight.errors import InputError, did_you_mean
+from speclight.io.output import create_new_file
 from speclight.plot.chain import chain_figure
 from speclight.plot.images import images_figure
 from speclight.plot.overview import overview_figure
@@ -169,6 +170,31 @@ def _load(dataset: Path) -> xr.Dataset:
     return ds
 
 
+#: Why a dataset cannot fill a figure, and what gives it the data.
+_MISSING = {
+    "images": "has no saved images (a scenario saves them with render.save_images_at)",
+    "ranging": "has no laser ranging (a scenario has it with illumination.lasers)",
+}
+
+
+def _refuse_missing(dataset: Path, ds: xr.Dataset, missing: list[str], choices: Choices) -> None:
+    """An :class:`InputError` for figures asked for with ``--kind`` that ``ds`` cannot fill."""
+    reasons = []
+    for name in missing:
+        if name != "chain":
+            reasons.append(f"asked for {name}, but the dataset {_MISSING[name]}")
+        elif not has_spectra(ds):
+            reasons.append("asked for chain, but the dataset has no spectra (a run without target)")
+        else:
+            reasons.append("asked for chain, but no epoch is observable and sunlit; give --epoch")
+    fillable = [f.name for f in FIGURES if f.applies(ds, choices)]
+    raise InputError(
+        f"{'; '.join(reasons)}; figures this dataset can fill: {', '.join(fillable)}",
+        source=str(dataset),
+        field="--kind",
+    )
+
+
 def plot_files(
     dataset: str | Path,
     output: str | Path,
@@ -198,7 +224,8 @@ def plot_files(
         Band of the radiance images (default: the first band; the whole wavelength grid
         when the dataset has no bands).
     kinds
-        Figures to write (names in :data:`KINDS`); None for all that apply.
+        Figures to write (names in :data:`KINDS`); None for all that apply. A figure asked
+        for that the dataset cannot fill (images of a run that saved none...) is an error.
     dpi
         Resolution of raster formats [dots per inch].
 
@@ -215,6 +242,8 @@ def plot_files(
     ds = _load(dataset)
     choices = _choices(ds, epoch, band)
     todo = [f for f in wanted if f.applies(ds, choices)]
+    if kinds is not None and len(todo) < len(wanted):
+        _refuse_missing(dataset, ds, [f.name for f in wanted if f not in todo], choices)
     paths = figure_paths(output, [f.name for f in todo])
     existing = [str(p) for p in paths.values() if p.exists()]
     if existing and not force:
@@ -223,22 +252,21 @@ def plot_files(
             "choose another name or pass --force to overwrite",
             field="--output",
         )
-    temporaries: list[tuple[str, Path]] = []
+    temporaries: list[tuple[Path, Path]] = []
     try:
         for kind in todo:
             target = paths[kind.name]
             fig = kind.build(ds, choices)
-            fd, tmp = tempfile.mkstemp(
-                prefix=f".{target.name}.", suffix=target.suffix, dir=target.parent
-            )
-            os.close(fd)
-            temporaries.append((tmp, target))
-            fig.savefig(tmp, dpi=dpi)
-        for tmp, target in temporaries:
-            os.replace(tmp, target)
+            temp = target.with_name(f".{target.name}.{secrets.token_hex(4)}{target.suffix}")
+            fd = create_new_file(temp)  # mode 0666 less the umask, like any new file
+            temporaries.append((temp, target))
+            with os.fdopen(fd, "wb") as f:
+                fig.savefig(f, dpi=dpi, format=target.suffix.lstrip(".").lower())
+        for temp, target in temporaries:
+            os.replace(temp, target)
     finally:
-        for tmp, _ in temporaries:
-            Path(tmp).unlink(missing_ok=True)
+        for temp, _ in temporaries:
+            temp.unlink(missing_ok=True)
     return [paths[f.name] for f in todo]
 
 

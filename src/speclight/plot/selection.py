@@ -93,9 +93,10 @@ def resolve_epoch(ds: xr.Dataset, epoch: int | str | None) -> int | None:
         epoch = int(epoch)
     if isinstance(epoch, (int, np.integer)):
         if not -n <= int(epoch) < n:
+            middle = np.datetime_as_string(ds["time"].values[n // 2], unit="s")
             raise InputError(
                 f"epoch index {epoch} is outside the pass; use 0 to {n - 1} "
-                "or a UTC time such as 2020-11-27T17:35:00",
+                f"or a UTC time within it such as {middle}",
                 field="--epoch",
             )
         return int(epoch) % n

@@ -14,6 +14,7 @@ from speclight import orbit
 from speclight import schema as v
 from speclight.constants import C_M_S
 from speclight.errors import InputError
+from speclight.orbit.staleness import warn_past_tables, warn_tle_age
 from speclight.orbit.timescale import time_from_utc
 from speclight.scenario import LoadedScenario
 from speclight.scenario.sections_attitude import (
@@ -94,6 +95,7 @@ def _trajectory(loaded: LoadedScenario, time_utc: NDArray[np.datetime64]) -> Tra
             tle = orbit.read_tle_file(
                 loaded.resolve(cfg.tle_file), norad_id=cfg.norad_id, near_epoch=middle
             )
+        warn_tle_age(tle.epoch, time_utc, float(tle.line2[52:63]))  # mean motion [rev/day]
         return lambda t: orbit.tle_position_gcrs_m(tle, t)
     if cfg.cpf_file is not None:
         cpf = orbit.read_cpf(loaded.resolve(cfg.cpf_file))
@@ -196,6 +198,7 @@ def scenario_geometry(
         time_utc = np.asarray(time_utc, dtype="datetime64[ns]").ravel()
         if time_utc.size == 0:
             raise InputError("no epochs given", source=loaded.source, field="time_utc")
+    warn_past_tables(time_utc)
     t = time_from_utc(time_utc)
     t_s = (time_utc - start) / np.timedelta64(1, "s")
     site = orbit.Site(sc.observer.latitude_deg, sc.observer.longitude_deg, sc.observer.altitude_m)
