@@ -10,7 +10,16 @@ content does not change the search's cost, its HEALPix nside and phase angles x 
 2. a 300-epoch pass (2 s steps) simulated from the passive map (``render.mode: map``);
 3. for each map: the resampling onto the spin frame, the grid search (RA x Dec cells of
    ``--grid-deg`` x ``--phases``: the misfit of every candidate) and the whole search with
-   the Nelder-Mead refinement; peak resident memory of the process at the end.
+   the Nelder-Mead refinement;
+4. a laser pass with ranging returns (the box-wing-laser example, Sun off, its bistatic
+   station removed: the laser worked example of docs/spin-axis.md at ``--px`` and 100 nm
+   bins), its phase-0 map of 768 directions with range offsets, and ``spin_axis_measured``
+   (as ``speclight spin-axis``) without refinement, with the ranging term (default weight)
+   and without (``ranging_weight=0``), then with refinement and the ranging term; the
+   ``seconds`` it reports (resampling + search);
+
+peak resident memory of the process at the end. The grid search runs on as many threads as
+there are cores, at most 4 (:func:`speclight.estimate.spin_axis_grid.grid_pass`).
 """
 
 from __future__ import annotations
@@ -26,7 +35,7 @@ from pathlib import Path
 
 from speclight.estimate.reflectivity_map import reflectivity_map
 from speclight.estimate.spin_axis import grid_errors, radec_grid, spin_axis_search
-from speclight.estimate.spin_axis_io import inertial_epochs
+from speclight.estimate.spin_axis_io import inertial_epochs, spin_axis_measured
 from speclight.estimate.spin_axis_lookup import load_band_map, spin_frame_map
 from speclight.estimate.unmix_inputs import read_reflectance_factors
 from speclight.io.netcdf import dataset_bytes
@@ -35,12 +44,42 @@ from speclight.simulate import simulate
 from speclight.simulate.geometry_stage import scenario_geometry
 
 
-def _text(px: int, render: str | None = None) -> str:
-    text = example_text("box-wing").replace("resolution_px: 256", f"resolution_px: {px}")
+def _text(px: int, render: str | None = None, example: str = "box-wing") -> str:
+    text = example_text(example).replace("resolution_px: 256", f"resolution_px: {px}")
     text = text.replace("step_nm: 5", "step_nm: 100").replace("step_s: 1.0", "step_s: 2.0")
     if render is not None:
         text = re.sub(r"render: \{.*\}", render, text)
     return text
+
+
+def _laser_runs(folder: Path, px: int, grid_deg: float, n_phases: int) -> None:
+    """Step 4 of the module docstring."""
+    text = _text(px, example="box-wing-laser").replace("sun: true", "sun: false")
+    text = re.sub(r"    - \{name: wettzell-532.*\n.*\n.*\n", "", text)  # coaxial lines only
+    (folder / "laser.yaml").write_text(text)
+    loaded = load_scenario(folder / "laser.yaml")
+    reflectivity_map(loaded, folder / "laser.zarr", directions=768, phase_angles_deg=[0], rolls=1)
+    (folder / "laser.nc").write_bytes(dataset_bytes(simulate(loaded).dataset))
+    for label, weight, refine in (
+        ("ranging term, grid only", None, False),
+        ("no ranging term (weight 0), grid only", 0.0, False),
+        ("ranging term, with refinement", None, True),
+    ):
+        run = spin_axis_measured(
+            loaded,
+            folder / "laser.nc",
+            folder / "laser.zarr",
+            grid_deg=grid_deg,
+            n_phases=n_phases,
+            refine=refine,
+            ranging_weight=weight,
+        )
+        r = run.result
+        print(
+            f"laser pass, {r.n_epochs} epochs x {len(r.band_names)} bands, {label}: "
+            f"{run.seconds:.2f} s (weight {run.ranging_weight:.3g}); best {r.best[:2]}, "
+            f"refined ({r.refined[0]:.1f}, {r.refined[1]:.1f})"
+        )
 
 
 def main() -> None:

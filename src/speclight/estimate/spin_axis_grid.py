@@ -47,7 +47,7 @@ F64 = NDArray[np.float64]
 F32 = NDArray[np.float32]
 I64 = NDArray[np.int64]
 #: Gathered floats per block of axes [bytes]: about the second-level cache of one core.
-BLOCK_BYTES = 2 * 1024**2
+BLOCK_BYTES = 1024**2
 
 
 def misfit_from_sums(s1: F64, s2: F64, sy: F64, yy: F64, n_t: int) -> F64:
