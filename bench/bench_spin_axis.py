@@ -65,6 +65,7 @@ def _laser_runs(folder: Path, px: int, grid_deg: float, n_phases: int) -> None:
         ("no ranging term (weight 0), grid only", 0.0, False),
         ("ranging term, with refinement", None, True),
     ):
+        c0 = time.process_time()
         run = spin_axis_measured(
             loaded,
             folder / "laser.nc",
@@ -77,8 +78,59 @@ def _laser_runs(folder: Path, px: int, grid_deg: float, n_phases: int) -> None:
         r = run.result
         print(
             f"laser pass, {r.n_epochs} epochs x {len(r.band_names)} bands, {label}: "
-            f"{run.seconds:.2f} s (weight {run.ranging_weight:.3g}); best {r.best[:2]}, "
+            f"{run.seconds:.2f} s (CPU {time.process_time() - c0:.2f} s, load average "
+            f"{os.getloadavg()[0]:.1f}; weight {run.ranging_weight:.3g}); best {r.best[:2]}, "
             f"refined ({r.refined[0]:.1f}, {r.refined[1]:.1f})"
+        )
+
+
+def _solar_runs(folder: Path, args: argparse.Namespace) -> None:
+    """Steps 1-3 of the module docstring."""
+    (folder / "bw.yaml").write_text(_text(args.px))
+    loaded = load_scenario(folder / "bw.yaml")
+    t0 = time.perf_counter()
+    reflectivity_map(loaded, folder / "active.zarr", directions=10_000, chunk=4096)
+    print(f"phase-0 map, 12288 directions: {time.perf_counter() - t0:.1f} s")
+    t0 = time.perf_counter()
+    reflectivity_map(
+        loaded,
+        folder / "passive.zarr",
+        directions=768,
+        phase_angles_deg=[40, 70, 100, 130],
+        chunk=768,
+    )
+    print(f"passive map, 768 directions x 4 x 8: {time.perf_counter() - t0:.1f} s")
+    (folder / "pass.yaml").write_text(_text(args.px, "render: {mode: map, map_file: passive.zarr}"))
+    ds = simulate(load_scenario(folder / "pass.yaml")).dataset
+    (folder / "pass.nc").write_bytes(dataset_bytes(ds))
+    rf = read_reflectance_factors(folder / "pass.nc", loaded, light="sun")
+    epochs = inertial_epochs(scenario_geometry(loaded, rf.time_utc), 120.0)
+    y = rf.factor
+    ra, dec = radec_grid(args.grid_deg)
+    n_axes = ra.size * dec.size
+    print(
+        f"pass: {y.shape[0]} epochs x {y.shape[1]} bands; grid {args.grid_deg} deg: "
+        f"{ra.size} x {dec.size} = {n_axes} axes x {args.phases} phases"
+    )
+    for name in ("active", "passive"):
+        bmap = load_band_map(folder / f"{name}.zarr")
+        t0 = time.perf_counter()
+        sfm = spin_frame_map(bmap, None, args.phases)
+        t_resample = time.perf_counter() - t0
+        t0, c0 = time.perf_counter(), time.process_time()
+        grid_errors(sfm, epochs, y, ra, dec)
+        t_grid, c_grid = time.perf_counter() - t0, time.process_time() - c0
+        t0 = time.perf_counter()
+        res = spin_axis_search(bmap, sfm, epochs, y, rf.bands.band_names, args.grid_deg)
+        t_all = time.perf_counter() - t0
+        print(
+            f"{name} map (nside {bmap.header.nside}, {sfm.phase_angle_deg.size} phase "
+            f"angles x {sfm.n_rolls} rolls; spin-frame grid {sfm.values.shape[:2]} x "
+            f"{sfm.n_phases}): resample {t_resample:.2f} s, grid search {t_grid:.2f} s "
+            f"(CPU time of all threads {c_grid:.2f} s; load average {os.getloadavg()[0]:.1f}) "
+            f"({t_grid / (n_axes * args.phases * y.shape[0]) * 1e9:.1f} ns per "
+            f"candidate-epoch), search with refinement {t_all:.2f} s; best "
+            f"{res.best[:2]}, refined ({res.refined[0]:.1f}, {res.refined[1]:.1f})"
         )
 
 
@@ -87,57 +139,15 @@ def main() -> None:
     ap.add_argument("--grid-deg", type=float, default=2.0)
     ap.add_argument("--phases", type=int, default=72)
     ap.add_argument("--px", type=int, default=16)
+    ap.add_argument("--cases", default="solar,laser", help="solar, laser or both")
     args = ap.parse_args()
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        (folder / "bw.yaml").write_text(_text(args.px))
-        loaded = load_scenario(folder / "bw.yaml")
-        t0 = time.perf_counter()
-        reflectivity_map(loaded, folder / "active.zarr", directions=10_000, chunk=4096)
-        print(f"phase-0 map, 12288 directions: {time.perf_counter() - t0:.1f} s")
-        t0 = time.perf_counter()
-        reflectivity_map(
-            loaded,
-            folder / "passive.zarr",
-            directions=768,
-            phase_angles_deg=[40, 70, 100, 130],
-            chunk=768,
-        )
-        print(f"passive map, 768 directions x 4 x 8: {time.perf_counter() - t0:.1f} s")
-        (folder / "pass.yaml").write_text(
-            _text(args.px, "render: {mode: map, map_file: passive.zarr}")
-        )
-        ds = simulate(load_scenario(folder / "pass.yaml")).dataset
-        (folder / "pass.nc").write_bytes(dataset_bytes(ds))
-        rf = read_reflectance_factors(folder / "pass.nc", loaded, light="sun")
-        epochs = inertial_epochs(scenario_geometry(loaded, rf.time_utc), 120.0)
-        y = rf.factor
-        ra, dec = radec_grid(args.grid_deg)
-        n_axes = ra.size * dec.size
-        print(
-            f"pass: {y.shape[0]} epochs x {y.shape[1]} bands; grid {args.grid_deg} deg: "
-            f"{ra.size} x {dec.size} = {n_axes} axes x {args.phases} phases"
-        )
-        for name in ("active", "passive"):
-            bmap = load_band_map(folder / f"{name}.zarr")
-            t0 = time.perf_counter()
-            sfm = spin_frame_map(bmap, None, args.phases)
-            t_resample = time.perf_counter() - t0
-            t0 = time.perf_counter()
-            grid_errors(sfm, epochs, y, ra, dec)
-            t_grid = time.perf_counter() - t0
-            t0 = time.perf_counter()
-            res = spin_axis_search(bmap, sfm, epochs, y, rf.bands.band_names, args.grid_deg)
-            t_all = time.perf_counter() - t0
-            print(
-                f"{name} map (nside {bmap.header.nside}, {sfm.phase_angle_deg.size} phase "
-                f"angles x {sfm.n_rolls} rolls; spin-frame grid {sfm.values.shape[:2]} x "
-                f"{sfm.n_phases}): resample {t_resample:.2f} s, grid search {t_grid:.2f} s "
-                f"({t_grid / (n_axes * args.phases * y.shape[0]) * 1e9:.1f} ns per "
-                f"candidate-epoch), search with refinement {t_all:.2f} s; best "
-                f"{res.best[:2]}, refined ({res.refined[0]:.1f}, {res.refined[1]:.1f})"
-            )
+        if "solar" in args.cases:
+            _solar_runs(folder, args)
+        if "laser" in args.cases:
+            _laser_runs(folder, args.px, args.grid_deg, args.phases)
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
     print(f"peak resident memory: {rss:.2f} GiB")
 

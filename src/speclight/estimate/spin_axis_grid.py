@@ -15,12 +15,15 @@ contiguous window of the grid); what this module adds is how the work is laid ou
 * **Blocks of a few axes** (:data:`BLOCK_BYTES` of gathered floats, about the size of the
   second-level cache), so the gathered windows, their products and their sums stay in the
   cache instead of streaming tens of MB through memory for every elementwise step.
-* **Sums over the epochs as matrix products** (``ones @ x``, BLAS, float32): ``sum p``,
-  ``sum p^2``, ``sum p y`` of the intensity term (:func:`.spin_axis.misfit_from_sums`) and,
-  for the ranging term, ``sum (o - o_meas)^2`` of the band offsets, whose table holds
-  ``o = M / R`` per grid cell (the ranging map is one geometry, phase angle 0, so its
-  lookup is a single corner and the offset of the looked-up cell is the ratio of the cell's
-  channels, as a ratio after the lookup would be).
+* **Sums over the epochs in one pass each** (float32 reductions and ``einsum`` over the
+  epoch axis of the block, the product fused with the sum): ``sum p``, ``sum p^2``,
+  ``sum p y`` of the intensity term (:func:`misfit_from_sums`) and, for the ranging term,
+  ``sum (o - o_meas)^2`` of the band offsets, whose table holds ``o = M / R`` per grid cell
+  (the ranging map is one geometry, phase angle 0, so its lookup is a single corner and the
+  offset of the looked-up cell is the ratio of the cell's channels, as a ratio after the
+  lookup would be; a ranging map of several geometries would interpolate the offsets
+  rather than the channels).
+* **Threads over the chunks** (numpy's gathers, ufuncs and einsum release the GIL).
 
 Accuracy: the table values and the per-candidate products are the same float32 numbers as
 a straightforward per-candidate loop would compute; only the order of the float32
@@ -79,11 +82,12 @@ def window_view(values: F32) -> F32:
 @dataclass(frozen=True)
 class Corners:
     """Window rows (for :func:`window_view`) and weights of the interpolation corners of
-    ``A x T`` lookups (axis slowest): ``rows[i]`` (A T,), ``weights[i]`` (A T,) float32 or
-    None where every weight is 1; ``bad`` (A T,) where the geometry has no phase vector."""
+    ``A x T`` lookups (axis slowest): ``rows`` (A T, corners), ``weights`` (A T, corners)
+    float32 or None for one corner of weight 1; ``bad`` (A T,) where the geometry has no
+    phase vector."""
 
-    rows: list[I64]
-    weights: list[F32 | None]
+    rows: I64
+    weights: F32 | None
     bad: NDArray[np.bool_]
 
 
@@ -162,38 +166,30 @@ def lookup_corners(sfm: SpinFrameMap, ef: EpochFrames, frames: F64) -> Corners:
         r_lo = np.floor(f).astype(np.int64) % n_r
         w_r = f - np.floor(f)
     rows: list[I64] = []
-    weights: list[F32 | None] = []
+    weights: list[F64] = []
     for jj in range(2 if n_p > 1 else 1):
         jt = np.tile(j_idx[jj], n_ax)
         wj = np.tile(w_j[jj], n_ax)
         for rr in range(2 if n_r > 1 else 1):
             r_idx = (r_lo + rr) % n_r if n_r > 1 else 0
             rows.append((base + jt * n_r + r_idx) * (2 * n_k) + start)
-            if n_p == 1 and n_r == 1:
-                weights.append(None)  # one corner of weight 1 (phase_angle_weights: ones)
-            else:
-                w = wj * (w_r if rr else 1.0 - w_r) if n_r > 1 else wj
-                weights.append(w.astype(np.float32))
-    return Corners(rows, weights, bad)
+            weights.append(wj * (w_r if rr else 1.0 - w_r) if n_r > 1 else wj)
+    # one corner: weight 1 (phase_angle_weights of one stored angle are ones)
+    w = None if len(rows) == 1 else np.stack(weights, axis=1).astype(np.float32)
+    return Corners(np.stack(rows, axis=1), w, bad)
 
 
 def gather(table: F32, corners: Corners, sl: slice, fill: float = np.nan) -> F32:
     """Interpolated windows (n, K C) of the lookups ``sl`` of ``corners`` (``fill`` where
     bad)."""
-    out: F32 | None = None
-    for rows, w in zip(corners.rows, corners.weights, strict=True):
-        g = table[rows[sl]]
-        if w is not None:
-            g *= w[sl, None]
-        if out is None:
-            out = g
-        else:
-            out += g
-    assert out is not None
+    if corners.weights is None:
+        out = table[corners.rows[sl, 0]]
+    else:  # (n, corners, K C) weighted and summed over the corners
+        out = np.einsum("nc,ncj->nj", corners.weights[sl], table[corners.rows[sl]])
     bad = corners.bad[sl]
     if bad.any():
         out[bad] = fill
-    return out
+    return np.asarray(out)
 
 
 def _offset_table(sfm: SpinFrameMap, n_b: int) -> tuple[F32, F32]:
@@ -324,10 +320,8 @@ def _chunk_terms(ps: _Pass, frames: F64) -> tuple[F64, F64 | None]:
         sl = slice(a0 * n_t, a1 * n_t)
         p = gather(ps.table, c_i, sl).reshape(a1 - a0, n_t, n_k * n_b)
         np.add.reduce(p, axis=1, out=sums[0, a0:a1])
-        buf = np.multiply(p, p)
-        np.add.reduce(buf, axis=1, out=sums[1, a0:a1])
-        np.multiply(p, ps.yn_tiled, out=buf)
-        np.add.reduce(buf, axis=1, out=sums[2, a0:a1])
+        np.einsum("ntj,ntj->nj", p, p, out=sums[1, a0:a1])
+        np.einsum("ntj,tj->nj", p, ps.yn_tiled, out=sums[2, a0:a1])
         if rg is not None and e_r is not None and c_r is not None:
             e_r[a0:a1] = _ranging_block(rg, c_r, sl, n_t, n_k, n_b)
     s = sums.astype(float).reshape(3, n_ax, n_k, n_b).transpose(0, 1, 3, 2)
@@ -344,6 +338,5 @@ def _ranging_block(rg: _Ranging, corners: Corners, sl: slice, n_t: int, n_k: int
     d -= rg.meas_tiled
     if rg.ok_tiled is not None:
         d *= rg.ok_tiled
-    np.multiply(d, d, out=d)
-    e = np.add.reduce(d, axis=1).reshape(n_ax, n_k, n_b)
+    e = np.einsum("ntj,ntj->nj", d, d).reshape(n_ax, n_k, n_b)
     return np.asarray(e.sum(axis=-1), dtype=float) / rg.norm
