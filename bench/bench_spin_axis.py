@@ -18,8 +18,8 @@ content does not change the search's cost, its HEALPix nside and phase angles x 
    and without (``ranging_weight=0``), then with refinement and the ranging term; the
    ``seconds`` it reports (resampling + search);
 
-peak resident memory of the process at the end. The grid search runs on as many threads as
-there are cores, at most 4 (:func:`speclight.estimate.spin_axis_grid.grid_pass`).
+peak resident memory of the process at the end. Wall and CPU time: other jobs share the
+machine.
 """
 
 from __future__ import annotations

@@ -23,7 +23,7 @@ contiguous window of the grid); what this module adds is how the work is laid ou
   offset of the looked-up cell is the ratio of the cell's channels, as a ratio after the
   lookup would be; a ranging map of several geometries would interpolate the offsets
   rather than the channels).
-* **Threads over the chunks** (numpy's gathers, ufuncs and einsum release the GIL).
+* **Threads over the chunks** on request (``workers``).
 
 Accuracy: the table values and the per-candidate products are the same float32 numbers as
 a straightforward per-candidate loop would compute; only the order of the float32
@@ -33,7 +33,6 @@ whole misfit surface with a float64 loop over candidates).
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -241,14 +240,15 @@ def grid_pass(
     progress: Callable[[int, int], None] | None = None,
     ranging: RangingTerm | None = None,
     block_bytes: int = BLOCK_BYTES,
-    workers: int | None = None,
+    workers: int = 1,
 ) -> tuple[F64, F64 | None]:
     """Intensity term (A, K) and ranging term (A, K) or None of the axes ``ra_all, dec_all``.
 
     ``chunk``: axes whose lookup indices are computed in one call (blocks of about
     ``block_bytes`` of gathered floats within it); ``workers``: threads over the chunks
-    (numpy and BLAS release the GIL; default: the CPU count, at most 4). The result does not
-    depend on ``chunk``, ``block_bytes`` or ``workers``.
+    (numpy's gathers, ufuncs and einsum release the GIL; default 1: on the shared 2-core
+    machine of BENCHMARKS.md two threads were not faster). The result does not depend on
+    ``chunk``, ``block_bytes`` or ``workers``.
     """
     n_t, n_b = y.shape
     n_k = sfm.n_phases
@@ -282,7 +282,8 @@ def grid_pass(
     n_axes = ra_all.size
     e_i = np.empty((n_axes, n_k))
     e_r = None if ranging is None else np.empty((n_axes, n_k))
-    starts = range(0, n_axes, max(1, int(chunk)))
+    chunk = max(1, int(chunk))
+    starts = range(0, n_axes, chunk)
 
     def one(start: int) -> int:
         stop = min(start + chunk, n_axes)
@@ -291,18 +292,11 @@ def grid_pass(
             e_r[start:stop] = er
         return stop
 
-    n_workers = min(4, os.cpu_count() or 1) if workers is None else max(1, int(workers))
-    if n_workers == 1:
-        for stop in map(one, starts):
+    n_workers = max(1, int(workers))
+    with ThreadPoolExecutor(n_workers) as pool:
+        for stop in (map if n_workers == 1 else pool.map)(one, starts):  # in order
             if progress is not None:
                 progress(stop, n_axes)
-        return e_i, e_r
-    with ThreadPoolExecutor(n_workers) as pool:
-        done = 0
-        for stop in pool.map(one, starts):
-            done += stop - max(0, stop - chunk)
-            if progress is not None:
-                progress(min(done, n_axes), n_axes)
     return e_i, e_r
 
 
