@@ -34,20 +34,20 @@ from numpy.typing import ArrayLike, NDArray
 from speclight.attitude.quaternion import quat_to_matrix
 from speclight.attitude.spin import spin_attitude
 from speclight.errors import InputError
+from speclight.estimate.spin_axis_grid import misfit_from_sums
 from speclight.estimate.spin_axis_lookup import (
     EpochGeometry,
     SpinFrameMap,
-    axis_frames,
-    predict_chunk,
 )
-from speclight.render.map_lookup import ReflectivityMap, phase_angle_weights
+from speclight.render.map_lookup import ReflectivityMap
 
 if TYPE_CHECKING:
     from speclight.estimate.spin_axis_ranging import RangingTerm
 
 F64 = NDArray[np.float64]
-#: Axes per chunk of the grid search (memory ~ chunk x epochs x bands x phases x 4 B x 3).
-DEFAULT_AXIS_CHUNK = 48
+#: Axes per chunk of the grid search whose lookup indices are computed in one call (memory
+#: ~ chunk x epochs x 0.5 kB; the gathers and sums run in smaller blocks within a chunk).
+DEFAULT_AXIS_CHUNK = 256
 #: A second minimum must lie this far from the best cell to count as the mirror [deg].
 MIRROR_SEP_DEG = 20.0
 
@@ -90,19 +90,6 @@ def normalised(y: F64) -> F64:
         return y / np.mean(y, axis=0)
 
 
-def misfit_from_sums(s1: F64, s2: F64, sy: F64, yy: F64, n_t: int) -> F64:
-    """Mean squared difference of mean-normalised curves from the sums over epochs.
-
-    ``s1 = sum p``, ``s2 = sum p^2``, ``sy = sum p y_n`` (..., B, K) and ``yy = sum y_n^2``
-    (B,): ``sum_t (p / mean p - y_n)^2 = s2 / pm^2 - 2 sy / pm + yy`` with ``pm = s1 / T``.
-    """
-    with np.errstate(invalid="ignore", divide="ignore"):
-        pm = s1 / n_t
-        e = s2 / pm**2 - 2 * sy / pm + yy[:, None]
-    e = np.where(pm > 0, e, np.inf)
-    return np.asarray(np.sum(e, axis=-2) / (n_t * s1.shape[-2]))
-
-
 def grid_errors(
     sfm: SpinFrameMap,
     geo: EpochGeometry,
@@ -129,41 +116,12 @@ def grid_terms(
     progress: Callable[[int, int], None] | None = None,
     ranging: RangingTerm | None = None,
 ) -> tuple[F64, F64 | None]:
-    """Intensity term (A, n_phases) and ranging term (or None) of every grid candidate."""
-    yn = normalised(y).astype(np.float32)
-    yy = np.sum(yn.astype(float) ** 2, axis=0)
-    a_deg = np.degrees(
-        np.arccos(np.clip(np.sum(geo.sun_gcrs * geo.observer_gcrs, axis=1), -1.0, 1.0))
-    )
-    weights = phase_angle_weights(sfm.phase_angle_deg, a_deg)
+    """Intensity term (A, n_phases) and ranging term (or None) of every grid candidate
+    (:func:`.spin_axis_grid.grid_pass`)."""
+    from speclight.estimate.spin_axis_grid import grid_pass
+
     dd, rr = np.meshgrid(dec_deg, ra_deg, indexing="ij")
-    ra_all, dec_all = rr.ravel(), dd.ravel()
-    n_t = y.shape[0]
-    out = np.empty((ra_all.size, sfm.n_phases))
-    e_r = None if ranging is None else np.empty_like(out)
-    for start in range(0, ra_all.size, chunk):
-        sl = slice(start, start + chunk)
-        frames = axis_frames(ra_all[sl], dec_all[sl])
-        pr = None
-        if ranging is not None and ranging.shares_rates:
-            from speclight.estimate.spin_axis_ranging import predict_channels
-
-            pr = predict_channels(ranging, geo, frames)
-            p = pr[..., : y.shape[1]]  # the laser rates: the scale drops out in the misfit
-        else:
-            p = predict_chunk(sfm, geo, frames, weights)
-        # float32 sums (relative round-off ~1e-6 over hundreds of epochs; 3-5x faster)
-        s1 = p.sum(axis=1).transpose(0, 2, 1).astype(float)
-        s2 = np.einsum("atkb,atkb->abk", p, p).astype(float)
-        sy = np.einsum("atkb,tb->abk", p, yn).astype(float)
-        out[sl] = misfit_from_sums(s1, s2, sy, yy, n_t)
-        if ranging is not None and e_r is not None:
-            from speclight.estimate.spin_axis_ranging import grid_term
-
-            e_r[sl] = grid_term(ranging, geo, frames, pr)
-        if progress is not None:
-            progress(min(start + chunk, ra_all.size), ra_all.size)
-    return out, e_r
+    return grid_pass(sfm, geo, y, rr.ravel(), dd.ravel(), chunk, progress, ranging)
 
 
 def local_minima(error: F64) -> NDArray[np.int64]:

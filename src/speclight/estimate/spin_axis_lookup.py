@@ -11,7 +11,8 @@ HEALPix bilinear, linear in phase angle and roll). The azimuth step divides the 
 ``360 / n_phases`` by an integer ``m``, so the ``n_phases`` candidate phases of one
 (axis, epoch) read one contiguous run of the grid: a window of a sliding-window view, no
 Python loop per candidate. The polar angle and azimuth are looked up at the nearest grid
-cell (the grid is a few times finer than the map), the phase angle and roll linearly.
+cell (the grid is a few times finer than the map), the phase angle and roll linearly
+(:mod:`.spin_axis_grid` does the lookups and the misfit sums for a whole grid of axes).
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 from speclight.attitude.quaternion import quat_to_matrix
 from speclight.attitude.spin import body_axis_to_z
 from speclight.errors import InputError
-from speclight.render.map_geometry import map_coordinates, sun_observer
+from speclight.render.map_geometry import sun_observer
 from speclight.render.map_lookup import ReflectivityMap, read_header
 
 F64 = NDArray[np.float64]
@@ -148,47 +149,3 @@ class EpochGeometry:
     observer_gcrs: F64  # (T, 3)
     t_s: F64  # (T,) seconds since the scenario start
     period_s: float
-
-
-def predict_chunk(sfm: SpinFrameMap, geo: EpochGeometry, frames: F64, phase_weights: tuple) -> F32:
-    """Band rates (A, T, n_phases, B) of A axes x T epochs x the candidate phases.
-
-    ``frames``: (A, 3, 3) from :func:`axis_frames`; phase ``k`` is ``360 k / n_phases`` deg
-    at ``t_s = 0``.
-    """
-    n_ax, n_t = frames.shape[0], geo.t_s.size
-    # spin-frame directions at phase 0: frame^T v
-    s = np.einsum("aij,ti->atj", frames, geo.sun_gcrs).reshape(-1, 3)
-    o = np.einsum("aij,ti->atj", frames, geo.observer_gcrs).reshape(-1, 3)
-    p, _, roll = map_coordinates(s, o)
-    polar = np.arccos(np.clip(p[:, 2], -1.0, 1.0))
-    spin_turn = 2 * np.pi * np.mod(geo.t_s / geo.period_s, 1.0)
-    az = np.arctan2(p[:, 1], p[:, 0]).reshape(n_ax, n_t) - spin_turn
-    n_az = sfm.n_phases * sfm.m
-    c = np.rint(np.mod(az.ravel(), 2 * np.pi) / (2 * np.pi) * n_az).astype(np.int64) % n_az
-    i_polar = np.clip((polar / np.pi * sfm.n_polar).astype(np.int64), 0, sfm.n_polar - 1)
-    q, s_sub = c // sfm.m, c % sfm.m
-    f = np.mod(np.nan_to_num(roll), 2 * np.pi) / (2 * np.pi / sfm.n_rolls)
-    r_lo = np.floor(f).astype(np.int64) % sfm.n_rolls
-    w_r = f - np.floor(f)
-    j_idx, w_j = phase_weights
-    n_p, n_r = sfm.phase_angle_deg.size, sfm.n_rolls
-    v = sfm.values.reshape(-1, 2 * sfm.n_phases, sfm.values.shape[-1])
-    windows = np.lib.stride_tricks.sliding_window_view(v, sfm.n_phases, axis=1)
-    base = ((i_polar * sfm.m + s_sub) * n_p) * n_r
-    start = (sfm.n_phases - 1 - q) % sfm.n_phases  # element k of the window: cell q - k
-    out: F32 | None = None
-    for jj in range(2 if n_p > 1 else 1):
-        jt = np.tile(j_idx[jj], n_ax)
-        wj = np.tile(w_j[jj], n_ax)
-        for rr in range(2 if n_r > 1 else 1):
-            r_idx = (r_lo + rr) % n_r
-            w = (wj * (w_r if rr else 1.0 - w_r) if n_r > 1 else wj).astype(np.float32)
-            # the gathered windows are laid out (n, phase, band) in memory: keep that order
-            term = windows[base + jt * n_r + r_idx, start].transpose(0, 2, 1) * w[:, None, None]
-            out = term if out is None else out + term
-    assert out is not None
-    bad = ~np.isfinite(polar)
-    if np.any(bad):
-        out[bad] = np.nan
-    return out.reshape(n_ax, n_t, sfm.n_phases, -1)

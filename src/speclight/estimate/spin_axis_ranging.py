@@ -40,8 +40,8 @@ import xarray as xr
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
-from speclight.estimate.spin_axis_lookup import EpochGeometry, SpinFrameMap, predict_chunk
-from speclight.render.map_lookup import ReflectivityMap, phase_angle_weights, read_header
+from speclight.estimate.spin_axis_lookup import EpochGeometry, SpinFrameMap
+from speclight.render.map_lookup import ReflectivityMap, read_header
 
 F64 = NDArray[np.float64]
 FIELD = "--map"
@@ -137,35 +137,6 @@ def term_from_offsets(pred: NDArray, meas: F64) -> NDArray:
         return np.zeros(pred.shape[:-2])
     d = np.where(ok, np.nan_to_num(pred) - np.nan_to_num(meas), 0.0)
     return np.asarray(np.sum(d**2, axis=(-2, -1)) / (ok.sum() * norm))
-
-
-def predict_channels(term: RangingTerm, geo: EpochGeometry, frames: F64) -> NDArray:
-    """Channels ``[R..., M...]`` (A, T, n_phases, 2B) of a chunk of axes (coaxial light)."""
-    w = phase_angle_weights(term.sfm.phase_angle_deg, np.zeros(geo.t_s.size))
-    return predict_chunk(term.sfm, coaxial(geo), frames, w)
-
-
-def grid_term(term: RangingTerm, geo: EpochGeometry, frames: F64, p: NDArray | None = None) -> F64:
-    """The ranging term (A, n_phases) of a chunk of axes (float32 arithmetic); ``p``: the
-    chunk's :func:`predict_channels` where already computed."""
-    if p is None:
-        p = predict_channels(term, geo, frames)  # (A, T, K, 2B)
-    n_b = term.n_bands
-    s = np.ones(2 * n_b) if term.sfm.scale is None else np.asarray(term.sfm.scale, dtype=float)
-    meas = term.offset_m
-    ok = np.isfinite(meas)
-    norm = float(np.mean(meas[ok] ** 2)) if ok.any() else 0.0
-    if norm <= 0:
-        return np.zeros((p.shape[0], p.shape[2]))
-    r, m = p[..., :n_b], p[..., n_b:]
-    off = np.zeros(r.shape, dtype=np.float32)
-    np.divide(m, r, out=off, where=r > 0)
-    off *= (s[n_b:] / s[:n_b]).astype(np.float32)  # undo the spin-frame map's scaling
-    # offsets where R <= 0 stay 0 (the centre of mass); unmeasured epochs and bands weigh 0
-    off -= np.where(ok, meas, 0.0).astype(np.float32)[None, :, None, :]
-    if not ok.all():
-        off *= ok.astype(np.float32)[None, :, None, :]
-    return np.einsum("atkb,atkb->ak", off, off).astype(float) / (ok.sum() * norm)
 
 
 def exact_term(term: RangingTerm, observer_body: F64) -> float:
