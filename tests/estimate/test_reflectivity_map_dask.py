@@ -44,6 +44,17 @@ def cluster():
         yield executor
 
 
+def _malloc_trim(_: int) -> str | None:
+    return os.environ.get("MALLOC_TRIM_THRESHOLD_")
+
+
+def test_local_workers_keep_glibc_malloc_defaults(cluster):
+    # Dask's nanny would set MALLOC_TRIM_THRESHOLD_, which turns off glibc's dynamic mmap
+    # threshold (mallopt(3), M_MMAP_THRESHOLD): a map chunk then rendered 2.1x slower
+    # (BENCHMARKS.md). speclight's local cluster starts its workers without it.
+    assert [o.result for o in cluster.run(_malloc_trim, [0, 1])] == [None, None]
+
+
 @pytest.fixture(scope="module")
 def serial(tmp_path_factory):
     """The serial reference map of each case: (folder, scenario, store)."""

@@ -71,6 +71,7 @@ def test_killed_worker_costs_only_its_tasks(local):
             os.kill(outcome.result[1], signal.SIGKILL)
     assert sorted(o.item for o in outcomes) == items  # each exactly once, none lost
     assert all(o.error is None and o.result[0] == o.item**2 for o in outcomes)
+    local.client.wait_for_workers(2, timeout=60)  # the restart takes seconds under load
     new_pids = set(local.client.run(os.getpid).values())
     assert len(new_pids) == 2 and new_pids != set(pids)  # the nanny restarted it
 
