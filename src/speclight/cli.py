@@ -596,10 +596,6 @@ def _phase_angles(text: str) -> list[float]:
         ) from None
 
 
-#: ``reflectivity-map --scheduler`` default (docs/scale-out.md: measured on 2 cores).
-MAP_SCHEDULER_DEFAULT = "none"
-
-
 @app.command("reflectivity-map")
 def reflectivity_map(
     scenario: Annotated[
@@ -627,7 +623,7 @@ def reflectivity_map(
             help="Where chunks render: none (this process), local (a local Dask cluster) "
             "or a running Dask scheduler, e.g. tcp://HOST:8786.",
         ),
-    ] = MAP_SCHEDULER_DEFAULT,
+    ] = "none",  # docs/scale-out.md: a local cluster was no faster on 2 cores
     workers: Annotated[
         int | None,
         typer.Option("--workers", help="Workers of a local cluster (default: the cores)."),
