@@ -1,15 +1,18 @@
 """Reflectivity-map benchmark (issue 11): map cost against the simulate pipeline's per epoch.
 
 Run: ``.venv/bin/python bench/bench_reflectivity_map.py [--directions 10000] [--px 128]
-[--passive-chunks 1] [--error-samples 300]``
+[--passive-chunks 1] [--error-samples 300] [--scheduler none,local] [--workers 2]
+[--map-only]``
 
 All on the built-in box-wing example (189 bins, 300-1240 nm), single mode at ``--px``, in one
-process:
+process unless ``--scheduler`` says otherwise:
 
 1. the simulate pipeline on the example's 600-epoch pass at the same resolution (once to
    warm up on 10 epochs, then timed): seconds per epoch;
-2. the phase-angle-0 map of ``--directions`` (HEALPix: the next 12 nside^2) in one run:
-   total seconds, seconds per direction, the ratio to 1.;
+2. the phase-angle-0 map of ``--directions`` (HEALPix: the next 12 nside^2), once per
+   ``--scheduler`` (``none``: in this process; ``local``: a local Dask cluster of
+   ``--workers`` workers, its start timed apart; or a scheduler address): seconds, seconds
+   per direction, the ratio to 1., and on a cluster each worker's peak resident memory;
 3. the passive map (phase angles 0, 30, 60, 90 x 8 rolls) estimated from its first
    ``--passive-chunks`` chunks of 512 directions (the rest extrapolated per chunk);
 4. ``render.mode: map``: the 600-epoch pass with the phase-0 map, the interpolation alone
@@ -24,6 +27,9 @@ process:
 5. the interpolation error of the phase-0 map against direct renders (``--error-samples``
    random directions, intensity summed over wavelength, ``|map / render - 1|``);
 6. peak resident memory (``ru_maxrss``) of the process.
+
+``--worker-memory`` instead renders one passive chunk (512 directions x 25 geometries) on a
+local cluster of one worker and prints that worker's peak resident memory.
 """
 
 from __future__ import annotations
@@ -71,6 +77,59 @@ def _rss_gib() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
 
 
+def _phase0_map(  # type: ignore[no-untyped-def]
+    loaded, folder: Path, directions: int, scheduler: str, workers: int | None, per_epoch: float
+) -> None:
+    """Step 2 on one scheduler; on a cluster, its start apart and the workers' peak RSS."""
+    from speclight.scale import open_executor
+
+    t0 = time.perf_counter()
+    with open_executor(scheduler, n_workers=workers) as ex:
+        start_s = time.perf_counter() - t0
+        address = "none" if ex.serial else ex.client.scheduler.address
+        t0 = time.perf_counter()
+        run = reflectivity_map(
+            loaded, folder / "map0.zarr", directions=directions, force=True, scheduler=address
+        )
+        seconds = time.perf_counter() - t0
+        rss = {} if ex.serial else ex.client.run(_rss_gib)
+    per_dir = seconds / run.n_directions
+    where = "in process" if ex.serial else f"{ex.description}, started in {start_s:.1f} s"
+    print(
+        f"phase-0 map ({where}): {run.n_directions} directions in {seconds:.1f} s "
+        f"({(seconds + start_s) / run.n_directions * 1e4:.1f} s per 10,000 with the start), "
+        f"{per_dir * 1e3:.2f} ms per direction ({per_dir / per_epoch:.2f} x simulate's per "
+        f"epoch), peak RSS of this process so far {_rss_gib():.2f} GiB"
+    )
+    if rss:
+        print("  peak RSS per worker: " + ", ".join(f"{v:.2f} GiB" for v in rss.values()))
+
+
+def _worker_memory(loaded, folder: Path, directions: int) -> None:  # type: ignore[no-untyped-def]
+    """Peak RSS of a worker for one passive chunk (512 directions x 25 geometries)."""
+    from speclight.scale import open_executor
+
+    with open_executor("local", n_workers=1) as ex:
+        start = ex.client.run(_rss_gib)
+        t0 = time.perf_counter()
+        reflectivity_map(
+            loaded,
+            folder / "passive-worker.zarr",
+            directions=directions,
+            phase_angles_deg=[0, 30, 60, 90],
+            rolls=8,
+            max_chunks=1,
+            scheduler=ex.client.scheduler.address,
+        )
+        seconds = time.perf_counter() - t0
+        peak = ex.client.run(_rss_gib)
+    print(
+        f"one passive chunk on a 1-worker local cluster: {seconds:.1f} s; worker peak RSS "
+        f"{max(peak.values()):.2f} GiB ({max(start.values()):.2f} GiB after its start); this "
+        f"process (no render) {_rss_gib():.2f} GiB"
+    )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--directions", type=int, default=10_000)
@@ -80,6 +139,14 @@ def main() -> None:
     ap.add_argument("--laser-directions", type=int, default=3072)
     ap.add_argument("--laser-px", type=int, default=32)
     ap.add_argument("--laser-only", action="store_true")
+    ap.add_argument("--scheduler", default="none", help="comma-separated: none, local, ADDRESS")
+    ap.add_argument("--workers", type=int, default=None, help="workers of a local cluster")
+    ap.add_argument("--map-only", action="store_true", help="steps 1-2 only")
+    ap.add_argument(
+        "--worker-memory",
+        action="store_true",
+        help="only: one passive chunk on a 1-worker local cluster, the worker's peak RSS",
+    )
     args = ap.parse_args()
     print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, {args.px} px")
     folder = Path(tempfile.mkdtemp(prefix="bench-refmap-"))
@@ -88,6 +155,9 @@ def main() -> None:
         print(f"peak RSS {_rss_gib():.2f} GiB")
         return
     loaded = _scenario(args.px, folder=folder)
+    if args.worker_memory:
+        _worker_memory(loaded, folder, args.directions)
+        return
 
     t_s = np.datetime64("2019-08-30T02:20:00") + np.arange(10) * np.timedelta64(1, "s")
     simulate(loaded, time_utc=t_s)  # warm-up: kernels, tables
@@ -96,15 +166,11 @@ def main() -> None:
     per_epoch = (time.perf_counter() - t0) / n_epochs
     print(f"simulate: {n_epochs} epochs, {per_epoch * 1e3:.2f} ms per epoch")
 
-    t0 = time.perf_counter()
-    run = reflectivity_map(loaded, folder / "map0.zarr", directions=args.directions, force=True)
-    seconds = time.perf_counter() - t0
-    per_dir = seconds / run.n_directions
-    print(
-        f"phase-0 map: {run.n_directions} directions in {seconds:.1f} s, "
-        f"{per_dir * 1e3:.2f} ms per direction ({per_dir / per_epoch:.2f} x simulate's per epoch)"
-        f", peak RSS so far {_rss_gib():.2f} GiB"
-    )
+    for scheduler in args.scheduler.split(","):
+        _phase0_map(loaded, folder, args.directions, scheduler.strip(), args.workers, per_epoch)
+    if args.map_only:
+        print(f"peak RSS {_rss_gib():.2f} GiB")
+        return
 
     k = args.passive_chunks
     t0 = time.perf_counter()

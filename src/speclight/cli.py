@@ -639,11 +639,28 @@ def reflectivity_map(
     ] = 8,
     chunk: Annotated[int, typer.Option("--chunk", help="Directions per chunk.")] = 512,
     force: Annotated[bool, typer.Option("--force", help="Replace an existing store.")] = False,
+    scheduler: Annotated[
+        str,
+        typer.Option(
+            "--scheduler",
+            metavar="ADDRESS",
+            help="Where chunks render: none (this process), local (a local Dask cluster) "
+            "or a running Dask scheduler, e.g. tcp://HOST:8786.",
+        ),
+    ] = "none",  # docs/scale-out.md: a local cluster was no faster on 2 cores
+    workers: Annotated[
+        int | None,
+        typer.Option("--workers", help="Workers of a local cluster (default: the cores)."),
+    ] = None,
 ) -> None:
     """Render the target for N body-frame phase-vector directions x phase angles x rolls and
     store intensity (Sun at 1 AU) and count rates per band (1 m, 1 m2, no atmosphere) in a
     chunked Zarr store. An interrupted run resumes where it stopped when rerun with the same
     parameters; a chunk that fails is recorded and retried on the next run (exit 1).
+
+    Chunks of directions are tasks: in this process (--scheduler none), on a local Dask
+    cluster (--scheduler local) or on an existing one (--scheduler tcp://HOST:8786, see
+    docs/scale-out.md); the map is the same, bit for bit.
 
     Example: speclight reflectivity-map box-wing.yaml -o map.zarr --phase-angles-deg 0,30,60,90
     """
@@ -654,7 +671,7 @@ def reflectivity_map(
         from speclight.scenario import load_scenario
 
         angles = _phase_angles(phase_angles_deg)
-        check_map_options(directions, angles, rolls, chunk)  # before loading anything
+        check_map_options(directions, angles, rolls, chunk, workers)  # before loading
         result = build(
             load_scenario(scenario),
             output,
@@ -664,6 +681,9 @@ def reflectivity_map(
             chunk=chunk,
             force=force,
             progress=sys.stderr.isatty(),
+            scheduler=scheduler,
+            n_workers=workers,
+            announce=True,
         )
         _raise_if_signalled()
         typer.echo(

@@ -19,9 +19,9 @@ command line are built on them:
 * :mod:`.reflection_map` (HEALPix maps in the body frame) and :mod:`.reflection_map_io`
   (``speclight reflection-map``);
 * :mod:`.reflectivity_map` (with :mod:`.reflectivity_map_store`,
-  :mod:`.reflectivity_map_render`): ``speclight reflectivity-map``, the target rendered
-  over body-frame geometries into a Zarr store (read back by
-  :mod:`speclight.render.map_lookup`);
+  :mod:`.reflectivity_map_render`, :mod:`.reflectivity_map_task`): ``speclight
+  reflectivity-map``, the target rendered over body-frame geometries into a Zarr store
+  (read back by :mod:`speclight.render.map_lookup`), chunks in process or on Dask;
 * :mod:`.period_io` (with :mod:`.periodogram`, :mod:`.period_fap`, :mod:`.period_decision`,
   :mod:`.synodic`, :mod:`.period_geometry`): the ``speclight period`` command;
 * :mod:`.spin_axis` (with :mod:`.spin_axis_lookup`, :mod:`.spin_axis_io`): ``speclight

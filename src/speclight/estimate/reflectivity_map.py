@@ -3,16 +3,18 @@
 :func:`reflectivity_map` renders the scenario's target (its materials, spectrum, render
 settings and bands) for every HEALPix phase-vector direction x phase angle x roll
 (conventions: :mod:`speclight.render.map_geometry`) and streams the results, chunk by chunk
-of directions, into a resumable store (layout: :mod:`.reflectivity_map_store`).
+of directions, into a resumable store (layout: :mod:`.reflectivity_map_store`). Each chunk is
+a task of :mod:`speclight.scale` (in this process, or on a Dask cluster:
+:mod:`.reflectivity_map_task`); this process alone writes the store, as chunks finish.
 ``render: {mode: map, map_file: MAP.zarr}`` then interpolates the map instead of rendering
 (:mod:`speclight.render.map_lookup`).
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
-import sys
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -24,9 +26,10 @@ from numpy.typing import NDArray
 
 from speclight.errors import InputError
 from speclight.estimate import reflectivity_map_store as store
-from speclight.estimate.reflectivity_map_render import coaxial_returns, render_chunk
+from speclight.estimate.reflectivity_map_task import MapChunk, MapJob, map_engine, render_map_chunk
 from speclight.ranging.bins import range_bin_edges_m
 from speclight.render.map_geometry import healpix_directions, nside_for
+from speclight.scale import Outcome, open_executor
 from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
@@ -52,7 +55,11 @@ class MapRun:
 
 
 def check_map_options(
-    directions: int, phase_angles_deg: Sequence[float], rolls: int, chunk: int
+    directions: int,
+    phase_angles_deg: Sequence[float],
+    rolls: int,
+    chunk: int,
+    workers: int | None = None,
 ) -> tuple[int, list[float], int]:
     """Validate the options; return ``(nside, sorted phase angles, stored rolls)``."""
     nside = nside_for(directions)
@@ -75,6 +82,8 @@ def check_map_options(
         raise InputError(f"--rolls = {rolls} must be >= 1", field="--rolls")
     if int(chunk) < 1:
         raise InputError(f"--chunk = {chunk} must be >= 1", field="--chunk")
+    if workers is not None and int(workers) < 1:
+        raise InputError(f"--workers = {workers} must be >= 1", field="--workers")
     stored_rolls = 1 if all(a == 0 for a in angles) else int(rolls)
     return nside, sorted(angles), stored_rolls
 
@@ -100,6 +109,9 @@ def reflectivity_map(
     force: bool = False,
     progress: bool = False,
     max_chunks: int | None = None,
+    scheduler: str | None = "none",
+    n_workers: int | None = None,
+    announce: bool = False,
 ) -> MapRun:
     """Render the scenario's target into a reflectivity map (docs/reflectivity-map.md).
 
@@ -125,6 +137,14 @@ def reflectivity_map(
         Show a progress bar over chunks on a terminal.
     max_chunks
         Render at most this many chunks in this call (the rest stay to do: resume later).
+    scheduler
+        Where the chunks are rendered (:func:`speclight.scale.open_executor`): ``none`` (in
+        this process, the default of this function), ``local`` (a new local Dask cluster)
+        or the address of a running Dask scheduler. The result is the same, bit for bit.
+    n_workers
+        Workers of a local cluster (default: the cores).
+    announce
+        Print where the chunks run and the Dask dashboard address on stderr.
 
     Returns
     -------
@@ -139,19 +159,17 @@ def reflectivity_map(
             f"render.mode = '{sc.render.mode}': a map is rendered in mode single or path",
             field="render.mode",
         )
-    nside, angles, n_rolls = check_map_options(directions, phase_angles_deg, rolls, chunk)
-    path = store.check_store_path(output, {"scenario file": Path(loaded.source)})
-    from speclight.render import RenderSession, engine_versions
-    from speclight.simulate.radiometry import instrument_response, wavelength_grid_nm
-    from speclight.simulate.reflection import build_target
-
-    target = build_target(loaded)
-    session = RenderSession.create(sc.render.mode, sc.render.variant, target.materials)
-    wl = wavelength_grid_nm(sc.spectrum)
-    kernel = instrument_response(
-        loaded, wl, np.zeros((1, wl.size)), np.ones((1, wl.size)), np.ones(1)
+    nside, angles, n_rolls = check_map_options(
+        directions, phase_angles_deg, rolls, chunk, n_workers
     )
-    band_names = kernel.band_names
+    path = store.check_store_path(output, {"scenario file": Path(loaded.source)})
+    from speclight.illumination import solar_irradiance_W_m2_nm
+    from speclight.render import engine_versions
+    from speclight.simulate.radiometry import wavelength_grid_nm
+
+    engine = map_engine(loaded, sc.render.variant)  # also the serial run's (cached)
+    band_names = engine.kernel.band_names
+    wl = wavelength_grid_nm(sc.spectrum)
     dirs = healpix_directions(nside)
     parameters = {
         "healpix_nside": nside,
@@ -162,7 +180,7 @@ def reflectivity_map(
     }
     ranging = bool(sc.illumination.lasers) and 0.0 in angles
     # single-bounce bins about the body origin (the map's centre of mass), as in simulate
-    edges = range_bin_edges_m(target, np.zeros(3))
+    edges = range_bin_edges_m(engine.target, np.zeros(3))
     shapes = {
         "ranging": int(ranging),
         "direction": len(dirs),
@@ -172,6 +190,16 @@ def reflectivity_map(
         "band": len(band_names),
         "range_bin": len(edges) - 1,
     }
+    job = MapJob(
+        loaded,
+        engine.session.variant,
+        _geometries(angles, n_rolls),
+        shapes,
+        wl,
+        solar_irradiance_W_m2_nm(wl, 1.0),
+        edges,
+        ranging,
+    )
     started = time.perf_counter()
     with store.store_lock(path):
         group, resumed = store.open_or_create(path, parameters, shapes, int(chunk), force)
@@ -193,46 +221,44 @@ def reflectivity_map(
                         "range_bin_bounds": np.stack([edges[:-1], edges[1:]], axis=1),
                     },
                 )
-            group.attrs.update(_metadata(loaded, band_names, nside, session.variant))
+            group.attrs.update(_metadata(loaded, band_names, nside, engine.session.variant))
             group.attrs["engine_versions"] = engine_versions()
-        from speclight.illumination import solar_irradiance_W_m2_nm
-
-        solar = solar_irradiance_W_m2_nm(wl, 1.0)
-        geoms = _geometries(angles, n_rolls)
         states = store.chunk_states(group)
         todo = [k for k in range(states.size) if states[k] != store.DONE]
         if max_chunks is not None:
             todo = todo[: max(int(max_chunks), 0)]
         run = MapRun(path, len(dirs), states.size, 0, int(np.sum(states == store.DONE)))
-
-        def one(k: int) -> None:
-            lo, hi = k * int(chunk), min((k + 1) * int(chunk), len(dirs))
-            try:
-                inten, rate = render_chunk(
-                    loaded, target, session, dirs[lo:hi], geoms, shapes, wl, solar, kernel, k
-                )
-                group["intensity"][lo:hi] = inten.astype(np.float32)
-                if band_names:
-                    group["count_rate"][lo:hi] = rate.astype(np.float32)
-                if ranging:
-                    offset, hist = coaxial_returns(
-                        target, session, dirs[lo:hi], wl, loaded, kernel, edges
-                    )
-                    group["range_offset"][lo:hi] = offset.astype(np.float32)
-                    if band_names:
-                        group["range_histogram"][lo:hi] = hist.astype(np.float32)
-                store.mark(group, k, store.DONE)
-            except Exception as exc:  # recorded, the run goes on
-                store.mark(group, k, store.FAILED, f"{type(exc).__name__}: {exc}")
-            run.rendered += 1
-
-        _over_chunks(todo, one, progress)
+        size = int(chunk)
+        chunks = [
+            MapChunk(k, k * size, min((k + 1) * size, len(dirs)), dirs[k * size : (k + 1) * size])
+            for k in todo
+        ]
+        if chunks:
+            with open_executor(scheduler, n_workers=n_workers, announce=announce) as executor:
+                task = functools.partial(render_map_chunk, job)
+                for outcome in executor.run(
+                    task, chunks, label="reflectivity map", progress=progress
+                ):
+                    write_chunk(group, outcome)
+                    run.rendered += 1
         states = store.chunk_states(group)
         run.failed = dict(group.attrs.get("failed_chunks", {}))
         run.complete = bool(np.all(states == store.DONE))
         group.attrs["complete"] = run.complete
     run.seconds = time.perf_counter() - started
     return run
+
+
+def write_chunk(group: Any, outcome: Outcome[MapChunk, dict[str, Any]]) -> None:
+    """Write one finished chunk's arrays into the store (its region) and mark it done, or
+    mark it failed with the error text. Only the calling process writes the store."""
+    c = outcome.item
+    if outcome.result is None:
+        store.mark(group, c.k, store.FAILED, outcome.error)
+        return
+    for name, values in outcome.result.items():
+        group[name][c.lo : c.hi] = values
+    store.mark(group, c.k, store.DONE)
 
 
 def _metadata(
@@ -278,17 +304,3 @@ def _metadata(
         "sin(a/2) u, observer = cos(a/2) p - sin(a/2) u, u = cos r e_lon + sin r e_lat",
         "failed_chunks": {},
     }
-
-
-def _over_chunks(todo: list[int], one: Any, progress: bool) -> None:
-    if not (progress and sys.stderr.isatty()):
-        for k in todo:
-            one(k)
-        return
-    from rich.progress import Progress
-
-    with Progress(transient=True) as bar:
-        task = bar.add_task("reflectivity map", total=len(todo))
-        for k in todo:
-            one(k)
-            bar.advance(task)

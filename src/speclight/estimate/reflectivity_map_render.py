@@ -6,7 +6,6 @@ Used by :func:`speclight.estimate.reflectivity_map.reflectivity_map`; convention
 
 from __future__ import annotations
 
-import os
 from typing import Any
 
 import numpy as np
@@ -30,8 +29,12 @@ def render_chunk(
     solar: F64,
     kernel: Any,
     k: int,
+    workers: int = 1,
 ) -> tuple[F64, F64]:
-    """Intensity (n, P, R, L) and unit count rates (n, P, R, B) of one chunk of directions."""
+    """Intensity (n, P, R, L) and unit count rates (n, P, R, B) of one chunk of directions.
+
+    ``workers``: processes of the numpy ray caster (Dr.Jit variants ignore it).
+    """
     from speclight.render import render_intensity
 
     sc = loaded.scenario
@@ -51,7 +54,7 @@ def render_chunk(
         samples_per_pixel=sc.render.samples_per_pixel,
         seed=(sc.render.seed + k) % 2**32,  # each chunk its own Monte Carlo samples
         variant=sc.render.variant,
-        workers=os.cpu_count(),
+        workers=workers,
         solar_disk=sc.illumination.solar_disk,
         session=session,
     )

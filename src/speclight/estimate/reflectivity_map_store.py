@@ -20,13 +20,15 @@ Layout (Zarr format 3, a folder ``MAP.zarr``):
 * ``direction_body(direction, xyz)``, ``phase_angle_deg(phase)``, ``roll_deg(roll)``,
   ``wavelength(wavelength)`` [nm];
 * ``chunk_state(chunk)`` uint8: 0 to do, 1 done, 2 failed (each written after its chunk's
-  data, so a killed run loses at most the chunk in flight);
+  data, so a killed run loses only the chunks in flight);
 * attributes: ``parameters`` (what a resumed run must match), band names, units, the
   scenario YAML, target and materials, engine and speclight versions, render variant,
   ``failed_chunks`` (chunk -> message) and ``complete``.
 
-The store is written in place, not to a temporary name: its partial content is the resume
-state. Readers (``render.mode: map``) accept only a store whose ``complete`` is true.
+Each array carries its dimension names (:data:`DIMS`), so that ``xarray.open_zarr(path,
+consolidated=False)`` reads the store too. The store is written in place, not to a
+temporary name: its partial content is the resume state. Readers (``render.mode: map``)
+accept only a store whose ``complete`` is true.
 """
 
 from __future__ import annotations
@@ -48,6 +50,20 @@ from speclight.io.output import lock_path
 FIELD = "--output"
 FORMAT_NAME = "speclight reflectivity map"
 TODO, DONE, FAILED = 0, 1, 2
+#: Dimension names of each array (Zarr ``dimension_names``: ``xarray.open_zarr`` reads them).
+DIMS = {
+    "intensity": ("direction", "phase", "roll", "wavelength"),
+    "count_rate": ("direction", "phase", "roll", "band"),
+    "range_offset": ("direction", "wavelength"),
+    "range_histogram": ("direction", "band", "range_bin"),
+    "chunk_state": ("chunk",),
+    "direction_body": ("direction", "xyz"),
+    "phase_angle_deg": ("phase",),
+    "roll_deg": ("roll",),
+    "wavelength": ("wavelength",),
+    "range_bin": ("range_bin",),
+    "range_bin_bounds": ("range_bin", "nv"),
+}
 
 
 def check_store_path(output: str | os.PathLike[str], inputs: dict[str, Path]) -> Path:
@@ -146,6 +162,7 @@ def open_or_create(
         chunks=(chunk, p, r, n_wl),
         dtype="f4",
         fill_value=np.nan,
+        dimension_names=DIMS["intensity"],
     )
     if n_band:
         group.create_array(
@@ -154,10 +171,16 @@ def open_or_create(
             chunks=(chunk, p, r, n_band),
             dtype="f4",
             fill_value=np.nan,
+            dimension_names=DIMS["count_rate"],
         )
     if shapes.get("ranging"):
         group.create_array(
-            "range_offset", shape=(d, n_wl), chunks=(chunk, n_wl), dtype="f4", fill_value=np.nan
+            "range_offset",
+            shape=(d, n_wl),
+            chunks=(chunk, n_wl),
+            dtype="f4",
+            fill_value=np.nan,
+            dimension_names=DIMS["range_offset"],
         )
         if n_band:
             n_bins = shapes["range_bin"]
@@ -167,9 +190,15 @@ def open_or_create(
                 chunks=(chunk, n_band, n_bins),
                 dtype="f4",
                 fill_value=np.nan,
+                dimension_names=DIMS["range_histogram"],
             )
     group.create_array(
-        "chunk_state", shape=(n_chunks,), chunks=(n_chunks,), dtype="u1", fill_value=0
+        "chunk_state",
+        shape=(n_chunks,),
+        chunks=(n_chunks,),
+        dtype="u1",
+        fill_value=0,
+        dimension_names=DIMS["chunk_state"],
     )
     group.attrs.update({"format": FORMAT_NAME, "parameters": parameters, "complete": False})
     return group, False
@@ -180,7 +209,12 @@ def write_coordinates(group: Any, coords: dict[str, NDArray[Any]]) -> None:
     for name, values in coords.items():
         values = np.asarray(values, dtype=float)
         arr = group.create_array(
-            name, shape=values.shape, chunks=values.shape, dtype="f8", overwrite=True
+            name,
+            shape=values.shape,
+            chunks=values.shape,
+            dtype="f8",
+            overwrite=True,
+            dimension_names=DIMS.get(name),
         )
         arr[...] = values
 

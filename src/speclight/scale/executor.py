@@ -37,6 +37,7 @@ R = TypeVar("R")
 
 #: Environment variable read by :mod:`speclight.render.variant`: Dr.Jit threads per process.
 RENDER_THREADS_ENV = "SPECLIGHT_RENDER_THREADS"
+MALLOC_TRIM_ENV = "MALLOC_TRIM_THRESHOLD_"
 SERIAL_NAMES = ("none", "serial")
 LOCAL_NAMES = ("local", "")
 FIELD = "--scheduler"
@@ -145,15 +146,16 @@ def open_executor(
         cores = os.cpu_count() or 1
         workers = max(1, int(n_workers or cores))
         threads = max(1, cores // workers)
-        cluster = LocalCluster(
-            n_workers=workers,
-            threads_per_worker=1,
-            processes=True,
-            host="127.0.0.1",
-            dashboard_address="127.0.0.1:0",
-            silence_logs=logging.CRITICAL,  # a failed task is reported as its outcome
-            env={RENDER_THREADS_ENV: str(threads)},
-        )
+        with _glibc_malloc_defaults():
+            cluster = LocalCluster(
+                n_workers=workers,
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                dashboard_address="127.0.0.1:0",
+                silence_logs=logging.CRITICAL,  # a failed task is reported as its outcome
+                env={RENDER_THREADS_ENV: str(threads)},
+            )
         client = Client(cluster)
         description = (
             f"a local Dask cluster of {workers} workers ({threads} render thread"
@@ -180,6 +182,27 @@ def open_executor(
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+@contextmanager
+def _glibc_malloc_defaults() -> Iterator[None]:
+    """Start local workers without Dask's ``MALLOC_TRIM_THRESHOLD_``.
+
+    Dask's nanny sets ``MALLOC_TRIM_THRESHOLD_=65536`` in each worker's environment (and in
+    this process's, to spawn it). Setting it turns off glibc's dynamic mmap threshold: every
+    array over 128 KiB is then mapped and unmapped anew, and a render chunk, which makes
+    many, ran 2.1 times slower in a worker than in this process (BENCHMARKS.md,
+    reflectivity maps). Workers keep glibc's defaults instead; a value this process had
+    before any cluster is kept.
+    """
+    import dask
+
+    key = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
+    dask_value = dask.config.get(key, default=None)
+    if dask_value is not None and os.environ.get(MALLOC_TRIM_ENV) == str(dask_value):
+        os.environ.pop(MALLOC_TRIM_ENV)  # left by an earlier cluster of this process
+    with dask.config.set({key: None}):
+        yield
 
 
 def _with_progress(
