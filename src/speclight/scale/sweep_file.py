@@ -287,7 +287,9 @@ class _Checker:
             raise self.error(line, f"{where}.{name}", None, problem)
         for other in self.fields:
             shorter = min(len(path), len(other.path))
-            if path[:shorter] == other.path[:shorter]:
+            # set: is applied first: a varied field inside a set section is fine
+            inside_set = other not in self.varied and len(other.path) < len(path)
+            if path[:shorter] == other.path[:shorter] and not inside_set:
                 again = "is given twice" if path == other.path else f"overlaps {other.name}"
                 raise self.error(
                     line, f"{where}.{name}", None, f"{again} (line {other.line}); keep one"

@@ -219,7 +219,7 @@ def _check_compatible(group: Any, plan: SweepPlan, path: Path) -> None:
     if plan.spec.spectra and not np.array_equal(group["wavelength"][...], plan.wavelength_nm):
         problems.append("its wavelength grid differs")
     accepts = {"float64": ("float64", "int64"), "int64": ("int64",), "bool": ("bool",)}
-    for f in plan.spec.fields:
+    for f in plan.spec.fields if not problems else ():
         have = _stored_kind(group[f.param])
         new = _param_dtype([v[f.name] for v in plan.values])
         if have in accepts and new not in accepts[have]:
