@@ -144,13 +144,16 @@ def run_sweep(
             if state[t.index] != store.DONE
         ]
         run.skipped = len(plan.tasks) - len(todo)
+        failed_before = {start + int(i) for i in np.flatnonzero(state == store.FAILED)}
+        writer = store.CaseWriter(group, failed_before)
         try:
             if todo:
                 with open_executor(scheduler, n_workers=n_workers, announce=announce) as ex:
                     run.where = ex.description
                     for outcome in ex.run(task, todo, label="cases", progress=progress):
-                        _write(group, plan, outcome, run)
+                        _write(writer, plan, outcome, run)
         finally:
+            writer.flush()
             run.complete = store.finish(path, group)
         errors = store.errors(group, start, start + len(plan.tasks))
         run.failed = {i: e for i, e in errors.items()}
@@ -158,15 +161,15 @@ def run_sweep(
     return run
 
 
-def _write(group: Any, plan: SweepPlan, outcome: Any, run: SweepRun) -> None:
+def _write(writer: store.CaseWriter, plan: SweepPlan, outcome: Any, run: SweepRun) -> None:
     index = outcome.item.index
     run.ran += 1
     if outcome.error is None:
         try:
             _check_shapes(outcome.result, plan)
         except ValueError as exc:
-            store.fail_case(group, index, f"ValueError: {exc}")
+            writer.failed(index, f"ValueError: {exc}")
             return
-        store.write_case(group, index, outcome.result)
+        writer.done(index, outcome.result)
     else:
-        store.fail_case(group, index, outcome.error)
+        writer.failed(index, outcome.error)

@@ -27,6 +27,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import time
 import warnings
 from pathlib import Path
 from typing import Any
@@ -258,22 +259,53 @@ def _add_segment(group: Any, plan: SweepPlan) -> int:
     return start
 
 
-def write_case(group: Any, index: int, result: dict[str, np.ndarray]) -> None:
-    """Write one case's arrays, then mark it done."""
-    for name, values in result.items():
-        if name in group:
-            group[name][index] = values
-    group["error"][index] = ""
-    group["case_state"][index] = DONE
+class CaseWriter:
+    """Writes cases as they finish: each case's arrays at once, its state in batches.
 
+    The states of the cases written since the last :meth:`flush` are written together (at
+    most every ``flush_s`` seconds, and on :meth:`flush`): always after the cases' data, so a
+    killed run re-runs at most those cases. Array handles are opened once.
+    """
 
-def fail_case(group: Any, index: int, message: str) -> None:
-    """Record a case's error (its rows stay, or become, NaN), then mark it failed."""
-    for name in (*CURVES, *SPECTRA):
-        if name in group:
-            group[name][index] = np.nan
-    group["error"][index] = message
-    group["case_state"][index] = FAILED
+    def __init__(self, group: Any, failed_before: set[int], flush_s: float = 1.0) -> None:
+        names = [n for n in (*CURVES, *SPECTRA) if n in group]
+        self.arrays = {name: group[name] for name in names}
+        self.state = group["case_state"]
+        self.error = group["error"]
+        self.failed_before = failed_before
+        self.pending: dict[int, int] = {}
+        self.flush_s = flush_s
+        self.last = time.monotonic()
+
+    def done(self, index: int, result: dict[str, np.ndarray]) -> None:
+        """Write one case's arrays (NaN rows of a retried case are overwritten)."""
+        for name, values in result.items():
+            if name in self.arrays:
+                self.arrays[name][index] = values
+        if index in self.failed_before:
+            self.error[index] = ""
+        self._mark(index, DONE)
+
+    def failed(self, index: int, message: str) -> None:
+        """Record a case's error; its rows stay NaN (or become NaN if it had run)."""
+        for arr in self.arrays.values():
+            arr[index] = np.nan
+        self.error[index] = message
+        self._mark(index, FAILED)
+
+    def _mark(self, index: int, state: int) -> None:
+        self.pending[index] = state
+        if time.monotonic() - self.last >= self.flush_s:
+            self.flush()
+
+    def flush(self) -> None:
+        """Write the pending states."""
+        if self.pending:
+            index = np.fromiter(self.pending, dtype=np.int64)
+            values = np.fromiter(self.pending.values(), dtype=np.uint8)
+            self.state.set_coordinate_selection(index, values)
+            self.pending.clear()
+        self.last = time.monotonic()
 
 
 def states(group: Any) -> np.ndarray:
