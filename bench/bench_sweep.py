@@ -18,21 +18,28 @@ memory of this process (the serial run) and of each worker.
 
 from __future__ import annotations
 
-import argparse
 import os
-import platform
-import resource
-import tempfile
-import time
-from pathlib import Path
 
-import numpy as np
-import xarray as xr
+# Dask's workers run BLAS on one thread (distributed.nanny.pre-spawn-environ); so does the
+# serial run here, so that the two stores can be compared bit for bit (the band integral is a
+# BLAS product whose last bit depends on the thread split: BENCHMARKS.md, "Sweep")
+for _name in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
+    os.environ.setdefault(_name, "1")
 
-from speclight.scale import open_executor
-from speclight.scale.sweep_cases import plan_sweep
-from speclight.scale.sweep_file import load_sweep
-from speclight.scale.sweep_run import run_sweep
+import argparse  # noqa: E402
+import platform  # noqa: E402
+import resource  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+import xarray as xr  # noqa: E402
+
+from speclight.scale import open_executor  # noqa: E402
+from speclight.scale.sweep_cases import plan_sweep  # noqa: E402
+from speclight.scale.sweep_file import load_sweep  # noqa: E402
+from speclight.scale.sweep_run import keep_worker_heap, run_sweep  # noqa: E402
 
 SWEEP = """base: calsphere
 set: {{render.resolution_px: {px}}}
@@ -53,6 +60,12 @@ def _peak_rss_gib() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
 
 
+def _cpu_s() -> float:
+    """CPU seconds of this process, all threads (user + system)."""
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=1000)
@@ -65,28 +78,37 @@ def main() -> None:
         t = time.perf_counter()
         plan = _plan(folder, "sweep.yaml", args.cases, args.px)
         print(f"check and expand {args.cases} cases: {time.perf_counter() - t:.2f} s")
-        warm = _plan(folder, "warm.yaml", max(args.workers, 1), args.px)
+        warm = _plan(folder, "warm.yaml", 4 * max(args.workers, 1), args.px)
 
         run_sweep(warm, folder / "warm-serial.zarr", scheduler="none")
-        t = time.perf_counter()
+        t, cpu = time.perf_counter(), _cpu_s()
         serial = run_sweep(plan, folder / "serial.zarr", scheduler="none")
-        s_serial = time.perf_counter() - t
+        s_serial, cpu_serial = time.perf_counter() - t, _cpu_s() - cpu
         print(
             f"serial: {args.cases} cases in {s_serial:.1f} s, "
-            f"{args.cases / s_serial:.2f} cases/s, failed {len(serial.failed)}"
+            f"{args.cases / s_serial:.2f} cases/s, failed {len(serial.failed)}; CPU "
+            f"{cpu_serial / args.cases:.3f} s per case"
         )
 
         t = time.perf_counter()
-        with open_executor("local", n_workers=args.workers) as ex:
+        with keep_worker_heap(), open_executor("local", n_workers=args.workers) as ex:
             address = ex.client.scheduler.address
             started = time.perf_counter() - t
             t = time.perf_counter()
             run_sweep(warm, folder / "warm-dask.zarr", scheduler=address)
             warmed = time.perf_counter() - t
             print(f"cluster of {args.workers}: start {started:.1f} s, warm-up {warmed:.1f} s")
-            t = time.perf_counter()
+            t, cpu = time.perf_counter(), _cpu_s()
+            before = ex.client.run(_cpu_s)
             dask = run_sweep(plan, folder / "dask.zarr", scheduler=address)
             s_dask = time.perf_counter() - t
+            after = ex.client.run(_cpu_s)
+            cpu_caller = _cpu_s() - cpu  # client, scheduler, Zarr writes
+            cpu_workers = sum(after[w] - before[w] for w in after)
+            print(
+                f"cluster CPU per case: workers {cpu_workers / args.cases:.3f} s, calling "
+                f"process (scheduler, client, writes) {cpu_caller / args.cases:.3f} s"
+            )
             peaks = ex.client.run(_peak_rss_gib).values()
             print(f"peak resident memory per worker: {', '.join(f'{p:.2f}' for p in peaks)} GiB")
         print(

@@ -15,7 +15,8 @@ import dataclasses
 import hashlib
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -80,6 +81,25 @@ def run_case(task: CaseTask) -> dict[str, np.ndarray]:
     if task.spectra:
         out.update({name: ds[name].values.astype(np.float32) for name in store.SPECTRA})
     return out
+
+
+@contextmanager
+def keep_worker_heap() -> Iterator[None]:
+    """Start local workers without Dask's ``MALLOC_TRIM_THRESHOLD_``.
+
+    Dask's nannies set it (65536) so that workers hand freed memory back to the system; but
+    setting it switches off glibc's adaptive mmap threshold, so every large array of a case
+    (the render batch: hundreds of MB) is mapped and page-faulted anew: measured +60 % CPU
+    per calsphere case (BENCHMARKS.md, "Sweep"). A worker runs one case at a time and
+    reuses that memory for the next. ``None`` unsets it (``distributed.nanny``).
+    """
+    try:
+        import dask
+    except ImportError:  # pragma: no cover - a dependency of speclight
+        yield
+        return
+    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+        yield
 
 
 def _check_shapes(result: dict[str, np.ndarray], plan: SweepPlan) -> None:
@@ -148,7 +168,10 @@ def run_sweep(
         writer = store.CaseWriter(group, failed_before)
         try:
             if todo:
-                with open_executor(scheduler, n_workers=n_workers, announce=announce) as ex:
+                with (
+                    keep_worker_heap(),
+                    open_executor(scheduler, n_workers=n_workers, announce=announce) as ex,
+                ):
                     run.where = ex.description
                     for outcome in ex.run(task, todo, label="cases", progress=progress):
                         _write(writer, plan, outcome, run)
