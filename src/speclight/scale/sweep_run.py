@@ -84,21 +84,31 @@ def run_case(task: CaseTask) -> dict[str, np.ndarray]:
 
 
 @contextmanager
-def keep_worker_heap() -> Iterator[None]:
-    """Start local workers without Dask's ``MALLOC_TRIM_THRESHOLD_``.
+def lean_local_workers() -> Iterator[None]:
+    """Start local Dask workers without two defaults that slow a sweep's cases down.
 
-    Dask's nannies set it (65536) so that workers hand freed memory back to the system; but
-    setting it switches off glibc's adaptive mmap threshold, so every large array of a case
-    (the render batch: hundreds of MB) is mapped and page-faulted anew: measured +60 % CPU
-    per calsphere case (BENCHMARKS.md, "Sweep"). A worker runs one case at a time and
-    reuses that memory for the next. ``None`` unsets it (``distributed.nanny``).
+    * ``MALLOC_TRIM_THRESHOLD_=65536``, which Dask's nannies set so that workers hand freed
+      memory back to the system: setting it switches off glibc's adaptive mmap threshold,
+      so every large array of a case (the render batch: hundreds of MB) is mapped and
+      page-faulted anew (+60 % CPU per calsphere case); a worker runs one case at a time
+      and reuses that memory for the next. ``None`` unsets it (``distributed.nanny``).
+    * the workers' statistical profiler (a stack sample of every thread every 10 ms, for the
+      dashboard's profile page): +25 % CPU per case.
+
+    Measured: BENCHMARKS.md, "Sweep". Workers of an existing cluster keep their own settings
+    (docs/sweep.md says how to start them).
     """
     try:
         import dask
+        import distributed  # noqa: F401 - its configuration first: set() below must not hide it
     except ImportError:  # pragma: no cover - a dependency of speclight
         yield
         return
-    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+    lean = {
+        "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+        "distributed.worker.profile.enabled": False,
+    }
+    with dask.config.set(lean):
         yield
 
 
@@ -169,7 +179,7 @@ def run_sweep(
         try:
             if todo:
                 with (
-                    keep_worker_heap(),
+                    lean_local_workers(),
                     open_executor(scheduler, n_workers=n_workers, announce=announce) as ex,
                 ):
                     run.where = ex.description
