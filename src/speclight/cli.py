@@ -936,6 +936,86 @@ def period(
 
 
 @app.command()
+def sweep(
+    sweep_file: Annotated[
+        Path, typer.Argument(metavar="SWEEP.yaml", help="Sweep file: base, vary, draws, seed.")
+    ],
+    output: Annotated[
+        str, typer.Option("--output", "-o", metavar="RUNS.zarr", help="Output Zarr store.")
+    ] = "runs.zarr",
+    scheduler: Annotated[
+        str,
+        typer.Option(
+            "--scheduler",
+            metavar="ADDRESS",
+            help="local (a Dask cluster on this machine), none (in this process) or the "
+            "address of a running scheduler, tcp://HOST:PORT.",
+        ),
+    ] = "local",
+    workers: Annotated[
+        int | None, typer.Option("--workers", help="Workers of the local cluster (default: cores).")
+    ] = None,
+    spectra: Annotated[
+        bool, typer.Option("--spectra", help="Store intensity and spectral flux too.")
+    ] = False,
+    append: Annotated[
+        bool, typer.Option("--append", help="Add the cases after those of an existing store.")
+    ] = False,
+    force: Annotated[bool, typer.Option("--force", help="Replace an existing store.")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")] = False,
+) -> None:
+    """Run many variants of a scenario (grids and seeded random draws of any of its fields)
+    on a Dask cluster and store every case's light curves in one Zarr store with a `case`
+    dimension (docs/sweep.md). Every case is validated before any runs. Rerunning the same
+    command resumes an interrupted sweep (done cases are skipped, failed ones retried); a
+    failed case is recorded in error(case) and the others go on.
+
+    Example: speclight sweep docs/examples/sweep-calsphere.yaml -o runs.zarr --workers 2
+    """
+
+    def run() -> None:
+        import dataclasses
+
+        from speclight.scale.sweep_cases import plan_sweep
+        from speclight.scale.sweep_file import load_sweep
+        from speclight.scale.sweep_run import run_sweep
+
+        if workers is not None and workers < 1:
+            raise InputError(f"--workers = {workers} must be >= 1", field="--workers")
+        spec = load_sweep(sweep_file)
+        if spectra and not spec.spectra:
+            spec = dataclasses.replace(spec, spectra=True)
+        plan = plan_sweep(spec)
+        result = run_sweep(
+            plan,
+            output,
+            scheduler=scheduler,
+            n_workers=workers,
+            force=force,
+            append=append,
+            progress=sys.stderr.isatty() and not quiet,
+            announce=not quiet,
+        )
+        _raise_if_signalled()
+        if quiet:
+            return
+        last = result.first_case + result.n_cases - 1
+        typer.echo(
+            f"cases {result.first_case}..{last}: ran {result.ran}, skipped {result.skipped} "
+            f"done before, in {result.seconds:.1f} s"
+        )
+        if result.failed:
+            index, message = next(iter(result.failed.items()))
+            typer.echo(
+                f"{len(result.failed)} case(s) failed (case {index}: {message}); their rows "
+                "are NaN and error(case) holds the message: rerun the same command to retry them"
+            )
+        typer.echo(f"wrote {output}")
+
+    _guarded(run)
+
+
+@app.command()
 def info() -> None:
     """Versions of speclight and its engines, render variants, and data coverage."""
 

@@ -1,0 +1,208 @@
+"""Run a sweep: every case through the ``simulate`` pipeline on the executor, into the store.
+
+Each case is one task (:func:`run_case`): it receives the case's scenario as text (plain,
+picklable data), runs the normal pipeline where the executor puts it, and returns its light
+curves as numpy arrays; the calling process alone writes them into ``RUNS.zarr`` as they
+finish (:mod:`.sweep_store`). Mitsuba scenes are built inside the task. What does not change
+from case to case is kept per worker: the geometry (orbit, observer, Sun, attitude) of a
+sweep that varies neither ``time``, ``observer``, ``orbit`` nor ``attitude`` is computed once
+per worker (:func:`~speclight.scale.worker_cached`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import os
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from speclight.errors import InputError
+from speclight.scale import sweep_store as store
+from speclight.scale.executor import open_executor
+from speclight.scale.sweep_cases import CaseTask, SweepPlan
+from speclight.scale.worker_cache import worker_cached
+from speclight.scenario import LoadedScenario, parse_scenario
+
+#: Scenario sections the geometry stage reads (``simulate.geometry_stage``).
+GEOMETRY_SECTIONS = {"time", "observer", "orbit", "attitude"}
+
+Task = Callable[[CaseTask], dict[str, np.ndarray]]
+
+
+@dataclass
+class SweepRun:
+    """What a :func:`run_sweep` call did."""
+
+    path: Path
+    n_cases: int
+    first_case: int
+    ran: int = 0
+    skipped: int = 0
+    failed: dict[int, str] = field(default_factory=dict)
+    complete: bool = False
+    seconds: float = 0.0
+    where: str = ""
+
+
+def _geometry_key(loaded: LoadedScenario) -> str:
+    sc = loaded.scenario
+    parts = [sc.model_dump_json(include=GEOMETRY_SECTIONS), str(loaded.base_dir)]
+    for name in ("tle_file", "cpf_file", "ephemeris_file"):
+        value = getattr(sc.orbit, name)
+        if value:  # a file edited between two sweeps on a long-lived worker is read again
+            try:
+                st = os.stat(loaded.resolve(value))
+                parts.append(f"{st.st_mtime_ns}:{st.st_size}")
+            except OSError:
+                pass
+    return "sweep-geometry:" + hashlib.sha256("\n".join(parts).encode()).hexdigest()
+
+
+def run_case(task: CaseTask) -> dict[str, np.ndarray]:
+    """One case through the pipeline: ``count_rate``, ``ab_magnitude`` (and
+    ``count_rate_measured`` with noise; ``intensity``, ``spectral_flux`` with spectra)."""
+    from speclight.simulate import simulate
+    from speclight.simulate.geometry_stage import scenario_geometry
+
+    loaded = parse_scenario(task.yaml_text, source=task.source, base_dir=Path(task.base_dir))
+    try:
+        geometry = worker_cached(_geometry_key(loaded), lambda: scenario_geometry(loaded))
+    except InputError as exc:  # as simulate reports it: with the case's source
+        raise InputError(exc.message, source=exc.source or task.source, field=exc.field) from None
+    ds = simulate(loaded, geometry=geometry).dataset
+    out = {name: np.asarray(ds[name].values) for name in store.CURVES if name in ds}
+    if task.spectra:
+        out.update({name: ds[name].values.astype(np.float32) for name in store.SPECTRA})
+    return out
+
+
+@contextmanager
+def lean_local_workers() -> Iterator[None]:
+    """Start local Dask workers without two defaults that slow a sweep's cases down.
+
+    * ``MALLOC_TRIM_THRESHOLD_=65536``, which Dask's nannies set so that workers hand freed
+      memory back to the system: setting it switches off glibc's adaptive mmap threshold,
+      so every large array of a case (the render batch: hundreds of MB) is mapped and
+      page-faulted anew (+60 % CPU per calsphere case); a worker runs one case at a time
+      and reuses that memory for the next. ``None`` unsets it (``distributed.nanny``).
+    * the workers' statistical profiler (a stack sample of every thread every 10 ms, for the
+      dashboard's profile page): +25 % CPU per case.
+
+    Measured: BENCHMARKS.md, "Sweep". Workers of an existing cluster keep their own settings
+    (docs/sweep.md says how to start them).
+    """
+    try:
+        import dask
+        import distributed  # noqa: F401 - its configuration first: set() below must not hide it
+    except ImportError:  # pragma: no cover - a dependency of speclight
+        yield
+        return
+    lean = {
+        "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+        "distributed.worker.profile.enabled": False,
+    }
+    with dask.config.set(lean):
+        yield
+
+
+def _check_shapes(result: dict[str, np.ndarray], plan: SweepPlan) -> None:
+    nt, nb = plan.time_utc.size, len(plan.band_names)
+    for name, values in result.items():
+        want = (nt, plan.wavelength_nm.size) if name in store.SPECTRA else (nt, nb)
+        if values.shape != want:
+            raise ValueError(f"{name} has shape {values.shape}, the store {want}")
+
+
+def run_sweep(
+    plan: SweepPlan,
+    output: str | os.PathLike[str],
+    *,
+    scheduler: str | None = "local",
+    n_workers: int | None = None,
+    force: bool = False,
+    append: bool = False,
+    progress: bool = False,
+    announce: bool = False,
+    task: Task = run_case,
+) -> SweepRun:
+    """Run the plan's cases into the store ``output`` (created, resumed or appended to).
+
+    Parameters
+    ----------
+    plan
+        The validated cases (:func:`~speclight.scale.sweep_cases.plan_sweep`).
+    output
+        The Zarr store (a folder). A store holding these cases is resumed: cases done are
+        skipped, failed ones run again.
+    scheduler, n_workers
+        Where the cases run (:func:`~speclight.scale.open_executor`).
+    force
+        Replace an existing store.
+    append
+        Add the cases after those of an existing store of the same fields and axes.
+    progress, announce
+        Progress bar over cases on a terminal; one line on where the work runs.
+    task
+        The function run per case (tests count its calls).
+
+    Returns
+    -------
+    SweepRun
+        Counts, failed cases (store index -> message), whether every case has run.
+    """
+    inputs = {"sweep file": Path(plan.spec.source)}
+    if plan.base.source and Path(plan.base.source).exists():
+        inputs["base scenario"] = Path(plan.base.source)
+    path = store.check_store_path(output, inputs)
+    from speclight.estimate.reflectivity_map_store import store_lock
+
+    started = time.perf_counter()
+    with store_lock(path):
+        group, start, _ = store.open_store(path, plan, force=force, append=append)
+        run = SweepRun(path, len(plan.tasks), start)
+        state = store.states(group)[start : start + len(plan.tasks)]
+        todo = [
+            dataclasses.replace(t, index=start + t.index)
+            for t in plan.tasks
+            if state[t.index] != store.DONE
+        ]
+        run.skipped = len(plan.tasks) - len(todo)
+        failed_before = {start + int(i) for i in np.flatnonzero(state == store.FAILED)}
+        writer = store.CaseWriter(group, failed_before)
+        try:
+            if todo:
+                with (
+                    lean_local_workers(),
+                    open_executor(scheduler, n_workers=n_workers, announce=announce) as ex,
+                ):
+                    run.where = ex.description
+                    for outcome in ex.run(task, todo, label="cases", progress=progress):
+                        _write(writer, plan, outcome, run)
+        finally:
+            writer.flush()
+            run.complete = store.finish(path, group)
+        errors = store.errors(group, start, start + len(plan.tasks))
+        run.failed = {i: e for i, e in errors.items()}
+    run.seconds = time.perf_counter() - started
+    return run
+
+
+def _write(writer: store.CaseWriter, plan: SweepPlan, outcome: Any, run: SweepRun) -> None:
+    index = outcome.item.index
+    run.ran += 1
+    if outcome.error is None:
+        try:
+            _check_shapes(outcome.result, plan)
+        except ValueError as exc:
+            writer.failed(index, f"ValueError: {exc}")
+            return
+        writer.done(index, outcome.result)
+    else:
+        writer.failed(index, outcome.error)
