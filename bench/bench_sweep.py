@@ -39,7 +39,7 @@ import xarray as xr  # noqa: E402
 from speclight.scale import open_executor  # noqa: E402
 from speclight.scale.sweep_cases import plan_sweep  # noqa: E402
 from speclight.scale.sweep_file import load_sweep  # noqa: E402
-from speclight.scale.sweep_run import lean_local_workers, run_sweep  # noqa: E402
+from speclight.scale.sweep_run import run_sweep  # noqa: E402
 
 SWEEP = """base: calsphere
 set: {{render.resolution_px: {px}}}
@@ -91,7 +91,7 @@ def main() -> None:
         )
 
         t = time.perf_counter()
-        with lean_local_workers(), open_executor("local", n_workers=args.workers) as ex:
+        with open_executor("local", n_workers=args.workers) as ex:
             address = ex.client.scheduler.address
             started = time.perf_counter() - t
             t = time.perf_counter()

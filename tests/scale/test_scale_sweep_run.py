@@ -24,7 +24,7 @@ from speclight.errors import InputError
 from speclight.scale import open_executor, worker_cache
 from speclight.scale.sweep_cases import plan_sweep
 from speclight.scale.sweep_file import load_sweep
-from speclight.scale.sweep_run import lean_local_workers, run_case, run_sweep
+from speclight.scale.sweep_run import run_case, run_sweep
 from speclight.scenario import parse_scenario
 from speclight.simulate import simulate
 
@@ -56,7 +56,7 @@ ORBIT_FROM_FILE = "  orbit: {tle_file: cs.tle}\n"  # set: the base's tle replace
 
 @pytest.fixture(scope="module")
 def cluster():
-    with lean_local_workers(), open_executor("local", n_workers=2) as ex:
+    with open_executor("local", n_workers=2) as ex:
         yield ex.client.scheduler.address
 
 

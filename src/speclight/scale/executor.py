@@ -146,7 +146,7 @@ def open_executor(
         cores = os.cpu_count() or 1
         workers = max(1, int(n_workers or cores))
         threads = max(1, cores // workers)
-        with _glibc_malloc_defaults():
+        with _lean_worker_defaults():
             cluster = LocalCluster(
                 n_workers=workers,
                 threads_per_worker=1,
@@ -185,15 +185,20 @@ def open_executor(
 
 
 @contextmanager
-def _glibc_malloc_defaults() -> Iterator[None]:
-    """Start local workers without Dask's ``MALLOC_TRIM_THRESHOLD_``.
+def _lean_worker_defaults() -> Iterator[None]:
+    """Start local workers without two Dask defaults that slow speclight's tasks down.
 
-    Dask's nanny sets ``MALLOC_TRIM_THRESHOLD_=65536`` in each worker's environment (and in
-    this process's, to spawn it). Setting it turns off glibc's dynamic mmap threshold: every
-    array over 128 KiB is then mapped and unmapped anew, and a render chunk, which makes
-    many, ran 2.1 times slower in a worker than in this process (BENCHMARKS.md,
-    reflectivity maps). Workers keep glibc's defaults instead; a value this process had
-    before any cluster is kept.
+    * ``MALLOC_TRIM_THRESHOLD_=65536``, which Dask's nanny sets in each worker's environment
+      (and in this process's, to spawn it). Setting it turns off glibc's dynamic mmap
+      threshold: every array over 128 KiB is then mapped and page-faulted anew, and a render
+      chunk, which makes many, ran 2.1 times slower in a worker than in this process
+      (BENCHMARKS.md, reflectivity maps; +60 % CPU per sweep case). Workers keep glibc's
+      defaults instead; a value this process had before any cluster is kept.
+    * the workers' statistical profiler (a stack sample of every thread every 10 ms, for the
+      dashboard's profile page): +25 % CPU per sweep case (BENCHMARKS.md, "Sweep").
+
+    Workers of an existing cluster keep their own settings (docs/scale-out.md says how to
+    start them the same way).
     """
     import dask
 
@@ -201,7 +206,7 @@ def _glibc_malloc_defaults() -> Iterator[None]:
     dask_value = dask.config.get(key, default=None)
     if dask_value is not None and os.environ.get(MALLOC_TRIM_ENV) == str(dask_value):
         os.environ.pop(MALLOC_TRIM_ENV)  # left by an earlier cluster of this process
-    with dask.config.set({key: None}):
+    with dask.config.set({key: None, "distributed.worker.profile.enabled": False}):
         yield
 
 

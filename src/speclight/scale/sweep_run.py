@@ -15,8 +15,7 @@ import dataclasses
 import hashlib
 import os
 import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -81,35 +80,6 @@ def run_case(task: CaseTask) -> dict[str, np.ndarray]:
     if task.spectra:
         out.update({name: ds[name].values.astype(np.float32) for name in store.SPECTRA})
     return out
-
-
-@contextmanager
-def lean_local_workers() -> Iterator[None]:
-    """Start local Dask workers without two defaults that slow a sweep's cases down.
-
-    * ``MALLOC_TRIM_THRESHOLD_=65536``, which Dask's nannies set so that workers hand freed
-      memory back to the system: setting it switches off glibc's adaptive mmap threshold,
-      so every large array of a case (the render batch: hundreds of MB) is mapped and
-      page-faulted anew (+60 % CPU per calsphere case); a worker runs one case at a time
-      and reuses that memory for the next. ``None`` unsets it (``distributed.nanny``).
-    * the workers' statistical profiler (a stack sample of every thread every 10 ms, for the
-      dashboard's profile page): +25 % CPU per case.
-
-    Measured: BENCHMARKS.md, "Sweep". Workers of an existing cluster keep their own settings
-    (docs/sweep.md says how to start them).
-    """
-    try:
-        import dask
-        import distributed  # noqa: F401 - its configuration first: set() below must not hide it
-    except ImportError:  # pragma: no cover - a dependency of speclight
-        yield
-        return
-    lean = {
-        "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
-        "distributed.worker.profile.enabled": False,
-    }
-    with dask.config.set(lean):
-        yield
 
 
 def _check_shapes(result: dict[str, np.ndarray], plan: SweepPlan) -> None:
@@ -178,10 +148,7 @@ def run_sweep(
         writer = store.CaseWriter(group, failed_before)
         try:
             if todo:
-                with (
-                    lean_local_workers(),
-                    open_executor(scheduler, n_workers=n_workers, announce=announce) as ex,
-                ):
+                with open_executor(scheduler, n_workers=n_workers, announce=announce) as ex:
                     run.where = ex.description
                     for outcome in ex.run(task, todo, label="cases", progress=progress):
                         _write(writer, plan, outcome, run)
