@@ -234,9 +234,7 @@ def test_xml_equals_kvn_and_truth(tmp_path: Path) -> None:
 
 
 def test_segments_gap_and_useable_span(tmp_path: Path) -> None:
-    first = kvn_segment(
-        "GCRF", "UTC", _epochs(0, 20, 60), USEABLE_START_TIME="2019-08-30T02:05:00"
-    )
+    first = kvn_segment("GCRF", "UTC", _epochs(0, 20, 60), USEABLE_START_TIME="2019-08-30T02:05:00")
     second = kvn_segment("ITRF2014", "GPS", _epochs(30, 50, 60))
     oem = read_oem(_write(tmp_path, kvn(first, second)))
     assert len(oem.segments) == 2
@@ -310,7 +308,7 @@ def test_object_choice(tmp_path: Path) -> None:
         "1964-063E", "1965-034C"
     )
     path = _write(tmp_path, kvn(a, b))
-    with pytest.raises(InputError, match="several objects .*CALSPHERE 2, LCS 1.*orbit.object"):
+    with pytest.raises(InputError, match=r"several objects .*CALSPHERE 2, LCS 1.*orbit.object"):
         read_oem(path)
     with pytest.raises(InputError, match="did you mean 'CALSPHERE 2'"):
         read_oem(path, "CALSPHERE2")

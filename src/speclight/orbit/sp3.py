@@ -136,7 +136,8 @@ def read_sp3(path: str | Path, satellite: str | None = None) -> Sp3:
     for lineno, line in enumerate(lines[2:], start=3):
         tag = line[:2]
         if tag == "+ ":
-            listed += [normalise_id(line[i : i + 3]) for i in range(9, min(len(line), 60), 3)]
+            ids = (line[i : i + 3] for i in range(9, min(len(line), 60), 3))
+            listed += [normalise_id(x) for x in ids if x.strip(" 0")]  # "  0" pads the list
         elif tag == "%c" and not seen_c:
             seen_c = True
             code = line[9:12].strip().upper()
