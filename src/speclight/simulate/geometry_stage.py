@@ -247,9 +247,9 @@ def scenario_geometry(
         flags[(geo.sunlit_fraction > 0.0) & (geo.sunlit_fraction < 1.0)] |= v.FLAG_PENUMBRA
     if not np.any(ok):
         raise InputError(
-            "the orbit gives no valid position in the time window: outside the CPF/ephemeris "
-            "span, inside a gap of the table or around its unusable records, or SGP4 failed "
-            "at every epoch",
+            "the orbit gives no valid position in the time window: outside the span of the "
+            "CPF, ephemeris, OEM or SP3 file, inside a gap of the table or around its unusable "
+            "records, or SGP4 failed at every epoch",
             source=loaded.source,
             field="time",
         )
