@@ -313,3 +313,26 @@ def test_object_choice(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="did you mean 'CALSPHERE 2'"):
         read_oem(path, "CALSPHERE2")
     assert read_oem(path, "lcs 1").object_id == "1965-034C"
+
+
+def test_epoch_numpy_cannot_hold_names_its_line(tmp_path: Path) -> None:
+    lines = kvn(kvn_segment("GCRF", "UTC", _epochs(0, 50, 60))).split("\n")
+    i = next(i for i, ln in enumerate(lines) if ln.startswith("2019-08-30T02:03"))
+    lines[i] = "3019" + lines[i][4:]  # numpy's nanosecond times would wrap around
+    with pytest.raises(InputError, match=rf"line {i + 1}: .*outside 1678-2262"):
+        read_oem(_write(tmp_path, "\n".join(lines)))
+
+
+@pytest.mark.parametrize(
+    ("orbit", "message"),
+    [
+        ({"oem_file": "a.oem", "sp3_file": "b.sp3"}, "exactly one of .*found oem_file, sp3_file"),
+        ({"tle_file": "a.tle", "object": "X"}, "object selects an object of oem_file"),
+        ({"oem_file": "a.oem", "satellite": "G01"}, "satellite selects a satellite of sp3_file"),
+    ],
+)
+def test_scenario_orbit_keys(orbit: dict, message: str) -> None:
+    d = yaml.safe_load(example_text("box-wing"))
+    d["orbit"] = orbit
+    with pytest.raises(InputError, match=message):
+        parse_scenario(yaml.safe_dump(d), source="s")

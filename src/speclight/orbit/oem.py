@@ -38,7 +38,13 @@ from speclight.errors import InputError, did_you_mean
 from speclight.input_files import read_user_text
 from speclight.orbit.frames import EarthOrientation, TimeLike
 from speclight.orbit.oem_xml import RawSegment, parse_oem_xml
-from speclight.orbit.state_table import Segment, frame_kind, segments_position_gcrs_m, tai_julian
+from speclight.orbit.state_table import (
+    Segment,
+    as_ns,
+    frame_kind,
+    segments_position_gcrs_m,
+    tai_julian,
+)
 
 FIELD = "orbit.oem_file"
 TIME_SYSTEMS = ("UTC", "TAI", "TT", "GPS")
@@ -79,19 +85,18 @@ def parse_epoch(text: str) -> np.datetime64:
     if s.upper().endswith("Z"):
         s = s[:-1]
     m = _DOY.match(s)
-    if m:
-        base = np.datetime64(f"{m.group(1)}-01-01T{m.group(3)[:18]}", "ns")
-        day = int(m.group(2))
-        if not 1 <= day <= 366:
-            raise ValueError(f"day of year {day} is not 1-366")
-        return base + np.timedelta64(day - 1, "D")
     if "." in s:  # numpy keeps at most nanoseconds
         head, _, frac = s.partition(".")
         s = f"{head}.{frac[:9]}"
-    t = np.datetime64(s, "ns")
-    if np.isnat(t) or "T" not in s:
+    if m:
+        day = int(m.group(2))
+        if not 1 <= day <= 366:
+            raise ValueError(f"day of year {day} is not 1-366")
+        base = as_ns(np.datetime64(f"{m.group(1)}-01-01T{s.partition('T')[2]}"))
+        return base + np.timedelta64(day - 1, "D")
+    if "T" not in s:
         raise ValueError("not a time")
-    return t
+    return as_ns(np.datetime64(s))
 
 
 def read_oem(path: str | Path, object_name: str | None = None) -> Oem:

@@ -36,7 +36,7 @@ import numpy as np
 from speclight.errors import InputError, did_you_mean
 from speclight.input_files import read_user_text
 from speclight.orbit.frames import EarthOrientation, TimeLike
-from speclight.orbit.state_table import Segment, segments_position_gcrs_m, tai_julian
+from speclight.orbit.state_table import Segment, as_ns, segments_position_gcrs_m, tai_julian
 
 FIELD = "orbit.sp3_file"
 #: SP3 time-system codes -> the scale of :func:`~speclight.orbit.state_table.tai_julian`
@@ -153,8 +153,8 @@ def read_sp3(path: str | Path, satellite: str | None = None) -> Sp3:
             try:
                 y, mo, d, h, mi = (int(v) for v in line[1:].split()[:5])
                 sec = float(line[1:].split()[5])
-                epoch = np.datetime64(f"{y:04d}-{mo:02d}-{d:02d}T{h:02d}:{mi:02d}", "ns")
-                epoch += np.timedelta64(round(sec * 1e9), "ns")
+                day = as_ns(np.datetime64(f"{y:04d}-{mo:02d}-{d:02d}T{h:02d}:{mi:02d}"))
+                epoch = day + np.timedelta64(round(sec * 1e9), "ns")
             except (ValueError, IndexError):
                 raise _err(
                     p, lineno, line, "not an epoch line '*  YYYY MM DD hh mm ss.ssss'"

@@ -44,6 +44,17 @@ INERTIAL_FRAMES = ("GCRF", "ICRF")
 EME2000_FRAMES = ("EME2000", "J2000")
 TEME_FRAMES = ("TEME",)
 J2000_EPOCH = np.datetime64("2000-01-01T12:00:00", "ns")
+#: Span of ``datetime64[ns]``; numpy wraps times beyond it around silently.
+TIME_RANGE = (np.datetime64("1678-01-01T00:00:00", "s"), np.datetime64("2262-01-01T00:00:00", "s"))
+
+
+def as_ns(t: np.datetime64) -> np.datetime64:
+    """A parsed time as ``datetime64[ns]``; ValueError outside 1678-2262 (numpy would wrap)."""
+    if np.isnat(t):
+        raise ValueError("not a time")
+    if not TIME_RANGE[0] <= t < TIME_RANGE[1]:
+        raise ValueError("the time is outside 1678-2262")
+    return t.astype("datetime64[ns]")
 
 
 def frame_kind(name: str) -> str | None:
