@@ -196,3 +196,50 @@ def test_pipeline_geometry_from_sp3_equals_tle(tmp_path: Path) -> None:
     assert np.abs(geo.range_m - geo_tle.range_m).max() < TOL_M
     assert np.abs(geo.elevation_deg - geo_tle.elevation_deg).max() < 1e-7  # 1 cm at 20,000 km
     np.testing.assert_array_equal(geo.flags, geo_tle.flags)
+
+
+#: The first example file of the SP3-d specification (Hilla 2016; simulated positions from
+#: broadcast ephemerides, 140 satellites of 6 systems), first two epochs and a few vehicles.
+SP3D_SPEC_EXAMPLE = """\
+#dP2013  4  3  0  0  0.00000000       3 ORBIT WGS84 BCT MGEX
+## 1734 259200.00000000   900.00000000 56385 0.0000000000000
++  140   G01G02G03G04G05G06G07G08G09G10G11G12G13G14G15G16G17
++        G18G19G20G21G22G23G24G25G26G27G28G29G30G31G32R01R02
++        R03R04R05R06R07R08R09R10R11R12R13R14R15R16R17R18R19
++        R20R21R22R23R24E01E02E03E04E05E06E07E08E09E10E11E12
++        E13E14E15E16E17E18E19E20E21E22E23E24E25E26E27E28E29
++        E30C01C02C03C04C05C06C07C08C09C10C11C12C13C14C15C16
++        C17C18C19C20C21C22C23C24C25C26C27C28C29C30C31C32C33
++        C34C35J01J02J03I01I02I03I04I05I06I07S20S24S27S28S29
++        S33S35S37S38  0  0  0  0  0  0  0  0  0  0  0  0  0
+++         0  0  0  0  0  0  0  0  0  0  0  0  0  0  0  0  0
+%c M  cc GPS ccc cccc cccc cccc cccc ccccc ccccc ccccc ccccc
+%c cc cc ccc ccc cccc cccc cccc cccc ccccc ccccc ccccc ccccc
+%f  1.2500000  1.025000000  0.00000000000  0.000000000000000
+%i    0    0    0    0      0      0      0      0         0
+/* Note: This is a simulated file, meant to illustrate what an SP3-d header
+*  2013  4  3  0  0  0.00000000
+PG01   5783.206741 -18133.044484 -18510.756016     12.734450
+PG02 -22412.401440  13712.162332    528.367722    425.364822
+PS28   5169.591020  41849.037979     17.421140      0.170452
+*  2013  4  3  0 15  0.00000000
+PG01      0.00000       0.000000      0.000000      0.000000
+PG02 -22399.401440  13799.162332   1599.367722    425.400822
+EOF
+"""
+
+
+def test_specification_example(tmp_path: Path) -> None:
+    path = _write(tmp_path, SP3D_SPEC_EXAMPLE, "spec.sp3")
+    with pytest.raises(InputError, match=r"140 satellites \(G01, G02, .*, ...\)"):
+        read_sp3(path)
+    with pytest.raises(InputError, match="G01: 1 good position records of 2"):
+        read_sp3(path, "G01")  # the 00:15 record is the format's "bad or absent" zero
+    sp3 = read_sp3(path, "G02")
+    assert (sp3.coordinate_system, sp3.time_system, sp3.interval_s) == ("WGS84", "GPS", 900.0)
+    # 2013-04-03 00:00 GPS is 2013-04-02 23:59:44 UTC (TAI - UTC = 35 s in 2013)
+    t = time_from_utc(np.array(["2013-04-02T23:59:44"], dtype="datetime64[ns]"))
+    r_gcrs, ok = sp3_position_gcrs_m(sp3, t)
+    r_itrs_km = itrs.rotation_at(t)[:, :, 0] @ r_gcrs[0] / 1e3
+    assert ok.all()
+    np.testing.assert_allclose(r_itrs_km, [-22412.401440, 13712.162332, 528.367722], atol=1e-9)
