@@ -336,3 +336,14 @@ def test_scenario_orbit_keys(orbit: dict, message: str) -> None:
     d["orbit"] = orbit
     with pytest.raises(InputError, match=message):
         parse_scenario(yaml.safe_dump(d), source="s")
+
+
+def test_missing_or_foreign_file(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="orbit.oem_file: cannot read OEM file: no such file"):
+        read_oem(tmp_path / "none.oem")
+    with pytest.raises(InputError, match="no CCSDS_OEM_VERS line"):
+        read_oem(_write(tmp_path, "META_START\nOBJECT_NAME = X\nMETA_STOP\n"))
+    with pytest.raises(InputError, match="root element is <ndm>, not <oem>"):
+        read_oem(_write(tmp_path, "<ndm><oem/></ndm>", "n.xml"))
+    with pytest.raises(InputError, match="DOCTYPE"):
+        read_oem(_write(tmp_path, '<!DOCTYPE oem [<!ENTITY a "b">]><oem/>', "d.xml"))
