@@ -339,7 +339,7 @@ def test_scenario_orbit_keys(orbit: dict, message: str) -> None:
 
 
 def test_missing_or_foreign_file(tmp_path: Path) -> None:
-    with pytest.raises(InputError, match="orbit.oem_file: cannot read OEM file: no such file"):
+    with pytest.raises(InputError, match=r"orbit\.oem_file: cannot read OEM file: no such file"):
         read_oem(tmp_path / "none.oem")
     with pytest.raises(InputError, match="no CCSDS_OEM_VERS line"):
         read_oem(_write(tmp_path, "META_START\nOBJECT_NAME = X\nMETA_STOP\n"))
