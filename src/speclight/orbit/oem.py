@@ -37,6 +37,7 @@ import numpy as np
 from speclight.errors import InputError, did_you_mean
 from speclight.input_files import read_user_text
 from speclight.orbit.frames import EarthOrientation, TimeLike
+from speclight.orbit.oem_kvn import parse_oem_kvn
 from speclight.orbit.oem_xml import RawSegment, parse_oem_xml
 from speclight.orbit.state_table import (
     Segment,
@@ -122,7 +123,7 @@ def read_oem(path: str | Path, object_name: str | None = None) -> Oem:
     if text.lstrip().startswith("<"):
         version, raw = parse_oem_xml(text, p)
     else:
-        version, raw = _parse_kvn(text, p)
+        version, raw = parse_oem_kvn(text, p)
     if not raw:
         raise InputError("no segment (META_START .. META_STOP and data lines)", source=p)
     names = [(r.meta.get("OBJECT_NAME", ""), r.meta.get("OBJECT_ID", "")) for r in raw]
@@ -153,55 +154,6 @@ def read_oem(path: str | Path, object_name: str | None = None) -> Oem:
         segments=segments,
         metadata=[r.meta for r in raw],
     )
-
-
-def _parse_kvn(text: str, p: str) -> tuple[str, list[RawSegment]]:
-    version = ""
-    raw: list[RawSegment] = []
-    meta: dict[str, str] | None = None
-    meta_line = ""
-    rows: list[tuple[str, list[str]]] = []
-    in_cov = False
-    for lineno, line in enumerate(text.splitlines(), start=1):
-        s = line.strip()
-        if not s or s.startswith("COMMENT"):
-            continue
-        if in_cov:
-            in_cov = s != "COVARIANCE_STOP"
-            continue
-        if s == "COVARIANCE_START":
-            in_cov = True
-        elif s == "META_START":
-            if meta is not None and meta_line:
-                raw.append(RawSegment(meta, meta_line, rows))
-            meta, meta_line, rows = {}, f"line {lineno}", []
-        elif s == "META_STOP":
-            if meta is None:
-                raise _line_error(p, lineno, s, "META_STOP without META_START")
-        elif "=" in s and (meta is None or not rows):
-            key, _, value = s.partition("=")
-            key = key.strip().upper()
-            if key == "CCSDS_OEM_VERS":
-                version = value.strip()
-            elif meta is not None:
-                meta[key] = value.strip()
-        else:
-            if meta is None:
-                raise _line_error(p, lineno, s, "a data line before any META_START block")
-            rows.append((f"line {lineno}", s.split()))
-    if in_cov:
-        raise InputError("COVARIANCE_START without COVARIANCE_STOP", source=p)
-    if meta is not None:
-        raw.append(RawSegment(meta, meta_line, rows))
-    if not version:
-        raise InputError(
-            "no CCSDS_OEM_VERS line: not a CCSDS OEM (KVN) file", source=p, field="CCSDS_OEM_VERS"
-        )
-    return version, raw
-
-
-def _line_error(p: str, lineno: int, line: str, what: str) -> InputError:
-    return InputError(f"line {lineno}: {what}: {line[:80]!r}", source=p)
 
 
 def _segment(raw: RawSegment, p: str) -> Segment:
