@@ -20,10 +20,10 @@ Interpolation: the segment's ``INTERPOLATION`` (``HERMITE``, ``LAGRANGE`` or ``L
 Lagrange of degree ``d`` uses ``d + 1`` nodes. Without the keys: Hermite of degree 5
 (3 nodes). Measured in ``tests/orbit/test_orbit_oem.py`` at 60 s sampling of a 1,000 km
 orbit: < 1 mm for exact states; 0.2 m for a file of SGP4 states, whose velocities differ
-from the derivative of its positions by ~1 cm/s (Lagrange of degree 7 there: < 1 mm). Each epoch is taken from the
-first segment whose usable span (``USEABLE_START_TIME`` .. ``USEABLE_STOP_TIME``, else
-``START_TIME`` .. ``STOP_TIME``, and inside its data) covers it; other epochs are orbit
-failures, never extrapolated.
+from the derivative of its positions by ~1 cm/s (Lagrange of degree 7 there: < 1 mm).
+Each epoch is taken from the first segment whose usable span (``USEABLE_START_TIME`` ..
+``USEABLE_STOP_TIME``, else ``START_TIME`` .. ``STOP_TIME``, and inside its data) covers it;
+other epochs are orbit failures, never extrapolated.
 """
 
 from __future__ import annotations
