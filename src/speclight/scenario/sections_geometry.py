@@ -133,17 +133,26 @@ class Orbit(Strict):
     norad_id: int | None = Field(default=None, ge=1, description="Catalogue number in tle_file")
     cpf_file: str | None = Field(default=None, description="ILRS CPF prediction (v1 or v2)")
     ephemeris_file: str | None = Field(default=None, description="CSV: time_utc, x, y, z")
+    oem_file: str | None = Field(default=None, description="CCSDS OEM, KVN or XML")
+    object: str | None = Field(default=None, description="OBJECT_NAME or OBJECT_ID in oem_file")
+    sp3_file: str | None = Field(default=None, description="IGS SP3-c or SP3-d precise orbit")
+    satellite: str | None = Field(default=None, description="Vehicle id in sp3_file, e.g. G01")
 
     @model_validator(mode="after")
     def _exactly_one(self) -> Orbit:
-        given = [k for k in ("tle", "tle_file", "cpf_file", "ephemeris_file") if getattr(self, k)]
+        sources = ("tle", "tle_file", "cpf_file", "ephemeris_file", "oem_file", "sp3_file")
+        given = [k for k in sources if getattr(self, k)]
         if len(given) != 1:
             raise ValueError(
-                "give exactly one of tle, tle_file, cpf_file, ephemeris_file "
+                f"give exactly one of {', '.join(sources)} "
                 f"(found {', '.join(given) if given else 'none'})"
             )
         if self.norad_id is not None and not self.tle_file:
             raise ValueError("norad_id selects a TLE from tle_file; it needs tle_file")
+        if self.object is not None and not self.oem_file:
+            raise ValueError("object selects an object of oem_file; it needs oem_file")
+        if self.satellite is not None and not self.sp3_file:
+            raise ValueError("satellite selects a satellite of sp3_file; it needs sp3_file")
         return self
 
 

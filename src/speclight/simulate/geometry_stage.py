@@ -14,6 +14,8 @@ from speclight import orbit
 from speclight import schema as v
 from speclight.constants import C_M_S
 from speclight.errors import InputError
+from speclight.orbit.oem import oem_position_gcrs_m, read_oem
+from speclight.orbit.sp3 import read_sp3, sp3_position_gcrs_m
 from speclight.orbit.staleness import warn_past_tables, warn_tle_age
 from speclight.orbit.timescale import time_from_utc
 from speclight.scenario import LoadedScenario
@@ -100,6 +102,12 @@ def _trajectory(loaded: LoadedScenario, time_utc: NDArray[np.datetime64]) -> Tra
     if cfg.cpf_file is not None:
         cpf = orbit.read_cpf(loaded.resolve(cfg.cpf_file))
         return lambda t: orbit.cpf_position_gcrs_m(cpf, t)
+    if cfg.oem_file is not None:
+        oem = read_oem(loaded.resolve(cfg.oem_file), cfg.object)
+        return lambda t: oem_position_gcrs_m(oem, t)
+    if cfg.sp3_file is not None:
+        sp3 = read_sp3(loaded.resolve(cfg.sp3_file), cfg.satellite)
+        return lambda t: sp3_position_gcrs_m(sp3, t)
     assert cfg.ephemeris_file is not None
     eph = orbit.read_ephemeris_csv(loaded.resolve(cfg.ephemeris_file))
     return lambda t: orbit.ephemeris_position_gcrs_m(eph, t)
@@ -239,9 +247,9 @@ def scenario_geometry(
         flags[(geo.sunlit_fraction > 0.0) & (geo.sunlit_fraction < 1.0)] |= v.FLAG_PENUMBRA
     if not np.any(ok):
         raise InputError(
-            "the orbit gives no valid position in the time window: outside the CPF/ephemeris "
-            "span, inside a gap of the table or around its unusable records, or SGP4 failed "
-            "at every epoch",
+            "the orbit gives no valid position in the time window: outside the span of the "
+            "CPF, ephemeris, OEM or SP3 file, inside a gap of the table or around its unusable "
+            "records, or SGP4 failed at every epoch",
             source=loaded.source,
             field="time",
         )
