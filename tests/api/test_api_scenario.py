@@ -59,10 +59,10 @@ def test_overrides_set_fields_and_leave_the_original_alone():
 @pytest.mark.parametrize(
     ("overrides", "expected"),
     [
-        ({"attitude.perod_s": 5}, "unknown key 'perod_s'; did you mean 'period_s'?"),
+        ({"attitude.perod_s": 5}, "no field 'perod_s' in attitude; did you mean 'period_s'?"),
         ({"attitude.period_s": -1}, "attitude.period_s = -1: Input should be greater than 0"),
-        ({"instrument.bands.99.name": "x"}, "is a list of 10 items: '99' is not one of"),
-        ({"time.step_s.x": 1}, "time.step_s is a value (1.0), not a section"),
+        ({"instrument.bands.99.name": "x"}, "list instrument.bands has 10 entries (indices 0..9)"),
+        ({"time.step_s.x": 1}, "time.step_s is a single value: it has no field 'x'"),
     ],
 )
 def test_bad_overrides_get_the_scenario_files_messages(overrides, expected):

@@ -23,10 +23,10 @@ from numpy.typing import NDArray
 from pydantic import ValidationError
 
 from speclight.errors import InputError, did_you_mean
-from speclight.scale.sweep_fields import Path_, set_field
 from speclight.scale.sweep_spec import Field, SweepSpec
 from speclight.scenario import LoadedScenario, Scenario, load_scenario, parse_scenario
 from speclight.scenario.builtin_examples import example_names, example_text
+from speclight.scenario.dotted_fields import Path_, set_field
 from speclight.scenario.engines import check_engines
 from speclight.simulate.geometry_stage import time_grid
 from speclight.simulate.memory import check_run_limits, grid_epochs

@@ -26,8 +26,8 @@ import yaml
 
 from speclight.errors import InputError, did_you_mean
 from speclight.input_files import read_user_text
-from speclight.scale.sweep_fields import field_problem, split_field
 from speclight.scale.sweep_spec import Axis, Distribution, Field, SweepSpec
+from speclight.scenario.dotted_fields import field_problem, split_field
 from speclight.scenario.load import _ScenarioLoader
 
 TOP_KEYS = ("base", "vary", "set", "draws", "seed", "spectra")

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from speclight.scale.sweep_fields import Path_
+from speclight.scenario.dotted_fields import Path_
 
 
 @dataclass(frozen=True)

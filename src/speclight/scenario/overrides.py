@@ -21,7 +21,8 @@ from typing import Any
 
 import yaml
 
-from speclight.errors import InputError, did_you_mean
+from speclight.errors import InputError
+from speclight.scenario.dotted_fields import field_problem, set_field, split_field
 from speclight.scenario.load import LoadedScenario, parse_scenario
 from speclight.scenario.scenario_model import Scenario
 
@@ -31,47 +32,22 @@ _LINE = re.compile(r"line \d+: ")
 def set_dotted(data: Any, name: str, value: Any) -> None:
     """Set ``name`` (dotted, list items by index) in plain scenario data, in place.
 
-    A missing last key is added (validation then says whether the field exists); a missing
-    key on the way is an error naming it, as is an index past a list's end or a path that
-    goes through a number or a text.
+    A name that is no field of the scenario model is an error with a did-you-mean (as a
+    misspelt key in a file); missing sections on the way are created (the validation then
+    says what else they need); an index past a list's end is an error.
     """
-    parts = name.split(".")
-    if not name or any(p == "" for p in parts):
+    path = split_field(name)
+    if not name or any(p == "" for p in path):
         raise InputError(
             f"'{name}' is not a dotted field name (e.g. attitude.period_s)", field=name
         )
-    node = data
-    for depth, part in enumerate(parts):
-        last = depth == len(parts) - 1
-        where = ".".join(parts[:depth]) or "(top level)"
-        if isinstance(node, list):
-            if not part.isdigit() or int(part) >= len(node):
-                raise InputError(
-                    f"{where} is a list of {len(node)} items: '{part}' is not one of its "
-                    f"indices (0..{len(node) - 1})",
-                    field=name,
-                )
-            if last:
-                node[int(part)] = value
-            else:
-                node = node[int(part)]
-        elif isinstance(node, dict):
-            if last:
-                node[part] = value
-            elif part not in node:
-                keys = [str(k) for k in node]
-                raise InputError(
-                    f"{where} has no '{part}'{did_you_mean(part, keys)} (it has: "
-                    f"{', '.join(keys) or 'nothing'}); set the whole section instead, e.g. "
-                    f"'{'.'.join(parts[: depth + 1])}': {{...}}",
-                    field=name,
-                )
-            else:
-                node = node[part]
-        else:
-            raise InputError(
-                f"{where} is a value ({node!r}), not a section: it has no '{part}'", field=name
-            )
+    problem = field_problem(path)
+    if problem is not None:
+        raise InputError(problem, field=name)
+    try:
+        set_field(data, path, value)
+    except ValueError as exc:
+        raise InputError(str(exc), field=name) from None
 
 
 def with_overrides(loaded: LoadedScenario, overrides: Mapping[str, Any]) -> LoadedScenario:

@@ -1,5 +1,5 @@
-"""Dotted scenario fields of a sweep: parse them, check them against the scenario model, set
-them in a scenario's data.
+"""Dotted scenario fields (``speclight.with_overrides``, sweep files): parse them, check them
+against the scenario model, set them in a scenario's data.
 
 ``instrument.bands.0.gaussian.center_nm`` is the path ``("instrument", "bands", 0,
 "gaussian", "center_nm")``: a number indexes a list; any other part names a field of a
