@@ -49,7 +49,8 @@ section 3.1) and a `comment` that names the system. `ab_magnitude` is at the ape
 moved to a range of 1000 km (`m - 5 log10(range / 1000 km)`, as SSA catalogues quote
 magnitudes; the phase angle is not normalised); `vega_v_magnitude` is the Vega magnitude in
 the Bessell V band (speclite's `bessell-V`): the AB magnitude in that band minus 0.02
-(Blanton & Roweis 2007, AJ 133, 734), so that Vega has V = 0.03. The files pass the
+(Blanton & Roweis 2007, AJ 133, 734; no Vega spectrum ships with the installed packages, so
+this published offset sets the zero point, good to about 0.02 mag). The files pass the
 compliance checker's CF-1.10 test without errors (`tests/io/test_io_cf_compliance.py`).
 """
 

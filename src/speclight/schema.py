@@ -38,9 +38,9 @@ AB_COMMENT = (
 #: The magnitude system of the Vega V magnitudes (for their ``comment``).
 VEGA_V_COMMENT = (
     "magnitude (logarithmic, units 1): the AB magnitude in speclite's bessell-V band minus "
-    "0.02, the AB - Vega offset of V (Blanton & Roweis 2007, AJ 133, 734, table 1); Vega "
-    "itself has V = 0.03 (Bessell 2005, ARA&A 43, 293); absent when the wavelength grid does "
-    "not cover the V band"
+    "0.02, the AB - Vega offset of V (Blanton & Roweis 2007, AJ 133, 734, table 1; V zero "
+    "points of different realisations differ by about 0.01-0.02 mag); absent when the "
+    "wavelength grid does not cover the V band"
 )
 
 V = VariableInfo

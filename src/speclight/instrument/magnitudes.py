@@ -10,8 +10,9 @@ over range squared); this module adds the two conventions SSA catalogues use:
 * the Vega magnitude in the Johnson-Cousins V band, Bessell's realisation (speclite's
   ``bessell-V``): the AB magnitude in that band minus ``V_AB - V_Vega = 0.02`` (Blanton &
   Roweis 2007, AJ 133, 734, table 1). No Vega spectrum ships with the installed packages, so
-  the zero point is this published offset rather than a synthetic Vega spectrum; with it Vega
-  itself (V = 0.03, Bessell 2005, ARA&A 43, 293) has V_AB = 0.05.
+  the zero point is this published offset rather than synthetic photometry of a Vega
+  spectrum (e.g. CALSPEC ``alpha_lyr_stis``); V zero points of different realisations
+  differ by about 0.01-0.02 mag (Bessell 2005, ARA&A 43, 293), which bounds its accuracy.
 """
 
 from __future__ import annotations
