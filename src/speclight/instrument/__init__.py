@@ -2,7 +2,8 @@
 
 Plain-array functions: :func:`aperture_area_m2`, :func:`spectral_flux_W_nm`,
 :func:`spectral_curve` (optics / QE), :func:`band_response`, :func:`count_rate_per_s`,
-:func:`ab_magnitude`, :func:`sky_count_rate_per_s`, :func:`simulate_measurement`.
+:func:`ab_magnitude`, :func:`standard_magnitude`, :func:`vega_v_magnitude`,
+:func:`sky_count_rate_per_s`, :func:`simulate_measurement`.
 """
 
 from speclight.instrument.bands import (
@@ -15,6 +16,12 @@ from speclight.instrument.bands import (
     table_band,
 )
 from speclight.instrument.curves import DETECTOR_PRESETS, load_preset, spectral_curve
+from speclight.instrument.magnitudes import (
+    STANDARD_RANGE_M,
+    V_AB_MINUS_VEGA,
+    standard_magnitude,
+    vega_v_magnitude,
+)
 from speclight.instrument.noise import simulate_measurement, sky_count_rate_per_s
 from speclight.instrument.photometry import (
     AB_ZERO_W_M2_HZ,
@@ -29,6 +36,8 @@ from speclight.wavelength_grid import bin_average, bin_edges_nm, bin_widths_nm
 __all__ = [
     "AB_ZERO_W_M2_HZ",
     "DETECTOR_PRESETS",
+    "STANDARD_RANGE_M",
+    "V_AB_MINUS_VEGA",
     "Band",
     "ab_magnitude",
     "ab_reference_W_m2_nm",
@@ -48,5 +57,7 @@ __all__ = [
     "speclite_filter_names",
     "spectral_curve",
     "spectral_flux_W_nm",
+    "standard_magnitude",
     "table_band",
+    "vega_v_magnitude",
 ]

@@ -23,8 +23,14 @@ def _encoding(ds: xr.Dataset) -> dict[str, dict[str, object]]:
     for name, var in ds.data_vars.items():
         if var.dtype.kind == "f" and var.ndim >= 2:
             enc[str(name)] = {"zlib": True, "complevel": 4, "shuffle": True}
+    # CF-1.10 section 2.5.1: coordinate variables must not have a _FillValue (they have no
+    # missing values); xarray gives every float variable one unless told not to. Boundary
+    # variables take their coordinate's rules (section 7.1).
+    for name in [*ds.coords, *(n for n in ds.data_vars if str(n).endswith("_bounds"))]:
+        if ds[name].dtype.kind in "fcM":
+            enc.setdefault(str(name), {})["_FillValue"] = None
     if "time" in ds.coords:
-        enc["time"] = {"units": "microseconds since 1970-01-01T00:00:00", "dtype": np.int64}
+        enc["time"].update(units="microseconds since 1970-01-01T00:00:00", dtype=np.int64)
     return enc
 
 

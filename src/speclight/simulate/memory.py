@@ -54,8 +54,9 @@ BYTES_PER_EPOCH_BIN = 21
 #: (N, L) arrays added by a target: intensity, intensity_std, spectral_flux, float64, each
 #: held twice (the stage's array and the dataset's, then the file) [bytes].
 BYTES_PER_RENDERED_EPOCH_BIN = 3 * 8 * 2
-#: (N, B) count_rate, count_rate_measured, ab_magnitude and their file copies [bytes].
-BYTES_PER_EPOCH_BAND = 3 * 8 * 2
+#: (N, B) count_rate, count_rate_measured, ab_magnitude, ab_magnitude_exo and
+#: ab_magnitude_standard, and their file copies [bytes].
+BYTES_PER_EPOCH_BAND = 5 * 8 * 2
 #: One primary ray of a single-mode batch with its hits, shadow rays and channel weights
 #: (measured: 1024 and 2048 px) [bytes].
 BYTES_PER_RAY = 341

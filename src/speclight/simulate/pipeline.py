@@ -12,7 +12,7 @@ from speclight import schema as v
 from speclight.errors import InputError
 from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
-from speclight.simulate.dataset import geometry_dataset, global_attributes
+from speclight.simulate.dataset import describe_run, geometry_dataset
 from speclight.simulate.geometry_stage import Geometry, scenario_geometry
 from speclight.simulate.map_reflection import map_reflection
 from speclight.simulate.memory import check_run_limits, grid_epochs
@@ -130,7 +130,7 @@ def _simulate(
     if target is None and not map_mode:  # geometry only: no (N, L) spectra at all
         ds = geometry_dataset(geo, flags)
         modes = {"render_mode": sc.render.mode, "atmosphere_model": sc.atmosphere.model}
-        ds.attrs.update(global_attributes(loaded, modes))
+        ds = describe_run(ds, loaded, modes)
         return SimulationResult(dataset=ds, geometry=geo, notes=_visibility_notes(geo))
     if map_mode:
         reflection = map_reflection(loaded, geo, wavelength_nm)
@@ -192,7 +192,7 @@ def _simulate(
     extra: dict[str, str] = {"render_mode": sc.render.mode, "atmosphere_model": sc.atmosphere.model}
     if reflection.variant:
         extra["render_variant"] = reflection.variant
-    ds.attrs.update(global_attributes(loaded, extra))
+    ds = describe_run(ds, loaded, extra)
     notes = _visibility_notes(geo)
     if ranging is not None:
         ds = ranging.add_to(ds)

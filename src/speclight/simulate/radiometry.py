@@ -80,6 +80,12 @@ class Radiometry:
     optics: F64
     qe: F64
     reflectance_factor_m2_sr: F64 | None = None
+    #: (N, B) AB magnitude above the atmosphere, and moved to 1000 km [mag]
+    ab_magnitude_exo: F64 | None = None
+    ab_magnitude_standard: F64 | None = None
+    #: (N,) Vega V at the aperture and its standard magnitude; None off the V band [mag]
+    vega_v_magnitude: F64 | None = None
+    vega_v_magnitude_standard: F64 | None = None
 
 
 def instrument_response(
@@ -134,6 +140,8 @@ def instrument_response(
     rate = instrument.count_rate_per_s(flux, wavelength_nm, optics, ones, response * qe)
     with np.errstate(divide="ignore", invalid="ignore"):
         mag = instrument.ab_magnitude(flux, area, wavelength_nm, response)
+        magnitudes = _more_magnitudes(intensity_W_sr_nm, range_m, flux, area, wavelength_nm)
+        exo = instrument.ab_magnitude(magnitudes["exo_flux"], area, wavelength_nm, response)
     measured = None
     noise = sc.instrument.noise
     if noise is not None and noise.enabled and bands:
@@ -171,7 +179,24 @@ def instrument_response(
         optics=optics,
         qe=qe,
         reflectance_factor_m2_sr=factor,
+        ab_magnitude_exo=exo,
+        ab_magnitude_standard=instrument.standard_magnitude(exo, range_m),
+        vega_v_magnitude=magnitudes["v"],
+        vega_v_magnitude_standard=magnitudes["v_standard"],
     )
+
+
+def _more_magnitudes(
+    intensity_W_sr_nm: F64, range_m: F64, flux: F64, area_m2: float, wavelength_nm: F64
+) -> dict[str, Any]:
+    """The exo-atmospheric flux (N, L) and the Vega V magnitudes (N,) (None off the V band)."""
+    exo_flux = instrument.spectral_flux_W_nm(
+        intensity_W_sr_nm, np.ones_like(intensity_W_sr_nm), area_m2, range_m
+    )
+    v = instrument.vega_v_magnitude(flux, area_m2, wavelength_nm)
+    v_exo = instrument.vega_v_magnitude(exo_flux, area_m2, wavelength_nm)
+    v_std = None if v_exo is None else instrument.standard_magnitude(v_exo, range_m)
+    return {"exo_flux": exo_flux, "v": v, "v_standard": v_std}
 
 
 def band_reflectance_factor(

@@ -36,6 +36,15 @@ def add_spectral(
     ds["spectral_flux"] = schema.variable("spectral_flux", radiometry.spectral_flux_W_nm)
     ds["count_rate"] = schema.variable("count_rate", radiometry.count_rate_per_s)
     ds["ab_magnitude"] = schema.variable("ab_magnitude", radiometry.ab_magnitude)
+    for name in (
+        "ab_magnitude_exo",
+        "ab_magnitude_standard",
+        "vega_v_magnitude",
+        "vega_v_magnitude_standard",
+    ):
+        values = getattr(radiometry, name)
+        if values is not None:
+            ds[name] = schema.variable(name, values)
     if radiometry.count_rate_measured_per_s is not None:
         ds["count_rate_measured"] = schema.variable(
             "count_rate_measured", radiometry.count_rate_measured_per_s
