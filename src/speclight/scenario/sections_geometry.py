@@ -133,13 +133,19 @@ class Orbit(Strict):
     norad_id: int | None = Field(default=None, ge=1, description="Catalogue number in tle_file")
     cpf_file: str | None = Field(default=None, description="ILRS CPF prediction (v1 or v2)")
     ephemeris_file: str | None = Field(default=None, description="CSV: time_utc, x, y, z")
+    observed: bool = Field(
+        default=False,
+        description="No orbit: `speclight compare` places the target where each "
+        "observation saw it (elevation_deg, azimuth_deg, range_m or height_m)",
+    )
 
     @model_validator(mode="after")
     def _exactly_one(self) -> Orbit:
         given = [k for k in ("tle", "tle_file", "cpf_file", "ephemeris_file") if getattr(self, k)]
+        given += ["observed"] if self.observed else []
         if len(given) != 1:
             raise ValueError(
-                "give exactly one of tle, tle_file, cpf_file, ephemeris_file "
+                "give exactly one of tle, tle_file, cpf_file, ephemeris_file, observed: true "
                 f"(found {', '.join(given) if given else 'none'})"
             )
         if self.norad_id is not None and not self.tle_file:
