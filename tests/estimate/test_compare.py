@@ -3,6 +3,7 @@ sphere's closed form with skyfield geometry per site, and speclite's filter inte
 
 from __future__ import annotations
 
+from datetime import UTC, datetime
 from pathlib import Path
 
 import astropy.units as u
@@ -59,15 +60,7 @@ def _skyfield_geometry(site: tuple[float, float, float], epochs: list[str]) -> d
     eph = load_ephemeris()
     name, l1, l2 = _tle()
     sat = EarthSatellite(l1, l2, name, ts)
-    t = ts.from_datetimes(
-        [
-            np.datetime64(e)
-            .astype("datetime64[us]")
-            .item()
-            .replace(tzinfo=__import__("datetime").UTC)
-            for e in epochs
-        ]
-    )
+    t = ts.from_datetimes([datetime.fromisoformat(e).replace(tzinfo=UTC) for e in epochs])
     topos = wgs84.latlon(site[0], site[1], elevation_m=site[2])
     r_sat = sat.at(t).position.m.T
     r_site = topos.at(t).position.m.T
@@ -208,3 +201,35 @@ def test_unknown_band_names_the_line(tmp_path) -> None:
             f"{EPOCHS[1]}Z,10.0,0.05,besell-V,{lat},{lon},{alt}"]  # fmt: skip
     with pytest.raises(InputError, match=r"line 3, column 'band': 'besell-V' is neither"):
         compare(loaded, read_observations(_write(tmp_path / "obs.csv", rows)))
+
+
+def test_observed_positions_replace_the_orbit(tmp_path) -> None:
+    # orbit: {observed: true}: each row places the sphere at skyfield's azimuth, elevation
+    # and range of the TLE satellite; the magnitudes then agree with the TLE run's (the
+    # light time moves the target ~40 m of ~1000 km: < 1e-4 mag; the render is the same)
+    # and the output's elevation and range are the placed ones.
+    ts = load_timescale()
+    name, l1, l2 = _tle()
+    sat = EarthSatellite(l1, l2, name, ts)
+    lat, lon, _ = STUTTGART
+    t = ts.from_datetimes([datetime.fromisoformat(e).replace(tzinfo=UTC) for e in EPOCHS])
+    el, az, dist = (sat - wgs84.latlon(lat, lon, elevation_m=0.0)).at(t).altaz()
+    header = "time,magnitude,magnitude_sigma,band,latitude_deg,longitude_deg,"
+    header += "elevation_deg,azimuth_deg,range_m"
+    rows = [
+        f"{e}Z,10.0,0.05,G-600/40,{lat},{lon},{a!r},{z!r},{d!r}"
+        for e, a, z, d in zip(
+            EPOCHS, el.degrees.tolist(), az.degrees.tolist(), dist.m.tolist(), strict=True
+        )
+    ]
+    obs = read_observations(_write(tmp_path / "obs.csv", rows, header))
+    data = yaml.safe_load(_scenario(tmp_path).read_text())
+    data["observer"]["altitude_m"] = 0.0  # the rows' sites have no altitude_m: 0 m
+    tle_run = compare(parse_scenario(yaml.safe_dump(data)), obs).dataset
+    data["orbit"] = {"observed": True}
+    placed = compare(parse_scenario(yaml.safe_dump(data)), obs).dataset
+    np.testing.assert_allclose(placed["elevation"].values, el.degrees, atol=1e-6)
+    np.testing.assert_allclose(placed["range"].values, dist.m, atol=1e-3)
+    np.testing.assert_allclose(
+        placed["magnitude_simulated"].values, tle_run["magnitude_simulated"].values, atol=1e-4
+    )

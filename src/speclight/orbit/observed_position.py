@@ -32,9 +32,10 @@ MAX_RANGE_M = 1e8
 #: LEO target is minutes long, and a target seen twice in 30 s moves on a near-straight
 #: line (a 7.5 km/s orbit's chord of 30 s departs from the arc by < 1 km).
 MAX_GAP_S = 30.0
-#: How far past the first or last observed position the trajectory still answers with it
-#: [s]: the light-time iteration asks at the reception time, ~0.01 s after emission.
-END_TOLERANCE_S = 0.1
+#: How far from an observed position the trajectory still answers with it where it cannot
+#: interpolate (an end of the table, or a gap) [s]: the light-time iteration first asks at
+#: the reception time, ~0.01 s after the emission.
+NEAR_S = 0.1
 
 
 def line_of_sight_itrs(site: Site, azimuth_deg: F64, elevation_deg: F64) -> F64:
@@ -123,8 +124,8 @@ def observed_trajectory(
     callable
         ``t -> (r (N, 3), ok (N,))``: exact at the given epochs, linear between two given
         epochs at most :data:`MAX_GAP_S` apart (the velocity a nadir attitude needs is the
-        chord's), the end positions within :data:`END_TOLERANCE_S` of either end, NaN
-        (``ok`` False) elsewhere.
+        chord's), the nearest position within :data:`NEAR_S` of a given epoch elsewhere,
+        NaN (``ok`` False) beyond.
     """
     keep = np.all(np.isfinite(r_gcrs_m), axis=1)
     order = np.argsort(emitted_utc[keep], kind="stable")
@@ -137,16 +138,21 @@ def observed_trajectory(
     def trajectory(t: Any) -> tuple[F64, NDArray[np.bool_]]:
         s = _seconds(t, ref)
         out = np.full((s.size, 3), np.nan)
-        if s_tab.size == 0:
-            return out, np.zeros(s.size, dtype=bool)
-        clamped = np.clip(s, s_tab[0], s_tab[-1])
-        near_end = np.abs(s - clamped) <= END_TOLERANCE_S
-        k = np.clip(np.searchsorted(s_tab, clamped, side="right"), 1, max(s_tab.size - 1, 1))
+        if s_tab.size < 2:  # no interpolation: the one position near its epoch
+            near = np.abs(s - s_tab[0]) <= NEAR_S if s_tab.size else np.zeros(s.size, bool)
+            out[near] = r_tab[0] if s_tab.size else np.nan
+            return out, near
+        inside = (s >= s_tab[0]) & (s <= s_tab[-1])
+        k = np.clip(np.searchsorted(s_tab, s, side="right"), 1, max(s_tab.size - 1, 1))
         gap = s_tab[k] - s_tab[k - 1] if s_tab.size > 1 else np.zeros(s.size)
-        exact = np.isin(clamped, s_tab)
-        ok = near_end & (exact | (gap <= MAX_GAP_S))
+        between = inside & (gap <= MAX_GAP_S)
+        nearest = np.where(np.abs(s - s_tab[k - 1]) <= np.abs(s - s_tab[k]), k - 1, k)
+        nearest = np.minimum(nearest, s_tab.size - 1)
+        near = np.abs(s - s_tab[nearest]) <= NEAR_S
         for axis in range(3):
-            out[:, axis] = np.interp(clamped, s_tab, r_tab[:, axis])
+            out[:, axis] = np.interp(s, s_tab, r_tab[:, axis])
+        out[~between] = r_tab[nearest[~between]]
+        ok = between | near
         out[~ok] = np.nan
         return out, ok
 
