@@ -233,3 +233,23 @@ def test_observed_positions_replace_the_orbit(tmp_path) -> None:
     np.testing.assert_allclose(
         placed["magnitude_simulated"].values, tle_run["magnitude_simulated"].values, atol=1e-4
     )
+
+
+def test_observed_orbit_rules(tmp_path) -> None:
+    data = yaml.safe_load(_scenario(tmp_path).read_text())
+    data["orbit"] = {"observed": True}
+    loaded = parse_scenario(yaml.safe_dump(data))
+    with pytest.raises(InputError, match=r"orbit.observed: observed: true has no orbit"):
+        simulate(loaded)
+    lat, lon, alt = STUTTGART
+    rows = [f"{EPOCHS[0]}Z,10.0,0.05,G-600/40,{lat},{lon},{alt}"]
+    with pytest.raises(InputError, match=r"line 2: the scenario has orbit: \{observed: true\}"):
+        compare(loaded, read_observations(_write(tmp_path / "obs.csv", rows)))
+    data["orbit"] = {
+        "observed": True,
+        "tle": yaml.safe_load(example_text("calsphere"))["orbit"]["tle"],
+    }
+    with pytest.raises(
+        InputError, match=r"give exactly one of .* observed: true \(found tle, observed\)"
+    ):
+        parse_scenario(yaml.safe_dump(data))
