@@ -1,5 +1,5 @@
 """``speclight compare``: a scenario simulated at every observed epoch and site, against the
-observed magnitudes (SPEC section 5, docs/compare.md).
+observed magnitudes (docs/compare.md).
 
 The observations are grouped by site; each site is one simulation of all its epochs (the
 scenario with its observer moved to the site, :func:`~speclight.scenario.overrides.

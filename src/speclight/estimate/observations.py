@@ -1,4 +1,4 @@
-"""Observed magnitudes in: the OBSERVATIONS CSV of ``speclight compare`` (SPEC section 5).
+"""Observed magnitudes in: the OBSERVATIONS CSV of ``speclight compare``.
 
 Format (``#`` lines are comments, except ``# key: value`` lines naming the site)::
 
