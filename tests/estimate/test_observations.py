@@ -86,6 +86,8 @@ ROW = "2020-02-29T21:16:00Z,7.5,0.05,V,48.5,9.25\n"
         (HEADER.strip() + ",elevation_deg,azimuth_deg,range_m\n" + ROW.strip() + ",30,120,800\n"
          .replace("800", "-800"),
          r"line 2, column 'range_m': '-800' is not accepted; expected a range \[m\]"),
+        (HEADER + "1850-01-01T00:00:00Z,7.5,0.1,V,45,9.25\n",
+         r"line 2, column 'time': 1850-01-01T00:00:00Z is outside .* accepted: 1899-07-30"),
         (HEADER, r"the file holds a header but no rows"),
         ("", r"the file holds no header and no rows"),
     ],

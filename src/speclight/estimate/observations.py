@@ -37,9 +37,12 @@ from numpy.typing import NDArray
 from speclight.errors import InputError, did_you_mean
 from speclight.estimate.measured import _time as _measured_time
 from speclight.input_files import read_user_text
+from speclight.scenario.sections_geometry import FIRST_EPOCH_UTC, LAST_EPOCH_UTC
 
 F64 = NDArray[np.float64]
 FIELD = "OBSERVATIONS"
+FIRST_EPOCH = np.datetime64(FIRST_EPOCH_UTC.replace(tzinfo=None), "ns")
+LAST_EPOCH = np.datetime64(LAST_EPOCH_UTC.replace(tzinfo=None), "ns")
 SITE_KEYS = ("latitude_deg", "longitude_deg", "altitude_m")
 POSITION_KEYS = ("elevation_deg", "azimuth_deg", "range_m", "height_m")
 REQUIRED = ("time", "magnitude", "magnitude_sigma", "band")
@@ -233,6 +236,13 @@ def _rows(
             times.append(_measured_time(cells[col["time"]], lineno, src))
         except InputError as exc:
             raise _error(f"{exc.message} (column 'time')", src) from None
+        if not FIRST_EPOCH <= times[-1] <= LAST_EPOCH:
+            raise _error(
+                f"line {lineno}, column 'time': {cells[col['time']]} is outside what the "
+                f"shipped Sun ephemeris (JPL DE421) covers; accepted: {FIRST_EPOCH_UTC.date()} "
+                f"to {LAST_EPOCH_UTC.date()} UTC",
+                src,
+            )
         band = cells[col["band"]]
         if not band:
             raise _error(
