@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 import xarray as xr
+import yaml
 from numpy.typing import NDArray
 
 from speclight import orbit
@@ -142,7 +143,12 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
             source=loaded.source,
             field="target",
         )
-    base = with_overrides(loaded, {"instrument.bands": _bands(loaded, obs)})
+    bands = _bands(loaded, obs)
+    base = loaded
+    if len(bands) > len(sc.instrument.bands):  # speclite filters added
+        written = yaml.safe_load(loaded.yaml_text) or {}
+        key = "instrument.bands" if isinstance(written.get("instrument"), dict) else "instrument"
+        base = with_overrides(loaded, {key: bands if key.endswith("bands") else {"bands": bands}})
     trajectory = _placed(loaded, obs) if sc.orbit.observed else None
     notes: list[str] = []
     if trajectory is None and np.any(np.isfinite(obs.elevation_deg)):
