@@ -1016,6 +1016,55 @@ def sweep(
 
 
 @app.command()
+def compare(
+    scenario: Annotated[
+        Path, typer.Argument(help="Scenario YAML: target, attitude, orbit (or observed: true).")
+    ],
+    observations: Annotated[
+        Path, typer.Argument(help="OBSERVATIONS CSV: time, site, magnitude, sigma, band.")
+    ],
+    output: Annotated[
+        str, typer.Option("--output", "-o", metavar="FILE", help="Output NetCDF (CMP.nc).")
+    ] = "compare.nc",
+    plot_file: Annotated[
+        str | None, typer.Option("--plot", metavar="FIG", help="Figure (.png, .pdf, .svg).")
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite existing outputs.")] = False,
+) -> None:
+    """Simulate the scenario at every observed epoch and site (one run per site) and write
+    observed, simulated and residual magnitudes with the geometry of each observation, and
+    residual statistics (also printed). See docs/compare.md.
+
+    Example: speclight compare calsphere.yaml observed.csv -o cmp.nc --plot cmp.png
+    """
+
+    def run() -> None:
+        from speclight.estimate.compare import compare as run_compare
+        from speclight.estimate.compare_stats import summary_lines
+        from speclight.estimate.observations import read_observations
+        from speclight.io.netcdf import dataset_bytes
+        from speclight.plot.figure_output import claim_outputs
+        from speclight.scenario import load_scenario
+
+        inputs = {"scenario file": scenario, "observations file": observations}
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+            result = run_compare(
+                load_scenario(scenario), read_observations(observations), sys.stderr.isatty()
+            )
+            _raise_if_signalled()
+            claim.write(dataset_bytes(result.dataset))
+            if figure is not None:
+                from speclight.plot.compare_figure import compare_figure
+
+                figure.write(compare_figure(result.dataset))
+        for line in [*result.notes, *summary_lines(result.dataset.attrs)]:
+            typer.echo(line)
+        typer.echo(f"wrote {output}" + (f" and {plot_file}" if plot_file else ""))
+
+    _guarded(run)
+
+
+@app.command()
 def info() -> None:
     """Versions of speclight and its engines, render variants, and data coverage."""
 

@@ -25,7 +25,9 @@ command line are built on them:
 * :mod:`.period_io` (with :mod:`.periodogram`, :mod:`.period_fap`, :mod:`.period_decision`,
   :mod:`.synodic`, :mod:`.period_geometry`): the ``speclight period`` command;
 * :mod:`.spin_axis` (with :mod:`.spin_axis_lookup`, :mod:`.spin_axis_io`): ``speclight
-  spin-axis``, the grid search of the spin axis and phase against a reflectivity map.
+  spin-axis``, the grid search of the spin axis and phase against a reflectivity map;
+* :mod:`.observations` (the OBSERVATIONS CSV) and :mod:`.compare` (with
+  :mod:`.compare_stats`): ``speclight compare``, simulated against observed magnitudes.
 """
 
 from speclight.estimate.accuracy import (
@@ -34,11 +36,13 @@ from speclight.estimate.accuracy import (
     mean_absolute_share_error,
     spectral_angle_rad,
 )
+from speclight.estimate.compare import CompareResult, compare
 from speclight.estimate.endmember_spectra import endmembers_from_files, endmembers_from_scenario
 from speclight.estimate.endmembers import EndmemberResult, extract_endmembers
 from speclight.estimate.fit import fit_scales, shot_noise_sigma
 from speclight.estimate.ground_truth import fractions, material_signatures, true_contributions
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
+from speclight.estimate.observations import Observations, read_observations
 from speclight.estimate.period_io import PeriodResult, estimate_period
 from speclight.estimate.reflection_map import ReflectionMap, reflection_map
 from speclight.estimate.reflection_map_io import reflection_map_measured
@@ -58,16 +62,19 @@ from speclight.estimate.upsampling import UpsampledSpectrum, upsample
 __all__ = [
     "UNMIX_METHODS",
     "BandResponses",
+    "CompareResult",
     "EndmemberResult",
     "FitResult",
     "MapRun",
     "MeasuredLightCurve",
+    "Observations",
     "PeriodResult",
     "ReflectionMap",
     "SpinAxisResult",
     "UnmixResult",
     "UpsampledSpectrum",
     "bin_light_curve",
+    "compare",
     "confusion_matrix",
     "endmembers_from_files",
     "endmembers_from_scenario",
@@ -82,6 +89,7 @@ __all__ = [
     "mean_absolute_share_error",
     "read_fit_albedos",
     "read_measured",
+    "read_observations",
     "read_reflectance_factors",
     "reflection_map",
     "reflection_map_measured",

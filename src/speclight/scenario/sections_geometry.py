@@ -138,13 +138,20 @@ class Orbit(Strict):
     sp3_file: str | None = Field(default=None, description="IGS SP3-c or SP3-d precise orbit")
     satellite: str | None = Field(default=None, description="Vehicle id in sp3_file, e.g. G01")
 
+    observed: bool = Field(
+        default=False,
+        description="No orbit: `speclight compare` places the target where each "
+        "observation saw it (elevation_deg, azimuth_deg, range_m or height_m)",
+    )
+
     @model_validator(mode="after")
     def _exactly_one(self) -> Orbit:
         sources = ("tle", "tle_file", "cpf_file", "ephemeris_file", "oem_file", "sp3_file")
         given = [k for k in sources if getattr(self, k)]
+        given += ["observed"] if self.observed else []
         if len(given) != 1:
             raise ValueError(
-                f"give exactly one of {', '.join(sources)} "
+                f"give exactly one of {', '.join(sources)}, observed: true "
                 f"(found {', '.join(given) if given else 'none'})"
             )
         if self.norad_id is not None and not self.tle_file:

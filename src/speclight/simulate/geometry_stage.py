@@ -191,12 +191,16 @@ def _at_emission(
 
 
 def scenario_geometry(
-    loaded: LoadedScenario, time_utc: NDArray[np.datetime64] | None = None
+    loaded: LoadedScenario,
+    time_utc: NDArray[np.datetime64] | None = None,
+    trajectory: Trajectory | None = None,
 ) -> Geometry:
     """Orbit, observer, Sun, shadow and attitude for every epoch of the scenario.
 
     ``time_utc``: UTC epochs to use instead of the scenario's time grid (e.g. the times of a
     measured light curve), ``datetime64``; the attitude's time origin stays ``time.start``.
+    ``trajectory``: ``t -> (r_gcrs_m, ok)`` in place of the scenario's orbit source (the
+    observed positions of ``orbit: {observed: true}``, built by ``speclight compare``).
     """
     sc = loaded.scenario
     start = np.datetime64(sc.time.start.replace(tzinfo=None), "ns")
@@ -210,7 +214,16 @@ def scenario_geometry(
     t = time_from_utc(time_utc)
     t_s = (time_utc - start) / np.timedelta64(1, "s")
     site = orbit.Site(sc.observer.latitude_deg, sc.observer.longitude_deg, sc.observer.altitude_m)
-    trajectory = _trajectory(loaded, time_utc)
+    if trajectory is None:
+        if sc.orbit.observed:
+            raise InputError(
+                "observed: true has no orbit of its own: the positions come from an "
+                "observations file (speclight compare SCENARIO OBSERVATIONS); for simulate, "
+                "give tle, tle_file, cpf_file or ephemeris_file",
+                source=loaded.source,
+                field="orbit.observed",
+            )
+        trajectory = _trajectory(loaded, time_utc)
     r_target, ok = trajectory(t)
     delay_s = np.zeros(t_s.size)
     if sc.observer.light_time:
