@@ -82,3 +82,7 @@ class RenderSession:
         if key not in self._casters:
             self._casters[key] = (target, make_caster(target, self.variant))
         return self._casters[key][1]
+
+    def forget(self, target: Target) -> None:
+        """Drop the caster of ``target`` (a posed copy of an articulated target, used once)."""
+        self._casters.pop(id(target), None)

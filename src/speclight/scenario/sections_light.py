@@ -27,7 +27,7 @@ ConductorName = Literal["Al", "Ag", "Au"]
 DielectricName = Literal["SiO2", "Si", "GaAs", "Kapton"]
 #: Shipped reflectance tables (``data/materials``, :mod:`speclight.target.material_tables`).
 MaterialTableName = Literal["aluminium", "kapton_mli", "solar_cell", "white_paint"]
-BuiltinShape = Literal["sphere", "plate", "cube", "cylinder", "box_wing"]
+BuiltinShape = Literal["sphere", "plate", "cube", "cylinder", "box_wing", "bus_array"]
 
 #: Largest ``render.seed``: Mitsuba's sampler seed is a 32-bit unsigned integer (path mode
 #: hashes the run's seed, the epoch and the launch into one, :mod:`speclight.render.path_sampling`;
@@ -170,6 +170,7 @@ _SHAPE_SIZES: dict[str, tuple[str, ...]] = {
         "dish_radius_m",
         "dish_depth_m",
     ),
+    "bus_array": ("bus_size_m", "array_size_m", "array_gap_m"),
 }
 _SHAPE_REQUIRED: dict[str, tuple[str, ...]] = {
     "sphere": ("radius_m",),
@@ -177,6 +178,7 @@ _SHAPE_REQUIRED: dict[str, tuple[str, ...]] = {
     "cube": ("edge_m",),
     "cylinder": ("radius_m", "length_m"),
     "box_wing": (),
+    "bus_array": (),
 }
 
 
@@ -197,6 +199,8 @@ class Shape(Strict):
     wing_gap_m: float | None = Field(default=None, ge=0)
     dish_radius_m: float | None = Field(default=None, gt=0)
     dish_depth_m: float | None = Field(default=None, gt=0)
+    array_size_m: Annotated[list[float], Field(min_length=2, max_length=2)] | None = None
+    array_gap_m: float | None = Field(default=None, ge=0)
 
     @field_validator("builtin", mode="before")
     @classmethod
@@ -258,10 +262,45 @@ def _check_scale(builtin: str, sizes: dict[str, Any]) -> None:
 _SHAPE_FIELDS = sorted({k for sizes in _SHAPE_SIZES.values() for k in sizes})
 
 
+class Joint(Strict):
+    """An articulated part: turned about a body axis to track the Sun, or by a table."""
+
+    axis: Vector3 = Field(description="Hinge axis, body frame (normalised)")
+    hinge_point_m: Vector3 = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0], description="A point on the hinge [m]"
+    )
+    normal: Vector3 = Field(description="The part's normal at angle 0 (not along the axis)")
+    mode: Literal["sun_tracking", "table"] = "sun_tracking"
+    table_file: str | None = Field(default=None, description="CSV time_utc,angle_deg")
+
+    @model_validator(mode="after")
+    def _check(self) -> Joint:
+        a, n = np.asarray(self.axis, float), np.asarray(self.normal, float)
+        if not np.linalg.norm(a) > 0:
+            raise ValueError(f"axis {self.axis} must be non-zero")
+        a = a / np.linalg.norm(a)
+        if not np.linalg.norm(n - a * (n @ a)) > 1e-6 * np.linalg.norm(n):
+            raise ValueError(
+                f"normal {self.normal} must be non-zero and not parallel to axis {self.axis}"
+            )
+        if (self.mode == "table") != (self.table_file is not None):
+            raise ValueError("table_file is needed by mode 'table' and used only by it")
+        return self
+
+
 class Target(Strict):
     shape: Shape
     materials: dict[str, Material] = Field(
         min_length=1, description="Part name -> material; '*' covers the parts not named"
+    )
+    articulation: dict[str, Joint] = Field(
+        default_factory=dict, description="Part name -> its hinge (docs/scenario.md)"
+    )
+    articulation_step_deg: float = Field(
+        default=0.5,
+        ge=0,
+        le=10,
+        description="Joint angles are rounded to this step to share one scene (0: exact)",
     )
 
 

@@ -29,6 +29,7 @@ from speclight.scenario.sections_light import (
 from speclight.scenario.sections_light import Material as MaterialModel
 from speclight.simulate.geometry_stage import Geometry
 from speclight.target import Material, Reflectance, Target
+from speclight.target.articulation import Joint, check_joint_parts, read_angle_table
 from speclight.target.brdf_table import load_brdf_table
 from speclight.target.from_values import BUILTIN_SHAPES
 from speclight.target.material_tables import material_table_path
@@ -57,6 +58,31 @@ def build_target(loaded: LoadedScenario) -> Target:
     kwargs = {k: getattr(shape, k) for k in sizes if getattr(shape, k) is not None}
     kwargs = {k: tuple(v) if isinstance(v, list) else v for k, v in kwargs.items()}
     return builder(materials=mats, **kwargs)  # type: ignore[operator]
+
+
+def build_joints(loaded: LoadedScenario, target: Target) -> tuple[Joint, ...]:
+    """The articulated parts of the scenario's target (``target.articulation``), checked."""
+    cfg = loaded.scenario.target
+    assert cfg is not None
+    joints = []
+    for part, j in cfg.articulation.items():
+        times = angles = None
+        if j.table_file is not None:
+            field = f"target.articulation.{part}.table_file"
+            times, angles = read_angle_table(loaded.resolve(j.table_file), field)
+        joints.append(
+            Joint(
+                part=part,
+                axis=tuple(j.axis),  # type: ignore[arg-type]
+                hinge_point_m=tuple(j.hinge_point_m),  # type: ignore[arg-type]
+                normal=tuple(j.normal),  # type: ignore[arg-type]
+                mode=j.mode,
+                table_times_utc=times,
+                table_angle_deg=angles,
+            )
+        )
+    check_joint_parts(target, tuple(joints))
+    return tuple(joints)
 
 
 def _reflectance(loaded: LoadedScenario, spec: Any, field: str) -> Reflectance:
@@ -161,24 +187,47 @@ def render_reflection(
             from speclight.simulate.memory import path_render_note
 
             print(path_render_note(sc, idx.size), file=sys.stderr)  # the bar follows
-        result = render_intensity(
-            target,
-            geo.sun_direction_body[idx],
-            geo.observer_direction_body[idx],
-            solar[idx],
-            wavelength_nm,
-            mode=session.mode,
+        common: dict[str, Any] = dict(
             resolution_px=sc.render.resolution_px,
             samples_per_pixel=sc.render.samples_per_pixel,
             seed=sc.render.seed,
-            variant=sc.render.variant,
             workers=os.cpu_count(),  # used by the numpy fallback; Dr.Jit uses all cores itself
-            progress=progress,
-            keep_images_for=keep or None,
             on_hits=None if on_hits is None else on_hits(idx),
             solar_disk=sc.illumination.solar_disk,
-            session=session,
         )
+        sun_b, obs_b = geo.sun_direction_body[idx], geo.observer_direction_body[idx]
+        joints = build_joints(loaded, target) if sc.target.articulation else ()
+        if joints:
+            from speclight.render.articulated import render_articulated
+
+            angles = np.stack([j.angles_rad(sun_b, geo.time_utc[idx]) for j in joints], axis=1)
+            result = render_articulated(
+                target,
+                joints,
+                angles,
+                sun_b,
+                obs_b,
+                solar[idx],
+                wavelength_nm,
+                session=session,
+                angle_step_deg=sc.target.articulation_step_deg,
+                keep_images_for=keep or None,
+                **common,
+            )
+        else:
+            result = render_intensity(
+                target,
+                sun_b,
+                obs_b,
+                solar[idx],
+                wavelength_nm,
+                mode=session.mode,
+                variant=sc.render.variant,
+                progress=progress,
+                keep_images_for=keep or None,
+                session=session,
+                **common,
+            )
         scale = sunlit[idx, None]
         intensity[idx] = result.intensity_W_sr_nm * scale
         if result.intensity_std_W_sr_nm is not None:

@@ -62,8 +62,16 @@ class MeasuredBRDF:
 def half_angles_deg(
     theta_i_deg: NDArray[np.float64], theta_o_signed_deg: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """(theta_h, theta_d) [deg] of in-plane samples; theta_o > 0 on the specular side."""
-    return np.abs(theta_o_signed_deg - theta_i_deg) / 2.0, (theta_i_deg + theta_o_signed_deg) / 2.0
+    """(theta_h, theta_d) [deg] of in-plane samples; theta_o > 0 on the specular side.
+
+    Both are angles between vectors, so >= 0: beyond the retro-reflection direction
+    (theta_o < -theta_i) the half vector passes the incident direction and theta_d is
+    ``|theta_i + theta_o| / 2`` (a signed value would put those samples outside the grid).
+    """
+    return (
+        np.abs(theta_o_signed_deg - theta_i_deg) / 2.0,
+        np.abs(theta_i_deg + theta_o_signed_deg) / 2.0,
+    )
 
 
 def _parse_rows(text: str, source: str) -> NDArray[np.float64]:

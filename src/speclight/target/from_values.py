@@ -3,8 +3,8 @@
 Accepted forms (docs/scenario.md): ``reflectance`` is a number, ``{file: path}``,
 ``{wavelength_nm: [...], value: [...]}``, ``{conductor: Al}`` or ``{dielectric: SiO2}``;
 a material is ``{bsdf, reflectance, roughness?, diffuse_reflectance?, brdf_table?}``; a shape is
-``{builtin: sphere|plate|cube|cylinder|box_wing, ...sizes}`` or ``{mesh_file: path}`` (or a
-list of PLY files). Unknown keys are errors with a did-you-mean.
+``{builtin: sphere|plate|cube|cylinder|box_wing|bus_array, ...sizes}`` or
+``{mesh_file: path}`` (or a list of PLY files). Unknown keys are errors with a did-you-mean.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ BUILTIN_SHAPES = {
         ("bus_size_m", "wing_span_m", "wing_width_m", "wing_gap_m", "dish_radius_m",
          "dish_depth_m"),
     ),
+    "bus_array": (shapes.bus_array, ("bus_size_m", "array_size_m", "array_gap_m")),
 }  # fmt: skip
 _MATERIAL_KEYS = ("bsdf", "reflectance", "roughness", "diffuse_reflectance", "brdf_table")
 
