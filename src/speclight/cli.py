@@ -10,6 +10,7 @@ removed by the next run writing to the same folder (see :mod:`speclight.io.outpu
 from __future__ import annotations
 
 import json
+import math
 import signal
 import sys
 import threading
@@ -800,9 +801,14 @@ def spin_axis(
             f"best axis RA {a['best_ra_deg']:.1f} Dec {a['best_dec_deg']:.1f} deg, phase "
             f"{a['best_phase_deg']:.1f} deg (misfit {a['best_error']:.4g}); mirror RA "
             f"{a['mirror_ra_deg']:.1f} Dec {a['mirror_dec_deg']:.1f} (misfit "
-            f"{a['mirror_error']:.4g}); refined RA {a['refined_ra_deg']:.2f} Dec "
-            f"{a['refined_dec_deg']:.2f} phase {a['refined_phase_deg']:.1f} "
-            f"({result.result.n_epochs} epochs, {result.light}, ranging weight "
+            f"{a['mirror_error']:.4g}); "
+            + (
+                f"refined RA {a['refined_ra_deg']:.2f} Dec {a['refined_dec_deg']:.2f} phase "
+                f"{a['refined_phase_deg']:.1f} "
+                if math.isfinite(float(a["refined_ra_deg"]))
+                else "not refined (--no-refine) "
+            )
+            + f"({result.result.n_epochs} epochs, {result.light}, ranging weight "
             f"{result.ranging_weight:g}, {result.seconds:.1f} s)"
         )
         typer.echo(f"wrote {output}" + (f" and {plot_file}" if plot_file else ""))

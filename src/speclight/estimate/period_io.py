@@ -170,8 +170,10 @@ class PeriodResult:
                 "Suveges 2014); period_std_s from "
                 "the curvature of chi2(f) at its minimum (harmonics and a cubic trend per "
                 "band), delta chi2 = 1 after scaling by "
-                "the reduced chi2, times sqrt((1 + rho) / (1 - rho)) for the lag-1 "
-                f"correlation rho = {self.peak.residual_correlation:.3f} of the residuals"
+                "the reduced chi2, times the coloured-noise factor sqrt(sum w_k / sum "
+                "(w_k / R_k)) (w_k = k^2 A_k^2, R_k the residuals' Lomb-Scargle power beside "
+                "harmonic k over their mean power; Kay 1993 ch. 3; never below 1); residuals' "
+                f"lag-1 correlation rho = {self.peak.residual_correlation:.3f}"
             ),
             "candidates": [{"period_s": p, "power": w} for p, w in self.candidates],
             "photometric_period_s": self.decision.photometric_period_s,
