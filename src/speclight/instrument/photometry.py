@@ -80,7 +80,9 @@ def count_rate_per_s(
     flux = np.asarray(spectral_flux_W_nm, dtype=np.float64)
     kernel = photon_kernel(wavelength_nm, optics, qe, band_response)
     _check(flux, np.asarray(wavelength_nm), kernel)
-    return flux @ kernel.T
+    # einsum's own loops, not BLAS: the same bits whatever the BLAS thread count (a Dask
+    # worker runs BLAS on one thread), so distributed runs equal serial ones exactly
+    return np.einsum("tl,bl->tb", flux, kernel)
 
 
 def reflectance_factor_m2_sr(
@@ -125,7 +127,8 @@ def reflectance_factor_m2_sr(
     illum = np.asarray(illumination_W_m2_nm, dtype=np.float64)
     kernel = photon_kernel(wavelength_nm, optics, qe, band_response)
     _check(illum, np.asarray(wavelength_nm), kernel)
-    photons = aperture_area_m2 * (illum @ kernel.T)  # per unit reflectance factor [s-1 m2]
+    # per unit reflectance factor [s-1 m2]
+    photons = aperture_area_m2 * np.einsum("tl,bl->tb", illum, kernel)
     r2 = np.asarray(range_m, dtype=np.float64)[:, None] ** 2
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.asarray(np.where(photons > 0, rate * r2 / photons, np.nan))
@@ -177,7 +180,7 @@ def ab_magnitude(
     band = np.atleast_2d(np.asarray(band_response, dtype=np.float64))
     _check(flux, wl, band)
     weight = band * (wl * bin_widths_nm(wl))[None, :]  # (B, L)
-    num = (flux / aperture_area_m2) @ weight.T
+    num = np.einsum("tl,bl->tb", flux / aperture_area_m2, weight)
     den = weight @ ab_reference_W_m2_nm(wl)
     with np.errstate(divide="ignore", invalid="ignore"):
         mag = -2.5 * np.log10(num / den[None, :])
