@@ -21,8 +21,8 @@ from __future__ import annotations
 import os
 
 # Dask's workers run BLAS on one thread (distributed.nanny.pre-spawn-environ); so does the
-# serial run here, so that the two stores can be compared bit for bit (the band integral is a
-# BLAS product whose last bit depends on the thread split: BENCHMARKS.md, "Sweep")
+# serial run here, so that both sides do the same work per case (the band integrals no longer
+# use BLAS, so the stores are equal bit for bit either way: BENCHMARKS.md, "Sweep")
 for _name in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
     os.environ.setdefault(_name, "1")
 
