@@ -20,6 +20,9 @@ from contextlib import contextmanager
 from typing import IO
 
 Advance = Callable[[int], None]
+#: A stage that took at least this long [s] leaves a closing line with its time (quicker
+#: ones vanish with their display, so that a loop of short runs, e.g. a fit, stays quiet).
+REPORT_AFTER_S = 1.0
 
 
 def _noop(n: int) -> None:
@@ -99,6 +102,7 @@ def stage(
     task = bar.add_task(label, total=total)
     with bar:
         yield lambda n: bar.advance(task, n)
-    # a line per finished stage, so a long run leaves the account of where its time went
+    # a line per finished long stage, so a long run leaves the account of where its time went
     elapsed = bar.tasks[0].elapsed or 0.0
-    console.print(f"[green]done[/green] {escape(label)} ({elapsed:.1f} s)", highlight=False)
+    if elapsed >= REPORT_AFTER_S:
+        console.print(f"[green]done[/green] {escape(label)} ({elapsed:.1f} s)", highlight=False)

@@ -25,7 +25,12 @@ class _Tty(io.StringIO):
         return True
 
 
-def test_stage_draws_on_a_terminal_and_reports_when_done() -> None:
+@pytest.fixture
+def every_stage_reported(monkeypatch):  # type: ignore[no-untyped-def]
+    monkeypatch.setattr(progress_module, "REPORT_AFTER_S", 0.0)  # also the quick ones
+
+
+def test_stage_draws_on_a_terminal_and_reports_when_done(every_stage_reported) -> None:
     out = _Tty()
     with stage("rendering (path)", 4, file=out) as advance:
         advance(4)
@@ -33,7 +38,14 @@ def test_stage_draws_on_a_terminal_and_reports_when_done() -> None:
     assert "rendering (path)" in text and "4/4" in text and "done rendering (path)" in text
 
 
-def test_forced_stage_draws_on_any_stream() -> None:
+def test_quick_stage_leaves_no_closing_line() -> None:
+    out = _Tty()
+    with stage("atmosphere (SPECTRL2)", file=out):
+        pass
+    assert "done" not in _text(out.getvalue())
+
+
+def test_forced_stage_draws_on_any_stream(every_stage_reported) -> None:
     out = io.StringIO()
     with stage("atmosphere (6S)", force=True, file=out) as advance:
         advance(1)
@@ -51,7 +63,9 @@ def test_stage_is_silent_without_a_terminal(enabled: bool) -> None:
 
 
 @pytest.mark.parametrize(("overrides", "mode"), [(SHORT, "single"), (PATH, "path")])
-def test_simulation_reports_every_long_stage(monkeypatch, capsys, overrides, mode) -> None:
+def test_simulation_reports_every_long_stage(
+    monkeypatch, capsys, every_stage_reported, overrides, mode
+) -> None:
     # a terminal, as far as the stages can tell
     monkeypatch.setattr(progress_module, "shown", lambda enabled, **_: enabled)
     speclight.simulate("box-wing", overrides, progress=True)
