@@ -2,14 +2,15 @@
 
 Both are closed-form published formulas that pvlib keeps (``pvlib.atmosphere``); this module
 adds the elevation convention (apparent elevation in degrees, NaN at and below the horizon)
-and the validation of the site altitude.
+and the validation of the site altitude. pvlib is an engine (``speclight[atmosphere]``):
+imported when a value is computed, never on import, so that a scenario loads without it
+and a missing pvlib is reported by the scenario's engine check.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from pvlib.atmosphere import alt2pres, get_relative_airmass
 
 from speclight.errors import InputError
 
@@ -39,6 +40,8 @@ def airmass(elevation_deg: ArrayLike) -> NDArray[np.float64]:
     F. Kasten and A. T. Young, "Revised optical air mass tables and approximation
     formula", Applied Optics 28(22), 4735-4738 (1989), doi:10.1364/AO.28.004735.
     """
+    from pvlib.atmosphere import get_relative_airmass
+
     h = np.asarray(elevation_deg, dtype=np.float64)
     out = np.full(h.shape, np.nan)
     up = np.isfinite(h) & (h > 0.0) & (h <= 90.0)
@@ -76,4 +79,6 @@ def pressure_from_altitude(site_altitude_m: float) -> float:
             "altitude above mean sea level in metres",
             field="observer.altitude_m",
         )
+    from pvlib.atmosphere import alt2pres
+
     return float(alt2pres(h))
