@@ -19,6 +19,7 @@ from speclight.errors import InputError
 from speclight.orbit import parse_tle, read_tle_file, read_tles, tle_position_gcrs_m
 from speclight.orbit.frames import as_time
 from speclight.orbit.timescale import load_timescale
+from speclight.orbit.tle import utc_julian_date
 
 TLE_FILE = str(files("speclight") / "data" / "tle" / "calibration_spheres.tle")
 L1 = "1 01361U 65034C   20199.53569372  .00000028  00000-0  25492-2 0  9994"
@@ -137,3 +138,16 @@ def test_latin1_name_line_names_the_file_and_line(tmp_path: Path) -> None:
     msg = str(exc.value)
     assert msg.startswith(f"{path}: orbit.tle_file: cannot read TLE file: byte 0xe4 at line 1")
     assert "Latin-1" in msg and "save it as UTF-8" in msg
+
+
+def test_utc_julian_date_applies_the_leap_seconds() -> None:
+    # Public route to SGP4's UTC Julian date (no private skyfield call). Hand-worked: the
+    # Julian date of 2020-06-01 12:00 UTC is 2459002.0 (Meeus, Astronomical Algorithms,
+    # ch. 7), and TAI - UTC was 37 s then (IERS Bulletin C 52), so the TAI instant
+    # 12:00:37 must map to it; the leap second 2016-12-31 23:59:60 raised TAI - UTC from 36 s
+    # to 37 s, so 00:00:37.5 TAI on 2017-01-01 is 0.5 s after midnight UTC (JD 2457754.5).
+    ts = load_timescale()
+    jd, fr = utc_julian_date(ts.tai(2020, 6, 1, 12, 0, np.array([37.0])))
+    assert jd[0] + fr[0] == pytest.approx(2459002.0, abs=1e-9)
+    jd, fr = utc_julian_date(ts.tai(2017, 1, 1, 0, 0, np.array([37.5])))
+    assert (jd[0] - 2457754.5) * 86400.0 + fr[0] * 86400.0 == pytest.approx(0.5, abs=1e-5)

@@ -66,7 +66,10 @@ def test_bad_mesh_files_are_input_errors(tmp_path):
     bad.write_text("v 0 0 0\nv 1 0 0\nf 1 2\n")
     with pytest.raises(InputError, match="line 3"):
         load_mesh(bad, M)
-    with pytest.raises(InputError, match=r"accepted: \.obj, \.ply"):
+    with pytest.raises(InputError, match=r"accepted: \.obj, \.ply, \.stl, \.gltf, \.glb"):
+        (tmp_path / "x.3ds").write_text("solid")
+        load_mesh(tmp_path / "x.3ds", M)
+    with pytest.raises(InputError, match=r"x\.stl"):  # an STL without a facet
         (tmp_path / "x.stl").write_text("solid")
         load_mesh(tmp_path / "x.stl", M)
 

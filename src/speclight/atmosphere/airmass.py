@@ -1,6 +1,10 @@
-"""Relative optical airmass and surface pressure of the observing site.
+"""Relative optical airmass and surface pressure of the observing site, through pvlib.
 
-Both are closed-form published formulas; they feed every atmosphere model.
+Both are closed-form published formulas that pvlib keeps (``pvlib.atmosphere``); this module
+adds the elevation convention (apparent elevation in degrees, NaN at and below the horizon)
+and the validation of the site altitude. pvlib is an engine (``speclight[atmosphere]``):
+imported when a value is computed, never on import, so that a scenario loads without it
+and a missing pvlib is reported by the scenario's engine check.
 """
 
 from __future__ import annotations
@@ -10,28 +14,16 @@ from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError
 
-#: Standard sea-level pressure [Pa] (ICAO Standard Atmosphere, Doc 7488).
-P0_PA = 101325.0
-#: Standard sea-level temperature [K].
-T0_K = 288.15
-#: Tropospheric temperature lapse rate [K m-1].
-LAPSE_K_PER_M = 0.0065
-#: Standard gravity [m s-2].
-G0_M_S2 = 9.80665
-#: Molar mass of dry air [kg mol-1].
-M_AIR_KG_MOL = 0.0289644
-#: Universal gas constant [J mol-1 K-1] (value used by the U.S. Standard Atmosphere 1976).
-R_J_MOL_K = 8.31432
-
 
 def airmass(elevation_deg: ArrayLike) -> NDArray[np.float64]:
-    """Relative optical airmass of a line of sight (Kasten & Young 1989).
+    """Relative optical airmass of a line of sight (Kasten & Young 1989, via pvlib).
 
     .. math:: m = \\frac{1}{\\sin h + 0.50572\\,(h + 6.07995^\\circ)^{-1.6364}}
 
-    with :math:`h` the apparent elevation in degrees. The formula includes the curvature
-    of the Earth and refraction of a standard atmosphere; it is 1 at the zenith and about
-    38 at the horizon.
+    with :math:`h` the apparent elevation in degrees
+    (``pvlib.atmosphere.get_relative_airmass(90 - h, model="kastenyoung1989")``). The
+    formula includes the curvature of the Earth and refraction of a standard atmosphere; it
+    is 1 at the zenith and about 38 at the horizon.
 
     Parameters
     ----------
@@ -48,18 +40,21 @@ def airmass(elevation_deg: ArrayLike) -> NDArray[np.float64]:
     F. Kasten and A. T. Young, "Revised optical air mass tables and approximation
     formula", Applied Optics 28(22), 4735-4738 (1989), doi:10.1364/AO.28.004735.
     """
+    from pvlib.atmosphere import get_relative_airmass
+
     h = np.asarray(elevation_deg, dtype=np.float64)
     out = np.full(h.shape, np.nan)
     up = np.isfinite(h) & (h > 0.0) & (h <= 90.0)
-    hu = h[up]
-    out[up] = 1.0 / (np.sin(np.radians(hu)) + 0.50572 * (hu + 6.07995) ** -1.6364)
+    zenith = 90.0 - h[up]
+    out[up] = np.asarray(get_relative_airmass(zenith, model="kastenyoung1989"), dtype=float)
     return out
 
 
 def pressure_from_altitude(site_altitude_m: float) -> float:
-    """Mean surface pressure at a site from the barometric formula of the troposphere.
+    """Mean surface pressure at a site from the barometric formula (``pvlib.atmosphere.alt2pres``).
 
-    .. math:: p = p_0\\,(1 - L h / T_0)^{g_0 M / (R L)}
+    The standard troposphere: 101325 Pa and 288.15 K at sea level, a lapse rate of
+    6.5 K km-1 and dry air.
 
     Parameters
     ----------
@@ -84,5 +79,6 @@ def pressure_from_altitude(site_altitude_m: float) -> float:
             "altitude above mean sea level in metres",
             field="observer.altitude_m",
         )
-    exponent = G0_M_S2 * M_AIR_KG_MOL / (R_J_MOL_K * LAPSE_K_PER_M)
-    return P0_PA * (1.0 - LAPSE_K_PER_M * h / T0_K) ** exponent
+    from pvlib.atmosphere import alt2pres
+
+    return float(alt2pres(h))

@@ -14,7 +14,8 @@ from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
-from sgp4.api import Satrec
+from sgp4.api import Satrec, jday
+from skyfield.timelib import Time
 
 from speclight.errors import InputError
 from speclight.input_files import read_user_text
@@ -234,15 +235,25 @@ def read_tle_file(
     return min(match, key=lambda t: abs(int(np.asarray(t.epoch).astype(np.int64) - ref)))
 
 
+def utc_julian_date(t: Time) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """UTC Julian date of skyfield times as SGP4 takes it (AIAA 2006-6753): whole + fraction.
+
+    From the public UTC calendar of the time (``Time.utc``, which applies the leap-second
+    table of the timescale) and sgp4's ``jday``; the split keeps the fraction's precision.
+    """
+    year, month, day, hour, minute, second = t.utc
+    jd, fr = jday(year, month, day, hour, minute, second)
+    jd_a = np.atleast_1d(np.asarray(jd, dtype=np.float64))
+    return jd_a, np.atleast_1d(np.asarray(fr, dtype=np.float64))
+
+
 def tle_position_teme_m(
     tle: Tle, t: TimeLike
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.int_]]:
     """SGP4 position in the TEME frame [m], the ok mask and sgp4's error codes (0 = ok)."""
     t = as_time(t)
     sat = Satrec.twoline2rv(tle.line1, tle.line2)
-    # SGP4 takes UTC Julian dates (AIAA 2006-6753); skyfield's Time splits them the same way.
-    jd = np.asarray(t.whole, dtype=np.float64)
-    fr = np.asarray(t.tai_fraction - t._leap_seconds() / 86400.0, dtype=np.float64)
+    jd, fr = utc_julian_date(t)
     err, r_km, _ = sat.sgp4_array(jd, fr)
     ok = (err == 0) & np.all(np.isfinite(r_km), axis=1)
     r_m = np.where(ok[:, None], r_km * 1e3, np.nan)

@@ -8,6 +8,7 @@ import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
+from speclight.plot.compass import draw_compass
 from speclight.plot.selection import band_radiance
 from speclight.plot.style import epoch_summary, new_figure
 
@@ -61,12 +62,20 @@ def _draw_parts(fig: Any, ax: Any, ds: xr.Dataset, k: int) -> str:
     return "part seen (grey: off target)"
 
 
+def _caption(names: list[str]) -> str:
+    words = {"N": "N celestial north", "Z": "Z zenith", "☉": "☉ Sun"}
+    return ", ".join(words[n] for n in names)
+
+
 def images_figure(ds: xr.Dataset, band: str | None) -> Any:
     """One row per saved epoch: radiance in ``band`` (or the whole grid), depth map, and the
     part seen in each pixel (when the dataset names the parts).
 
     Pixel row 0 is the top of the image (the renderer's convention); axes are metres at
-    the target, right and up as seen by the observer.
+    the target, right and up as seen by the observer. The first image of each row carries a
+    compass (:mod:`speclight.plot.compass`): celestial north (N), the observer's zenith (Z)
+    and the Sun (☉) projected into the image plane, arrow length the sine of their angle
+    to the line of sight.
     """
     from matplotlib import colormaps
     from matplotlib.colors import LogNorm
@@ -131,6 +140,9 @@ def images_figure(ds: xr.Dataset, band: str | None) -> Any:
             ax.set_title(f"{what}\n{epoch_summary(ds, i)}", fontsize="small")
             ax.set_xlabel("right [m]")
             ax.set_ylabel("up [m]")
+        drawn = draw_compass(axes[k][0], ds, k)
+        if drawn:
+            axes[k][0].set_xlabel("right [m]; arrows: " + _caption(drawn))
     name = ds.attrs.get("scenario_name", "speclight dataset")
     more = f" (first {shown} of {n})" if n > shown else ""
     fig.suptitle(f"{name}: saved images{more}")

@@ -1,4 +1,10 @@
-"""Light curves per band: photo-electron rate and AB magnitude against time."""
+"""Light curves per band: photo-electron rate and AB magnitude against time.
+
+Up to :data:`MAX_LEGEND_BANDS` bands are named in a legend; with more, the bands are told
+apart by colour alone (their mean wavelength) and a colour bar over wavelength replaces the
+legend. The simulated measurements (with noise) are drawn as small translucent markers
+*above* the noiseless model lines, so that the scatter stays visible where the two overlap.
+"""
 
 from __future__ import annotations
 
@@ -7,23 +13,54 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from speclight.plot.style import band_styles, shade_unobservable
+from speclight.plot.style import (
+    band_centres_nm,
+    band_styles,
+    shade_unobservable,
+    wavelength_colour_map,
+)
+
+#: Most bands named in one legend; more get a colour bar over wavelength instead.
+MAX_LEGEND_BANDS = 6
 
 
-def _legend(ax: Any, extra: list[Any]) -> None:
-    handles, labels = ax.get_legend_handles_labels()
+def _legend(ax: Any, extra: list[Any], with_bands: bool) -> None:
+    handles, labels = ax.get_legend_handles_labels() if with_bands else ([], [])
     handles += extra
     labels += [h.get_label() for h in extra]
+    if not handles:
+        return
     ax.legend(
         handles,
         labels,
         loc="upper left",
-        bbox_to_anchor=(1.01, 1.0),
+        bbox_to_anchor=(1.01 if with_bands else 1.11, 1.0),  # right of the colour bar
         fontsize="small",
-        title="band",
+        title="band" if with_bands else None,
         title_fontsize="small",
         frameon=False,
     )
+
+
+def many_bands(ds: xr.Dataset) -> bool:
+    """More bands than a legend can name readably (:data:`MAX_LEGEND_BANDS`)."""
+    return int(ds.sizes.get("band", 0)) > MAX_LEGEND_BANDS
+
+
+def band_colour_bar(ds: xr.Dataset, fig: Any, ax: Any) -> Any:
+    """Colour bar of the band colours over wavelength, ticks at the bands' mean wavelengths."""
+    from matplotlib.cm import ScalarMappable
+
+    cmap, norm = wavelength_colour_map()
+    cax = ax.inset_axes((1.015, 0.0, 0.018, 1.0))
+    bar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), cax=cax)
+    bar.set_label("band mean wavelength [nm]", fontsize="small")
+    centres = band_centres_nm(ds)
+    centres = centres[np.isfinite(centres)]
+    if centres.size:
+        bar.ax.set_ylim(max(norm.vmin, centres.min() - 30), min(norm.vmax, centres.max() + 30))
+        bar.ax.hlines(centres, 0, 1, colors="k", lw=0.6)
+    return bar
 
 
 def count_rate_panel(ds: xr.Dataset, ax: Any) -> None:
@@ -40,9 +77,9 @@ def count_rate_panel(ds: xr.Dataset, ax: Any) -> None:
     )
     shade = shade_unobservable(ax, ds)
     for b, name in enumerate(ds["band"].values):
-        if measured is not None:
-            ax.plot(t, measured[:, b], ".", ms=2.0, alpha=0.45, color=styles[b]["color"])
-        ax.plot(t, rate[:, b], lw=1.4, label=str(name), **styles[b])
+        ax.plot(t, rate[:, b], lw=1.2, label=str(name), zorder=2, **styles[b])
+        if measured is not None:  # on top of the lines, small and translucent
+            ax.plot(t, measured[:, b], ".", ms=2.5, alpha=0.5, color=styles[b]["color"], zorder=3)
     positive = rate[np.isfinite(rate) & (rate > 0)]
     if positive.size:
         ax.set_yscale("log")
@@ -50,7 +87,10 @@ def count_rate_panel(ds: xr.Dataset, ax: Any) -> None:
     extra = list(shade)
     if measured is not None:
         extra.append(Line2D([], [], ls="", marker=".", color="0.3", label="measured (with noise)"))
-    _legend(ax, extra)
+        extra.append(Line2D([], [], color="0.3", lw=1.2, label="model (noiseless)"))
+    _legend(ax, extra, with_bands=not many_bands(ds))
+    if many_bands(ds):
+        band_colour_bar(ds, ax.figure, ax)
     ax.set_ylabel("photo-electron rate [s$^{-1}$]")
     ax.grid(alpha=0.3, which="both")
     ax.set_title("light curve per band", loc="left", fontsize="medium")

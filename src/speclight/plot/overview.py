@@ -8,6 +8,7 @@ import numpy as np
 import xarray as xr
 
 from speclight.plot.geometry_panels import PANELS, geometry_panels
+from speclight.plot.laser_panels import laser_panel, laser_rows
 from speclight.plot.lightcurve import count_rate_panel, magnitude_panel
 from speclight.plot.selection import has_bands, has_spectra
 from speclight.plot.spectrogram import spectrogram_panel
@@ -15,7 +16,7 @@ from speclight.plot.style import format_time_axis, new_figure
 
 
 def overview_figure(ds: xr.Dataset, epoch: int | None = None) -> Any:
-    """Light curve per band, spectrogram and geometry along the pass.
+    """Light curve per band, spectrogram, laser returns (with lasers) and geometry.
 
     Panels that the dataset cannot fill (no bands, no wavelength grid) are left out, so a
     geometry-only dataset gives the four geometry panels. ``epoch`` (the one the chain
@@ -29,6 +30,8 @@ def overview_figure(ds: xr.Dataset, epoch: int | None = None) -> Any:
             rows.append(("ab_magnitude", 1.8))
     if has_spectra(ds):
         rows.append(("spectrogram", 2.4))
+    lasers = laser_rows(ds)
+    rows += lasers
     rows += [(name, 1.3) for name, _, _ in PANELS]
     ratios = [h for _, h in rows]
     fig = new_figure(height_in=1.0 + sum(ratios))
@@ -42,6 +45,8 @@ def overview_figure(ds: xr.Dataset, epoch: int | None = None) -> Any:
         mesh, label = spectrogram_panel(ds, by_name["spectrogram"])
         cax = by_name["spectrogram"].inset_axes((1.015, 0.0, 0.018, 1.0))
         fig.colorbar(mesh, cax=cax, label=label, extend="min")
+    for name, _ in lasers:
+        laser_panel(ds, name, by_name[name])
     geometry_panels(ds, [by_name[name] for name, _, _ in PANELS])
     _mark_epochs(ds, axes, epoch)
     for ax in axes[:-1]:
@@ -50,6 +55,7 @@ def overview_figure(ds: xr.Dataset, epoch: int | None = None) -> Any:
     fig.align_ylabels(axes)
     name = ds.attrs.get("scenario_name", "speclight dataset")
     parts = (["light curves"] if has_bands(ds) else []) + (["spectrum"] if has_spectra(ds) else [])
+    parts += ["laser returns"] if lasers else []
     what = f"{', '.join(parts)} and geometry" if parts else "geometry"
     fig.suptitle(f"{name}: {what} along the pass")
     return fig

@@ -124,6 +124,20 @@ def band_centres_nm(ds: xr.Dataset) -> NDArray[np.float64]:
         return np.where(total > 0, (r * w).sum(axis=1) / total, np.nan)
 
 
+#: Wavelength span of the band colour scale [nm].
+COLOUR_SCALE_NM = (380.0, 1100.0)
+
+
+def wavelength_colour_map() -> tuple[Any, Any]:
+    """The colour map and normalisation [nm] that give each band its colour."""
+    from matplotlib import colormaps
+    from matplotlib.colors import ListedColormap, Normalize
+
+    base = colormaps["turbo"]
+    cmap = ListedColormap(base(np.linspace(0.05, 0.95, 256)), name="speclight_bands")
+    return cmap, Normalize(*COLOUR_SCALE_NM)
+
+
 def band_styles(ds: xr.Dataset) -> list[dict[str, Any]]:
     """Colour (by the band's mean wavelength, 380-1100 nm) and line style of each band.
 
@@ -132,14 +146,14 @@ def band_styles(ds: xr.Dataset) -> list[dict[str, Any]]:
     """
     from matplotlib import colormaps
 
-    cmap = colormaps["turbo"]
+    cmap, norm = wavelength_colour_map()
     centres = band_centres_nm(ds)
     n = centres.size
     styles: list[dict[str, Any]] = []
     dashes = ["-", "--", ":", "-."]
     for i, c in enumerate(centres):
         if np.isfinite(c):
-            colour = cmap(float(np.clip((c - 380.0) / (1100.0 - 380.0), 0.0, 1.0)) * 0.9 + 0.05)
+            colour = cmap(float(np.clip(norm(c), 0.0, 1.0)))
             twins = int(np.sum(np.abs(centres[:i] - c) < 15.0))
         else:
             colour = colormaps["tab10"](i % 10)

@@ -8,6 +8,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError
+from speclight.progress import stage
 from speclight.render.result import RenderResult
 from speclight.render.session import RenderMode, RenderSession
 from speclight.target.parts import Target
@@ -159,7 +160,7 @@ def render_intensity(
             caster = session.caster(target)
             from speclight.render.single import render_single
 
-            with _progress(progress, len(valid)) as advance:
+            with stage("rendering (single)", len(valid), enabled=progress) as advance:
                 inten, imgs = render_single(
                     target,
                     sun[valid],
@@ -179,7 +180,7 @@ def render_intensity(
         chosen = session.variant
         from speclight.render.path import render_path
 
-        with _progress(progress, len(valid)) as advance:
+        with stage("rendering (path)", len(valid), enabled=progress) as advance:
             inten, err, imgs = render_path(
                 target,
                 sun[valid],
@@ -247,30 +248,6 @@ def _single_in_processes(
         for k, img in imgs.items():
             images[int(a) + k] = img
     return np.concatenate([p[0] for p in parts]), images
-
-
-class _progress:
-    """Context manager giving an ``advance(n)`` callback; a rich bar on a terminal if asked."""
-
-    def __init__(self, show: bool, total: int) -> None:
-        import sys
-
-        self.show = show and sys.stderr.isatty()
-        self.total = total
-
-    def __enter__(self):  # type: ignore[no-untyped-def]
-        if not self.show:
-            return lambda n: None
-        from rich.progress import Progress
-
-        self.bar = Progress(transient=True)
-        self.bar.start()
-        task = self.bar.add_task("rendering", total=self.total)
-        return lambda n: self.bar.advance(task, n)
-
-    def __exit__(self, *exc: object) -> None:
-        if self.show:
-            self.bar.stop()
 
 
 def material_contributions(

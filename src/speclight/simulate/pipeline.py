@@ -10,6 +10,7 @@ from numpy.typing import NDArray
 
 from speclight import schema as v
 from speclight.errors import InputError
+from speclight.progress import stage
 from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
 from speclight.simulate.dataset import describe_run, geometry_dataset
@@ -123,9 +124,14 @@ def _simulate(
         if target is not None
         else None
     )
-    geo = geometry if geometry is not None else scenario_geometry(loaded, time_utc)
+    if geometry is not None:
+        geo = geometry
+    else:
+        with stage("orbit, attitude and geometry", enabled=progress):
+            geo = scenario_geometry(loaded, time_utc)
     wavelength_nm = wavelength_grid_nm(sc.spectrum)
-    setup = prepare_ranging(loaded, geo, wavelength_nm, target, session)  # None without lasers
+    with stage("laser ranging set-up", enabled=progress and bool(sc.illumination.lasers)):
+        setup = prepare_ranging(loaded, geo, wavelength_nm, target, session)  # None: no lasers
     flags = geo.flags.copy()  # every stage's flag bits: geometry, render, lasers
     if target is None and not map_mode:  # geometry only: no (N, L) spectra at all
         ds = geometry_dataset(geo, flags)
@@ -133,7 +139,8 @@ def _simulate(
         ds = describe_run(ds, loaded, modes)
         return SimulationResult(dataset=ds, geometry=geo, notes=_visibility_notes(geo))
     if map_mode:
-        reflection = map_reflection(loaded, geo, wavelength_nm)
+        with stage("reflectivity map", enabled=progress):
+            reflection = map_reflection(loaded, geo, wavelength_nm)
     else:
         reflection = render_reflection(
             loaded,
@@ -145,7 +152,8 @@ def _simulate(
             session=session,
         )
     elevation = np.where(geo.observable, geo.elevation_deg, np.nan)
-    transmission = atmosphere_transmission(loaded, wavelength_nm, elevation)
+    with stage(f"atmosphere ({sc.atmosphere.model})", enabled=progress):
+        transmission = atmosphere_transmission(loaded, wavelength_nm, elevation)
     radiometry = None
     if reflection.intensity_W_sr_nm is not None:
         sunlit = geo.sunlit_fraction if sc.illumination.sun else np.zeros(geo.t_s.size)
@@ -160,7 +168,8 @@ def _simulate(
         )
     ranging = None
     if setup is not None:
-        ranging = laser_ranging(loaded, geo, setup, transmission, radiometry)
+        with stage("laser ranging", enabled=progress):
+            ranging = laser_ranging(loaded, geo, setup, transmission, radiometry)
     if reflection.flags is not None:
         flags |= reflection.flags
     if setup is not None:

@@ -1,8 +1,11 @@
-"""Read target meshes: Wavefront OBJ (groups/objects become parts) and PLY (one part per file).
+"""Read target meshes: OBJ (material groups, groups or objects become parts), PLY (one part
+per file), STL and glTF (through trimesh, :mod:`speclight.target.mesh_trimesh`).
 
-OBJ: Wavefront Technologies, "Object Files (.obj)", Advanced Visualizer manual, appendix B.
-PLY: Turk 1994, "The PLY polygon file format" (Stanford). Coordinates are taken as metres
-times ``scale_m_per_unit``; polygons are split into triangle fans.
+OBJ: Wavefront Technologies, "Object Files (.obj)", Advanced Visualizer manual, appendix B:
+``usemtl NAME`` starts a part named NAME (the faces of one material), ``g``/``o`` a part
+named for the group or object. PLY: Turk 1994, "The PLY polygon file format" (Stanford).
+Coordinates are taken as metres times ``scale_m_per_unit``; polygons are split into triangle
+fans.
 
 Every malformed file is an :class:`InputError` naming the file and, where it helps, the
 line. Faces of zero area (repeated or collinear vertices) are dropped with a warning that
@@ -25,6 +28,7 @@ from speclight.input_files import read_user_bytes
 from speclight.target.materials import Material
 from speclight.target.mesh_common import FIELD, Mesh, fan
 from speclight.target.mesh_common import mesh_error as _fail
+from speclight.target.mesh_trimesh import TRIMESH_SUFFIXES, read_trimesh
 from speclight.target.parts import Part, Target, assign_materials
 from speclight.target.ply import read_ply
 
@@ -53,7 +57,7 @@ def read_obj(path: Path) -> dict[str, Mesh]:
                 verts.append([float(x) for x in tok[1:4]])
                 if len(verts[-1]) != 3:
                     raise ValueError("a vertex needs x y z")
-            elif tok[0] in ("g", "o"):
+            elif tok[0] in ("g", "o", "usemtl"):
                 current = " ".join(tok[1:]) or path.stem
             elif tok[0] == "f":
                 idx = []
@@ -134,12 +138,13 @@ def load_mesh(
     *,
     scale_m_per_unit: float = 1.0,
 ) -> Target:
-    """Target from an OBJ file (each group/object is a part) or PLY files (one part each).
+    """Target from a mesh file (OBJ, STL, glTF: parts as the module says) or PLY files.
 
     Parameters
     ----------
     path
-        One ``.obj`` or ``.ply`` file, or a list of ``.ply`` files (part name = file stem).
+        One ``.obj``, ``.stl``, ``.gltf``, ``.glb`` or ``.ply`` file, or a list of files
+        (a ``.ply`` or ``.stl`` part is named for its file stem).
     part_materials
         One material for all parts or a mapping part name -> material (``"*"``: the rest).
         Naming a part that the file lacks is an :class:`InputError` listing the parts found.
@@ -170,8 +175,11 @@ def load_mesh(
             found = read_obj(p)
         elif ext == ".ply":
             found = {p.stem: read_ply(p)}
+        elif ext in TRIMESH_SUFFIXES:
+            found = read_trimesh(p)
         else:
-            raise _fail(p, f"unsupported mesh format '{ext}' (accepted: .obj, .ply)")
+            accepted = ", ".join((".obj", ".ply", *TRIMESH_SUFFIXES))
+            raise _fail(p, f"unsupported mesh format '{ext}' (accepted: {accepted})")
         for name, (v, f) in found.items():
             with np.errstate(over="ignore"):  # a coordinate overflowing to inf is refused
                 meshes[name] = _checked_part(name, v * scale_m_per_unit, f, p, scale_m_per_unit)
