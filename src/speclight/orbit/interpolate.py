@@ -59,14 +59,35 @@ def lagrange_interpolate(
     if m < 2 or yn.shape[0] != m:
         raise ValueError(f"need at least 2 nodes with matching values, got {m} and {yn.shape}")
     n = min(int(n_points), m)
+    ok, idx, _, weights, _ = lagrange_window(xn, xq, n)
+    y = np.zeros((xq.shape[0], yn.shape[1]))
+    for j in range(n):
+        y += weights[:, j, None] * yn[idx[:, j]]
+    y[~ok] = np.nan
+    return (y[:, 0] if squeeze else y), ok
 
+
+F64 = NDArray[np.float64]
+
+
+def lagrange_window(
+    xn: F64, xq: F64, n: int
+) -> tuple[NDArray[np.bool_], NDArray[np.intp], F64, F64, F64]:
+    """The sliding window of ``n`` nodes centred on each query and its Lagrange basis.
+
+    Returns ``(ok, idx, dx, basis, slope)``: ``ok`` (N,) the queries inside the nodes' span
+    (finite); ``idx`` (N, n) the window's node indices (shifted inwards at the table's ends);
+    ``dx`` (N, n) ``x - x_k``; ``basis`` (N, n) ``L_j(x)``; ``slope`` (N, n) ``L_j'(x_j) =
+    sum_{k != j} 1 / (x_j - x_k)`` (for Hermite interpolation). The numerator
+    ``prod_{k != j} (x - x_k)`` comes from prefix and suffix products (no division, so exact
+    at the nodes); the denominators depend only on the window's start.
+    """
+    m = xn.size
     ok = np.isfinite(xq) & (xq >= xn[0]) & (xq <= xn[-1])
     xs = np.where(ok, xq, xn[0])
     start = np.clip(np.searchsorted(xn, xs) - n // 2, 0, m - n)
     idx = start[:, None] + np.arange(n)  # (N, n)
     dx = xs[:, None] - xn[idx]  # (N, n)
-    # Numerator prod_{k != j} (x - x_k) from prefix and suffix products (no division, so
-    # exact at the nodes); the denominator depends only on the window start.
     left = np.ones_like(dx)
     right = np.ones_like(dx)
     left[:, 1:] = np.cumprod(dx[:, :-1], axis=1)
@@ -74,10 +95,8 @@ def lagrange_interpolate(
     starts, inverse = np.unique(start, return_inverse=True)
     xw = xn[starts[:, None] + np.arange(n)]  # (S, n)
     eye = np.eye(n, dtype=bool)
-    den = np.where(eye, 1.0, xw[:, :, None] - xw[:, None, :]).prod(axis=2)  # (S, n)
-    weights = left * right / den[inverse.reshape(-1)]
-    y = np.zeros((xq.shape[0], yn.shape[1]))
-    for j in range(n):
-        y += weights[:, j, None] * yn[idx[:, j]]
-    y[~ok] = np.nan
-    return (y[:, 0] if squeeze else y), ok
+    diff = np.where(eye, 1.0, xw[:, :, None] - xw[:, None, :])  # (S, n, n)
+    inv = inverse.reshape(-1)
+    basis = left * right / diff.prod(axis=2)[inv]
+    slope = np.where(eye, 0.0, 1.0 / diff).sum(axis=2)[inv]
+    return ok, idx, dx, basis, slope

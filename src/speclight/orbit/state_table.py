@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 from skyfield.framelib import ICRS_to_J2000
 
 from speclight.orbit.frames import EarthOrientation, TimeLike, as_time, earth_orientation
-from speclight.orbit.interpolate import lagrange_interpolate
+from speclight.orbit.interpolate import lagrange_interpolate, lagrange_window
 from speclight.orbit.timescale import time_from_utc
 
 #: Time scales as their constant offset to TAI [s] (``TAI = t + offset``); UTC and GLONASS
@@ -104,24 +104,9 @@ def hermite_interpolate(
     m = xn.size
     n = min(int(n_points), m)
     xq = np.atleast_1d(np.asarray(x, dtype=np.float64))
-    ok = np.isfinite(xq) & (xq >= xn[0]) & (xq <= xn[-1])
-    xs = np.where(ok, xq, xn[0])
-    start = np.clip(np.searchsorted(xn, xs) - n // 2, 0, m - n)
-    idx = start[:, None] + np.arange(n)
-    dx = xs[:, None] - xn[idx]  # (N, n)
-    left = np.ones_like(dx)
-    right = np.ones_like(dx)
-    left[:, 1:] = np.cumprod(dx[:, :-1], axis=1)
-    right[:, :-1] = np.cumprod(dx[:, :0:-1], axis=1)[:, ::-1]
-    starts, inverse = np.unique(start, return_inverse=True)
-    xw = xn[starts[:, None] + np.arange(n)]  # (S, n)
-    eye = np.eye(n, dtype=bool)
-    diff = np.where(eye, 1.0, xw[:, :, None] - xw[:, None, :])  # (S, n, n)
-    den = diff.prod(axis=2)
-    slope = np.where(eye, 0.0, 1.0 / diff).sum(axis=2)  # L_j'(x_j)
-    inv = inverse.reshape(-1)
-    basis2 = (left * right / den[inv]) ** 2  # L_j(x)^2
-    a = basis2 * (1.0 - 2.0 * slope[inv] * dx)
+    ok, idx, dx, basis, slope = lagrange_window(xn, xq, n)
+    basis2 = basis**2  # L_j(x)^2
+    a = basis2 * (1.0 - 2.0 * slope * dx)
     b = basis2 * dx
     yn = np.asarray(y_nodes, dtype=np.float64)
     dyn = np.asarray(dy_nodes, dtype=np.float64)

@@ -36,6 +36,7 @@ import numpy as np
 
 from speclight import schema
 from speclight.errors import InputError
+from speclight.io import zarr_store_path
 from speclight.scale.sweep_cases import SweepPlan
 
 FIELD = "--output"
@@ -48,23 +49,8 @@ SMALL_CHUNK = 4096
 
 
 def check_store_path(output: str | os.PathLike[str], inputs: dict[str, Path]) -> Path:
-    """Refuse a store name that cannot be written: empty, missing folder, a file, an input."""
-    text = os.fspath(output)
-    if not text.strip():
-        raise InputError("the store name is empty; give one such as runs.zarr", field=FIELD)
-    path = Path(text)
-    if not path.parent.is_dir():
-        raise InputError(f"folder {path.parent} of {text} does not exist", field=FIELD)
-    for role, other in inputs.items():
-        if path.exists() and Path(other).exists() and path.resolve() == Path(other).resolve():
-            raise InputError(f"{text} is the {role}; choose another name", field=FIELD)
-    if path.exists() and not path.is_dir():
-        raise InputError(
-            f"{text} exists and is not a Zarr store (a folder); choose another name", field=FIELD
-        )
-    if not os.access(path.parent, os.W_OK | os.X_OK):
-        raise InputError(f"cannot write in folder {path.parent} (permission denied)", field=FIELD)
-    return path
+    """Refuse a store name that cannot be written (:mod:`speclight.io.zarr_store_path`)."""
+    return zarr_store_path.check_store_path(output, inputs, example="runs.zarr")
 
 
 def open_store(path: Path, plan: SweepPlan, *, force: bool, append: bool) -> tuple[Any, int, bool]:
