@@ -226,6 +226,14 @@ def plot(
             "that the data can fill; the overview is always written).",
         ),
     ] = None,
+    magnitude: Annotated[
+        str,
+        typer.Option(
+            "--magnitude",
+            help="Magnitudes of the overview: ab (at the aperture), exo (above the "
+            "atmosphere), standard (above the atmosphere, at 1000 km) or vega (Vega V).",
+        ),
+    ] = "ab",
     force: Annotated[bool, typer.Option("--force", help="Overwrite existing figures.")] = False,
 ) -> None:
     """Plot a dataset: light curves, spectrogram and geometry in OUTPUT; the one-epoch chain,
@@ -252,7 +260,13 @@ def plot(
                         field=FIELD,
                     )
             written = plot_files(
-                dataset, claim.path, force=force, epoch=chosen, band=band, kinds=kinds
+                dataset,
+                claim.path,
+                force=force,
+                epoch=chosen,
+                band=band,
+                kinds=kinds,
+                magnitude=magnitude,
             )
         for path in written:
             typer.echo(f"wrote {path}")

@@ -26,6 +26,7 @@ from speclight.errors import InputError, did_you_mean
 from speclight.io.output import create_new_file
 from speclight.plot.chain import chain_figure
 from speclight.plot.images import images_figure
+from speclight.plot.lightcurve import MAGNITUDES
 from speclight.plot.overview import overview_figure
 from speclight.plot.ranging import has_ranging, ranging_figure
 from speclight.plot.selection import (
@@ -46,6 +47,7 @@ class Choices:
     epoch_reason: str
     band: str | None
     epoch_given: bool = False
+    magnitude: str = "ab"
 
 
 @dataclass(frozen=True)
@@ -59,7 +61,9 @@ class FigureKind:
 
 
 FIGURES: tuple[FigureKind, ...] = (
-    FigureKind("overview", "", lambda ds, c: True, lambda ds, c: overview_figure(ds, c.epoch)),
+    FigureKind(
+        "overview", "", lambda ds, c: True, lambda ds, c: overview_figure(ds, c.epoch, c.magnitude)
+    ),
     FigureKind(
         "chain",
         "-chain",
@@ -86,11 +90,24 @@ def _require_matplotlib() -> None:
     require_engine("matplotlib", "plot", "drawing figures")
 
 
-def _choices(ds: xr.Dataset, epoch: int | str | None, band: str | None) -> Choices:
+def _choices(
+    ds: xr.Dataset, epoch: int | str | None, band: str | None, magnitude: str = "ab"
+) -> Choices:
     index = resolve_epoch(ds, epoch)
     reason = "brightest observable epoch" if epoch is None else "chosen with --epoch"
     band = resolve_band(ds, band) if has_images(ds) else band
-    return Choices(index, reason, band, epoch_given=epoch is not None)
+    if magnitude not in MAGNITUDES:
+        raise InputError(
+            f"--magnitude = '{magnitude}' (choices: {', '.join(MAGNITUDES)})", field="--magnitude"
+        )
+    name = MAGNITUDES[magnitude][0]
+    if magnitude != "ab" and name not in ds:
+        raise InputError(
+            f"--magnitude {magnitude}: the dataset has no {name} (written by speclight "
+            "0.1 since the CF/magnitudes update, and Vega V only where the grid covers V)",
+            field="--magnitude",
+        )
+    return Choices(index, reason, band, epoch_given=epoch is not None, magnitude=magnitude)
 
 
 def _kinds(kinds: Sequence[str] | None) -> list[FigureKind]:
@@ -204,6 +221,7 @@ def plot_files(
     band: str | None = None,
     kinds: Sequence[str] | None = None,
     dpi: int = DPI,
+    magnitude: str = "ab",
 ) -> list[Path]:
     """Read a dataset file and write all its figures; returns the files, main one first.
 
@@ -228,6 +246,9 @@ def plot_files(
         for that the dataset cannot fill (images of a run that saved none...) is an error.
     dpi
         Resolution of raster formats [dots per inch].
+    magnitude
+        The overview's magnitudes: ``ab`` (at the aperture), ``exo`` (above the
+        atmosphere), ``standard`` (above the atmosphere, at 1000 km) or ``vega`` (Vega V).
 
     Raises
     ------
@@ -240,7 +261,7 @@ def plot_files(
     _check_output(output)
     wanted = _kinds(kinds)
     ds = _load(dataset)
-    choices = _choices(ds, epoch, band)
+    choices = _choices(ds, epoch, band, magnitude)
     todo = [f for f in wanted if f.applies(ds, choices)]
     if kinds is not None and len(todo) < len(wanted):
         _refuse_missing(dataset, ds, [f.name for f in wanted if f not in todo], choices)

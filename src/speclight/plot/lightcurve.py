@@ -96,15 +96,30 @@ def count_rate_panel(ds: xr.Dataset, ax: Any) -> None:
     ax.set_title("light curve per band", loc="left", fontsize="medium")
 
 
-def magnitude_panel(ds: xr.Dataset, ax: Any) -> None:
-    """AB magnitude per band (bright up)."""
+#: ``--magnitude`` choices: the dataset variable and the panel's axis label.
+MAGNITUDES = {
+    "ab": ("ab_magnitude", "AB magnitude [mag]"),
+    "exo": ("ab_magnitude_exo", "AB mag, above the atmosphere"),
+    "standard": ("ab_magnitude_standard", "AB mag at 1000 km, above atm."),
+    "vega": ("vega_v_magnitude", "Vega V magnitude [mag]"),
+}
+
+
+def magnitude_panel(ds: xr.Dataset, ax: Any, kind: str = "ab") -> None:
+    """Magnitudes (bright up): per band, or Vega V (one curve); ``kind`` in
+    :data:`MAGNITUDES`."""
+    name, label = MAGNITUDES[kind]
     t = ds["time"].values
-    styles = band_styles(ds)
-    mag = ds["ab_magnitude"].transpose("time", "band").values
     shade_unobservable(ax, ds)
-    for b in range(ds.sizes["band"]):
-        ax.plot(t, mag[:, b], lw=1.4, **styles[b])
+    if "band" in ds[name].dims:
+        styles = band_styles(ds)
+        mag = ds[name].transpose("time", "band").values
+        for b in range(ds.sizes["band"]):
+            ax.plot(t, mag[:, b], lw=1.4, **styles[b])
+    else:
+        mag = ds[name].values
+        ax.plot(t, mag, lw=1.4, color="0.2", label="Vega V")
     if np.isfinite(mag).any():
         ax.invert_yaxis()
-    ax.set_ylabel("AB magnitude [mag]")
+    ax.set_ylabel(label)
     ax.grid(alpha=0.3)
