@@ -16,8 +16,19 @@ AU_M = 149_597_870_700.0
 #: Nominal solar radius [m] (IAU 2015 Resolution B3; Prsa et al. 2016, AJ 152, 41,
 #: doi:10.3847/0004-6256/152/2/41).
 SUN_RADIUS_M = 695_700_000.0
+#: Mean radius of the Earth [m] (IUGG: R1 = (2a + b) / 3 of WGS84; Moritz 2000, J. Geodesy
+#: 74, 128, doi:10.1007/s001900050278): the sphere Earthshine is reflected from.
+EARTH_MEAN_RADIUS_M = 6_371_008.8
 #: AB magnitude zero point: flux density of a source of AB magnitude 0 [W m-2 Hz-1]
 #: (3631 Jy; Oke & Gunn 1983, ApJ 266, 713, doi:10.1086/160817).
 AB_ZERO_W_M2_HZ = 3631.0e-26
 
-__all__ = ["AB_ZERO_W_M2_HZ", "AU_M", "C_M_S", "HC_J_M", "H_J_S", "SUN_RADIUS_M"]
+__all__ = [
+    "AB_ZERO_W_M2_HZ",
+    "AU_M",
+    "C_M_S",
+    "EARTH_MEAN_RADIUS_M",
+    "HC_J_M",
+    "H_J_S",
+    "SUN_RADIUS_M",
+]

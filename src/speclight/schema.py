@@ -97,6 +97,11 @@ VARIABLES: dict[str, VariableInfo] = {
         "W sr-1 nm-1",
         "radiant intensity of the target toward the observer, above the atmosphere",
     ),
+    "earthshine_intensity": V(
+        TW,
+        "W sr-1 nm-1",
+        "the part of intensity from sunlight reflected by the Earth (illumination.earthshine)",
+    ),
     "transmission": V(TW, "1", "atmospheric direct-beam transmission along the line of sight"),
     "spectral_flux": V(TW, "W nm-1", "spectral power entering the telescope aperture"),
     "count_rate": V(TB, "s-1", "detected photo-electrons per second in each band"),

@@ -341,6 +341,19 @@ class Laser(Strict):
         return self
 
 
+class Earthshine(Strict):
+    """Sunlight reflected by the Earth (a grey Lambertian sphere) onto the target."""
+
+    albedo: float = Field(default=0.3, ge=0.0, le=1.0, description="The Earth's albedo [1]")
+    samples: int = Field(
+        default=64,
+        ge=4,
+        le=4096,
+        description="Cells of the visible Earth cap, each one directional source (one more "
+        "render per epoch each; 64: about 3 % accuracy)",
+    )
+
+
 class Illumination(Strict):
     sun: bool = True
     solar_disk: bool = Field(
@@ -348,6 +361,9 @@ class Illumination(Strict):
         description="Path mode: the Sun as its 0.53 deg disk (for smooth mirror glints)",
     )
     lasers: list[Laser] = Field(default_factory=list)
+    earthshine: Earthshine | None = Field(
+        default=None, description="Sunlight reflected by the Earth (off when absent)"
+    )
 
 
 class Atmosphere(Strict):

@@ -135,6 +135,8 @@ class Reflection:
     part_names: list[str] = field(default_factory=list)
     #: (N,) flag bits set by this stage (:data:`~speclight.schema.FLAG_RENDER_FAILED`).
     flags: NDArray[np.uint8] | None = None
+    #: (N, L) the part of the intensity from Earthshine (``illumination.earthshine``).
+    earthshine_W_sr_nm: F64 | None = None
 
 
 def render_reflection(
@@ -240,4 +242,64 @@ def render_reflection(
         images = {int(idx[k]): image for k, image in result.images.items()}
         for epoch, image in images.items():  # penumbra: as the intensity
             image.radiance_W_m2_sr_nm = image.radiance_W_m2_sr_nm * sunlit[epoch]
-    return Reflection(solar, intensity, std, variant, images, part_names, flags)
+    earthshine = None
+    if sc.illumination.earthshine is not None and np.any(observable):
+        if target is None:
+            target = build_target(loaded)
+        if session is None:
+            session = RenderSession.create(sc.render.mode, sc.render.variant, target.materials)
+        earthshine = earthshine_intensity(loaded, geo, solar, wavelength_nm, target, session)
+        intensity = intensity + np.nan_to_num(earthshine)  # NaN rows stay NaN (failed, unseen)
+    return Reflection(solar, intensity, std, variant, images, part_names, flags, earthshine)
+
+
+def earthshine_intensity(
+    loaded: LoadedScenario,
+    geo: Geometry,
+    solar: F64,
+    wavelength_nm: F64,
+    target: Target,
+    session: RenderSession,
+) -> F64:
+    """(N, L) intensity from Earthshine (:mod:`speclight.illumination.earthshine`): one
+    render per lit cell of the visible Earth cap and observable epoch, the cell as the Sun
+    in its direction with the irradiance ``w_k E_sun``. Unobservable epochs get NaN. The
+    target is rendered as built (articulated parts at their reference pose)."""
+    from speclight.attitude.quaternion import quat_conjugate, quat_rotate
+    from speclight.illumination.earthshine import earthshine_sources
+    from speclight.render import render_intensity
+
+    sc = loaded.scenario
+    es = sc.illumination.earthshine
+    assert es is not None
+    n = geo.t_s.size
+    out = np.full((n, wavelength_nm.size), np.nan)
+    idx = np.flatnonzero(geo.observable)
+    q = geo.quaternion_body_to_gcrs[idx]
+    sun_gcrs = quat_rotate(q, geo.sun_direction_body[idx])
+    dirs, weights = earthshine_sources(geo.r_target_gcrs_m[idx], sun_gcrs, es.albedo, es.samples)
+    weights = np.nan_to_num(weights)
+    epoch, cell = np.nonzero(weights > 0)
+    out[idx] = 0.0
+    if epoch.size == 0:
+        return out
+    q_inv = quat_conjugate(q[epoch])
+    sources_body = quat_rotate(q_inv, dirs[epoch, cell])
+    result = render_intensity(
+        target,
+        sources_body,
+        geo.observer_direction_body[idx][epoch],
+        solar[idx][epoch] * weights[epoch, cell][:, None],
+        wavelength_nm,
+        mode=session.mode,
+        variant=sc.render.variant,
+        session=session,
+        resolution_px=sc.render.resolution_px,
+        samples_per_pixel=sc.render.samples_per_pixel,
+        seed=sc.render.seed,
+        workers=os.cpu_count(),
+    )
+    total = np.zeros((idx.size, wavelength_nm.size))
+    np.add.at(total, epoch, np.nan_to_num(result.intensity_W_sr_nm))
+    out[idx] = total
+    return out

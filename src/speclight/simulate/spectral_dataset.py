@@ -29,6 +29,10 @@ def add_spectral(
     if reflection.intensity_W_sr_nm is not None:
         ds["intensity"] = schema.variable("intensity", reflection.intensity_W_sr_nm)
         ds["intensity_std"] = schema.variable("intensity_std", reflection.intensity_std_W_sr_nm)
+        if reflection.earthshine_W_sr_nm is not None:
+            ds["earthshine_intensity"] = schema.variable(
+                "earthshine_intensity", reflection.earthshine_W_sr_nm
+            )
     if radiometry is None:
         return ds
     ds = ds.assign_coords(band=("band", np.array(radiometry.band_names, dtype=str)))
