@@ -28,6 +28,7 @@ from speclight.scenario import LoadedScenario, Scenario, load_scenario, parse_sc
 from speclight.scenario.builtin_examples import example_names, example_text
 from speclight.scenario.dotted_fields import Path_, set_field
 from speclight.scenario.engines import check_engines
+from speclight.scenario.load import data_path
 from speclight.simulate.geometry_stage import time_grid
 from speclight.simulate.memory import check_run_limits, grid_epochs
 from speclight.simulate.radiometry import wavelength_grid_nm
@@ -167,20 +168,6 @@ def _set(spec: SweepSpec, data: dict[str, Any], f: Field, value: Any, where: str
         raise InputError(f"line {f.line}: {where}.{f.name}: {exc}", source=spec.source) from None
 
 
-def _data_path(loc: tuple[Any, ...], data: Any) -> Path_:
-    """The parts of a pydantic error location that index the data (union tags dropped)."""
-    path: list[str | int] = []
-    node = data
-    for part in loc:
-        if isinstance(node, dict) and part in node:
-            path.append(part)
-            node = node[part]
-        elif isinstance(node, list) and isinstance(part, int) and 0 <= part < len(node):
-            path.append(part)
-            node = node[part]
-    return tuple(path)
-
-
 def _validate(
     spec: SweepSpec, data: dict[str, Any], i: int | None, case: dict[str, Any]
 ) -> Scenario:
@@ -188,7 +175,7 @@ def _validate(
         return Scenario.model_validate(data)
     except ValidationError as exc:
         err = exc.errors()[0]
-        path = _data_path(tuple(err["loc"]), data)
+        path = tuple(data_path(tuple(err["loc"]), data)[0])
         blamed = _blame(spec, path)
         dotted = ".".join(str(p) for p in path) or "(top level)"
         if err["type"] == "extra_forbidden":

@@ -184,7 +184,7 @@ def _check_nesting(text: str, source: str) -> None:
             depth -= 1
 
 
-def _data_path(loc: tuple[Any, ...], data: Any) -> tuple[list[Any], Any, bool]:
+def data_path(loc: tuple[Any, ...], data: Any) -> tuple[list[Any], Any, bool]:
     """Keep the parts of a pydantic error location that index the input data.
 
     Pydantic inserts union-member tags into locations; they are dropped here. Returns the
@@ -273,7 +273,7 @@ def _describe(exc: ValidationError, data: dict[str, Any], root: Any) -> str:
     lines: dict[str, list[str]] = {}
     for err in exc.errors():
         loc = tuple(err["loc"])
-        path, value, _ = _data_path(loc, data)
+        path, value, _ = data_path(loc, data)
         kind = err["type"]
         if kind == "extra_forbidden":
             key = str(loc[-1])
