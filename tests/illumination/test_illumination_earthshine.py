@@ -11,6 +11,8 @@
   the Lambert sphere phase law (2/3) rho r^2 w_k E [sin a_k + (pi - a_k) cos a_k] / pi.
 """
 
+import re
+
 import numpy as np
 import pytest
 from scipy.integrate import quad
@@ -100,3 +102,16 @@ def test_pipeline_earthshine_of_a_lambertian_sphere():
     np.testing.assert_allclose(got, expected, rtol=3e-3)
     # without the Sun the intensity is the Earthshine alone
     np.testing.assert_array_equal(ds["intensity"].values[idx], got)
+
+
+@pytest.mark.parametrize(
+    ("value", "expected"),
+    [
+        ({"albedo": 1.5}, "illumination.earthshine.albedo = 1.5: Input should be less than"),
+        ({"samples": 2}, "illumination.earthshine.samples = 2: Input should be greater than"),
+        ({"albdo": 0.3}, "did you mean 'albedo'"),
+    ],
+)
+def test_bad_earthshine_fields_name_the_field(value, expected):
+    with pytest.raises(speclight.InputError, match=re.escape(expected)):
+        speclight.with_overrides(speclight.load("calsphere"), {"illumination.earthshine": value})
