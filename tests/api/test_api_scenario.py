@@ -123,3 +123,14 @@ def test_python_m_speclight_version_and_short_help():
     assert out.stdout.strip() == f"speclight {speclight.__version__}"
     help_text = subprocess.run([*run, "-h"], capture_output=True, text=True, check=True).stdout
     assert "Usage: speclight" in help_text and "simulate" in help_text
+
+
+def test_an_override_inside_a_missing_section_creates_it():
+    # compare adds filter bands to scenarios that have no instrument section this way
+    data = yaml.safe_load(example_text("calsphere"))
+    data.pop("instrument")
+    loaded = speclight.load(data)
+    assert loaded.scenario.instrument.bands == []
+    bands = [{"name": "bessell-V", "filter": "bessell-V"}]
+    changed = speclight.with_overrides(loaded, {"instrument.bands": bands})
+    assert [b.name for b in changed.scenario.instrument.bands] == ["bessell-V"]

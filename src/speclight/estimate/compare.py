@@ -18,7 +18,6 @@ from typing import Any
 
 import numpy as np
 import xarray as xr
-import yaml
 from numpy.typing import NDArray
 
 from speclight import orbit
@@ -146,9 +145,7 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
     bands = _bands(loaded, obs)
     base = loaded
     if len(bands) > len(sc.instrument.bands):  # speclite filters added
-        written = yaml.safe_load(loaded.yaml_text) or {}
-        key = "instrument.bands" if isinstance(written.get("instrument"), dict) else "instrument"
-        base = with_overrides(loaded, {key: bands if key.endswith("bands") else {"bands": bands}})
+        base = with_overrides(loaded, {"instrument.bands": bands})  # a missing section is made
     trajectory = _placed(loaded, obs) if sc.orbit.observed else None
     notes: list[str] = []
     if trajectory is None and np.any(np.isfinite(obs.elevation_deg)):
