@@ -176,14 +176,18 @@ def render_reflection(
     variant = ""
     images: dict[int, RenderImage] = {}
     part_names: list[str] = []
-    if idx.size:
-        from speclight.render import render_intensity
-
-        keep = [int(np.searchsorted(idx, i)) for i in sc.render.save_images_at if i in set(idx)]
+    earthshine_on = sc.illumination.earthshine is not None and bool(np.any(observable))
+    if idx.size or earthshine_on:
         if target is None:
             target = build_target(loaded)
         if session is None:
             session = RenderSession.create(sc.render.mode, sc.render.variant, target.materials)
+    if idx.size:
+        from speclight.render import render_intensity
+
+        assert target is not None and session is not None
+
+        keep = [int(np.searchsorted(idx, i)) for i in sc.render.save_images_at if i in set(idx)]
         part_names = [part.name for part in target.parts]
         if progress and sc.render.mode == "path":
             from speclight.simulate.memory import path_render_note
@@ -243,11 +247,8 @@ def render_reflection(
         for epoch, image in images.items():  # penumbra: as the intensity
             image.radiance_W_m2_sr_nm = image.radiance_W_m2_sr_nm * sunlit[epoch]
     earthshine = None
-    if sc.illumination.earthshine is not None and np.any(observable):
-        if target is None:
-            target = build_target(loaded)
-        if session is None:
-            session = RenderSession.create(sc.render.mode, sc.render.variant, target.materials)
+    if earthshine_on:
+        assert target is not None and session is not None
         earthshine = earthshine_intensity(loaded, geo, solar, wavelength_nm, target, session)
         intensity = intensity + np.nan_to_num(earthshine)  # NaN rows stay NaN (failed, unseen)
     return Reflection(solar, intensity, std, variant, images, part_names, flags, earthshine)
