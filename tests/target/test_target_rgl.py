@@ -175,3 +175,61 @@ def test_scenario_spec_resolves_a_relative_bsdf_path(tmp_path):
     assert m.reflectance.value == 1.0
     with pytest.raises(InputError, match="does not exist"):
         material_from_spec("paint", {**spec, "brdf_table": "other.bsdf"}, base_dir=tmp_path)
+
+
+# --- Why the numpy reader is kept instead of ``mitsuba.TensorFile`` (issue 14, item 12) ---
+# Mitsuba 3.9's Python binding of TensorFile cannot replace it: a field's ``shape`` cannot be
+# read, uint8 fields (``description``, ``jacobian``) cannot be converted, and a header whose
+# field runs past the end of the file is accepted and crashes the process when read. These
+# tests pin those facts: when one fails, Mitsuba has fixed it and the reader can be revisited.
+
+
+@needs_mitsuba
+def test_mitsuba_reads_the_same_float_values_as_the_numpy_reader(tmp_path):
+    import drjit as dr
+
+    path = _write(tmp_path)
+    from speclight.render.variant import activate
+
+    tensors = activate("scalar_spectral").TensorFile(path)
+    ours = read_tensor_file(path)
+    for k, (dt, _) in RGL_FIELDS.items():
+        if dt == "<f4":
+            theirs = np.array(tensors[k].to(dr.scalar.TensorXf))
+            np.testing.assert_array_equal(theirs, ours[k])
+
+
+@needs_mitsuba
+def test_mitsuba_tensorfile_binding_lacks_shapes_and_uint8_fields(tmp_path):
+    import drjit as dr
+
+    path = _write(tmp_path)
+    from speclight.render.variant import activate
+
+    tensors = activate("scalar_spectral").TensorFile(path)
+    with pytest.raises(TypeError, match="Unable to convert function return value"):
+        _ = tensors["spectra"].shape  # the binding cannot return std::vector<size_t>
+    with pytest.raises(Exception, match="incompatible dtype"):
+        tensors["description"].to(dr.scalar.TensorXu8)
+
+
+@needs_mitsuba
+def test_a_lying_header_is_refused_here_but_crashes_mitsuba(tmp_path):
+    # one float32 field claiming 10^6 x 10 values in a 88-byte file
+    head = b"tensor_file\0\x01\x00" + (1).to_bytes(4, "little") + b"\x01\x00a\x02\x00\x0a"
+    head += (48).to_bytes(8, "little") + (10**6).to_bytes(8, "little")
+    head += (10).to_bytes(8, "little")
+    path = tmp_path / "lying.bsdf"
+    path.write_bytes(head.ljust(88, b"\0"))
+    with pytest.raises(InputError, match=r"field 'a' runs past the end of the file"):
+        read_tensor_file(path)
+    probe = (
+        "import drjit as dr, mitsuba as mi\n"
+        "mi.set_variant('scalar_spectral')\n"
+        f"mi.TensorFile({str(path)!r})['a'].to(dr.scalar.TensorXf)\n"
+    )
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, timeout=120)
+    assert done.returncode != 0  # a signal (bus error / segfault) or an exception, not data

@@ -1,5 +1,13 @@
 """RGL measured-material files (``.bsdf``): Mitsuba tensor files, read and checked in numpy.
 
+Why not ``mitsuba.TensorFile``: Mitsuba 3.9's Python binding cannot read a field's shape
+(``Field.shape`` raises ``TypeError``), cannot convert uint8 fields (``description``,
+``jacobian``), and accepts a header whose field runs past the end of the file, then crashes
+the process (bus error) when that field is read. This reader checks every field against the
+file size and names the file and field in its errors; it also runs where Mitsuba is not
+imported (the scenario's load-time checks). tests/target/test_target_rgl.py compares its
+values with Mitsuba's and pins those three limits, so a Mitsuba that lifts them is noticed.
+
 The RGL material database (https://rgl.epfl.ch/materials) distributes spectral BRDFs measured
 with the adaptive parameterisation of Dupuy & Jakob 2018, "An Adaptive Parameterization for
 Efficient Material Acquisition and Rendering", ACM TOG 37(6) 274,
