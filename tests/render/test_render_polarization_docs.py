@@ -22,6 +22,6 @@ def test_polarization_page_runs_as_written(tmp_path: Path) -> None:
     assert shown[1].strip() == "Stokes frame" + run.stdout.split("Stokes frame")[1].rstrip()
     # the single mode's DoLP of a microfacet sphere is the Fresnel ratio at the half angle
     for line in run.stdout.splitlines()[1:13]:
-        _, name, dolp, fresnel, _ = line.split()
+        _, _, dolp, fresnel, _ = line.split()
         assert dolp == fresnel, line
     assert (tmp_path / "calsphere-polarization.png").stat().st_size > 10_000
