@@ -45,9 +45,16 @@ def _fractions(r):
     return r.stokes_W_sr_nm / r.intensity_W_sr_nm[..., None]
 
 
-def test_rough_conductor_agrees_with_single_mode() -> None:
-    gold = Material("gold", "ggx", Reflectance.conductor("Au"), roughness=0.3)
-    single, path = _both(sphere(1.0, gold), [0.2, 0.9, 0.3], [1.0, 0.0, 0.2])
+@pytest.mark.parametrize(
+    "material",
+    [
+        Material("gold", "ggx", Reflectance.conductor("Au"), roughness=0.3),
+        Material("glass", "beckmann", Reflectance.dielectric("SiO2"), roughness=0.2),
+    ],
+    ids=["rough conductor", "rough dielectric"],
+)
+def test_rough_surfaces_agree_with_single_mode(material: Material) -> None:
+    single, path = _both(sphere(1.0, material), [0.2, 0.9, 0.3], [1.0, 0.0, 0.2])
     assert path.variant.endswith("_spectral_polarized")
     st, sd = path.stokes_W_sr_nm, path.stokes_std_W_sr_nm
     i_single = single.intensity_W_sr_nm
@@ -95,3 +102,14 @@ def test_path_refuses_what_it_cannot_polarise() -> None:
     )
     with pytest.raises(InputError, match="panel"):
         RenderSession.create("path", None, [table], polarization=True)
+
+
+def test_dielectric_microfacet_without_absorption_renders_in_path_mode() -> None:
+    # k = 0 everywhere (fused silica): Mitsuba refuses an all-zero irregular spectrum, the
+    # scene gives it the constant 0 (this failed before, polarised or not)
+    glass = Material("glass", "ggx", Reflectance.dielectric("SiO2"), roughness=0.2)
+    r = render_intensity(
+        sphere(1.0, glass), [[0.2, 0.9, 0.3]], [[1.0, 0.0, 0.2]], np.ones(3), WL,
+        mode="path", resolution_px=16, samples_per_pixel=8, variant="llvm_ad_spectral",
+    )  # fmt: skip
+    assert np.all(r.intensity_W_sr_nm > 0)

@@ -54,9 +54,8 @@ def test_variables_and_frame(ds: xr.Dataset) -> None:
     assert np.all((ds["dolp"].values[lit] > 0.001) & (ds["dolp"].values[lit] < 1.0))
 
 
-def test_aolp_is_the_scattering_plane_normal_on_the_sky(ds: xr.Dataset) -> None:
-    # s-polarisation (conductors: R_s > R_p) lies along the normal to the scattering plane;
-    # its position angle from the dataset's geometry, through RA/Dec unit vectors
+def _scattering_normal_position_angle(ds: xr.Dataset) -> np.ndarray:
+    """Position angle [deg, mod 180] of the scattering plane's normal, via RA/Dec vectors."""
     q = ds["attitude_quaternion"].values
     s = _rotate(q, ds["sun_direction_body"].values)
     o = _rotate(q, ds["observer_direction_body"].values)
@@ -65,11 +64,33 @@ def test_aolp_is_the_scattering_plane_normal_on_the_sky(ds: xr.Dataset) -> None:
     e_ra = np.stack([-np.sin(ra), np.cos(ra), np.zeros_like(ra)], axis=1)
     e_dec = np.stack([-np.sin(dec) * np.cos(ra), -np.sin(dec) * np.sin(ra), np.cos(dec)], axis=1)
     normal = np.cross(s, o)
-    pa = np.degrees(np.arctan2((normal * e_ra).sum(1), (normal * e_dec).sum(1))) % 180.0
+    return np.degrees(np.arctan2((normal * e_ra).sum(1), (normal * e_dec).sum(1))) % 180.0
+
+
+def _assert_aolp_is_the_scattering_normal(ds: xr.Dataset) -> None:
+    pa = _scattering_normal_position_angle(ds)
     lit = np.isfinite(ds["aolp"].values).all(axis=1)
+    assert lit.sum() >= 2
     for b in range(ds.sizes["band"]):
         diff = (ds["aolp"].values[lit, b] - pa[lit] + 90.0) % 180.0 - 90.0
         assert np.all(np.abs(diff) < 1e-6)
+
+
+def test_aolp_is_the_scattering_plane_normal_on_the_sky(ds: xr.Dataset) -> None:
+    # s-polarisation (conductors: R_s > R_p) lies along the normal to the scattering plane;
+    # its position angle from the dataset's geometry, through RA/Dec unit vectors
+    _assert_aolp_is_the_scattering_normal(ds)
+
+
+def test_articulated_plastic_target_is_s_polarised_too(tmp_path) -> None:
+    # Sun-tracking arrays (articulated, rendered per pose) of coated plastic: the coat's
+    # reflection is s-polarised, the bases unpolarised, so the AoLP is the same angle
+    data = yaml.safe_load(example_text("gnss-meo"))
+    data["time"] = {"start": "2024-10-15T21:00:00Z", "stop": "2024-10-15T21:03:00Z", "step_s": 60}
+    data["render"].update({"resolution_px": 24, "polarization": True})
+    out = simulate(parse_scenario(yaml.safe_dump(data), base_dir=tmp_path)).dataset
+    assert np.nanmax(out["dolp"].values) > 1e-3
+    _assert_aolp_is_the_scattering_normal(out)
 
 
 def test_band_dolp_is_a_weighted_mean_of_the_spectral_dolp(ds: xr.Dataset) -> None:
@@ -104,3 +125,12 @@ def test_overview_has_a_dolp_panel(ds: xr.Dataset) -> None:
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+def test_earthshine_adds_its_stokes(tmp_path) -> None:
+    data = _scenario(tmp_path)
+    data["illumination"] = {"sun": True, "earthshine": {"albedo": 0.3, "samples": 16}}
+    out = simulate(parse_scenario(yaml.safe_dump(data), base_dir=tmp_path)).dataset
+    lit = np.isfinite(out["dolp"].values).all(axis=1)
+    assert lit.sum() >= 3 and np.all(out["dolp"].values[lit] > 0)
+    assert np.all(np.isfinite(out["intensity_q"].values[lit]))

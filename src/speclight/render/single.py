@@ -16,6 +16,12 @@ direction falls inside the disk shows the radiance ``R * E / Omega_sun``. Surfac
 two-sided (thin sheets reflect on both faces with the same material). RGL measured materials
 (``.bsdf``) do not factorise: Mitsuba's ``measured`` plugin is evaluated per pixel at the
 file's wavelength nodes, one channel per node (:mod:`speclight.render.rgl`).
+
+Polarisation (:func:`render_single_polarized`): every polarising reflection of single
+scattering (mirror, microfacet, plastic coat) has the half vector as its facet normal, so
+its plane of incidence is the scattering plane of the epoch; the Stokes Q referenced to that
+plane's normal is ``E sum_c w_c Q_c(lambda)`` with the same weights and the factors
+``(R_s - R_p) / 2`` (:mod:`speclight.render.polarization`), and U = V = 0 in that frame.
 """
 
 from __future__ import annotations
