@@ -102,6 +102,13 @@ def test_path_refuses_what_it_cannot_polarise() -> None:
     )
     with pytest.raises(InputError, match="panel"):
         RenderSession.create("path", None, [table], polarization=True)
+    grey = Material("grey", "lambertian", Reflectance.constant(0.5))
+    plain = RenderSession.create("path", None, [grey])  # made without polarization
+    with pytest.raises(InputError, match="_spectral_polarized"):
+        render_intensity(
+            sphere(1.0, grey), [[0, 0, 1.0]], [[1.0, 0, 0]], np.ones(3), WL, session=plain,
+            polarization=True, pole_body=POLE,
+        )  # fmt: skip
 
 
 def test_dielectric_microfacet_without_absorption_renders_in_path_mode() -> None:

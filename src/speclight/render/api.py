@@ -121,6 +121,12 @@ def render_intensity(
         raise InputError(
             "polarization needs pole_body (the GCRS z axis in the body frame)", field="pole_body"
         )
+    if polarization and session.mode == "path" and "polarized" not in session.variant:
+        raise InputError(
+            f"polarization in path mode needs a session with a *_spectral_polarized variant "
+            f"(RenderSession.create(..., polarization=True)), got '{session.variant}'",
+            field="render.variant",
+        )
     mode = session.mode
     if int(resolution_px) < MIN_RESOLUTION_PX:
         raise InputError(
