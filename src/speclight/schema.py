@@ -162,7 +162,8 @@ VARIABLES: dict[str, VariableInfo] = {
         TW,
         "W sr-1 nm-1",
         "Stokes V of the intensity, above the atmosphere",
-        comment=f"{POLARIZATION_FRAME}; V: Mitsuba's sign, 0 in single mode",
+        comment=f"{POLARIZATION_FRAME}; V: Mitsuba's sign (not checked against the IAU's), "
+        "0 in single mode",
     ),
     "count_rate_q": V(
         TB,
