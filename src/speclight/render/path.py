@@ -20,6 +20,10 @@ with ``solar_disk`` it shows its glint. Flat mirrors then glint with little nois
 sample of the face reaches the disk); a curved mirror's glint covers ~theta_sun^2 / 4 of its
 image (4e-6 for a sphere), so it needs ~1e7 samples per epoch for 10 % noise.
 
+In a ``*_spectral_polarized`` variant (``render.polarization``) each sample's radiance is a
+Mueller matrix; its Stokes vector is rotated to the sky's north and binned like the
+intensity (:class:`.path_sampling.PassSampler`), giving Q, U, V and their standard errors.
+
 Reference: Jakob et al., Mitsuba 3 renderer, https://mitsuba-renderer.org (2022);
 Veach 1997, Robust Monte Carlo methods for light transport simulation, PhD thesis, Stanford.
 """
