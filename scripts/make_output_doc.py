@@ -41,7 +41,8 @@ scenario names (TLE, CPF, ephemeris, mesh, tables, BRDF and material files, the 
 table, a map store: a folder's hash is that of its files' `path sha256` lines in sorted
 order) and for the Earth-orientation table used (`earth_orientation_table`). Tables shipped
 with speclight and named by their name (`detector_qe: sony-imx428-cmos`) are identified by
-`speclight_version`.
+`speclight_version`. With `render.polarization: true`, `polarization_frame` states the
+frame of the Stokes variables (docs/polarization.md).
 
 Magnitudes have no UDUNITS unit: they are written with units `1` (dimensionless, CF-1.10
 section 3.1) and a `comment` that names the system. `ab_magnitude` is at the aperture

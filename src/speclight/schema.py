@@ -43,6 +43,13 @@ VEGA_V_COMMENT = (
     "wavelength grid does not cover the V band"
 )
 
+#: The reference frame of the Stokes parameters (for their ``comment``).
+POLARIZATION_FRAME = (
+    "Stokes frame on the sky at the observer (IAU 1974): reference direction celestial "
+    "(GCRS) north at the target's position, angles from north through east; the atmosphere "
+    "is taken as unpolarising"
+)
+
 V = VariableInfo
 VARIABLES: dict[str, VariableInfo] = {
     # geometry (time)
@@ -137,6 +144,51 @@ VARIABLES: dict[str, VariableInfo] = {
         "1",
         "standard Vega V magnitude: above the atmosphere, range-normalised to 1000 km",
         comment=VEGA_V_COMMENT + "; above the atmosphere, m - 5 log10(range / 1000 km)",
+    ),
+    # polarisation (render.polarization; docs/polarization.md)
+    "intensity_q": V(
+        TW,
+        "W sr-1 nm-1",
+        "Stokes Q of the intensity, above the atmosphere",
+        comment=f"{POLARIZATION_FRAME}; Q > 0: polarised along north",
+    ),
+    "intensity_u": V(
+        TW,
+        "W sr-1 nm-1",
+        "Stokes U of the intensity, above the atmosphere",
+        comment=f"{POLARIZATION_FRAME}; U > 0: polarised at position angle 45 degree",
+    ),
+    "intensity_v": V(
+        TW,
+        "W sr-1 nm-1",
+        "Stokes V of the intensity, above the atmosphere",
+        comment=f"{POLARIZATION_FRAME}; V: Mitsuba's sign (not checked against the IAU's), "
+        "0 in single mode",
+    ),
+    "count_rate_q": V(
+        TB,
+        "s-1",
+        "Stokes Q of the count rate: count rate of light polarised along north minus along east",
+        comment=POLARIZATION_FRAME,
+    ),
+    "count_rate_u": V(
+        TB,
+        "s-1",
+        "Stokes U of the count rate: count rate polarised at position angle 45 degree minus "
+        "at 135 degree",
+        comment=POLARIZATION_FRAME,
+    ),
+    "count_rate_v": V(TB, "s-1", "Stokes V of the count rate", comment=POLARIZATION_FRAME),
+    "dolp": V(
+        TB,
+        "1",
+        "degree of linear polarisation in each band, sqrt(Q^2 + U^2) / I of the count rates",
+    ),
+    "aolp": V(
+        TB,
+        "degree",
+        "angle of linear polarisation in each band, in [0, 180), from north through east",
+        comment=POLARIZATION_FRAME,
     ),
     "intensity_std": V(
         TW, "W sr-1 nm-1", "Monte Carlo standard error of the intensity (0 in single mode)"

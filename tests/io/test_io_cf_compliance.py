@@ -45,6 +45,7 @@ def _calsphere(tmp_path: Path, **changes: object) -> dict:
 def output(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("cf")
     data = _calsphere(folder)
+    data["render"]["polarization"] = True  # the polarisation variables are checked too
     loaded = parse_scenario(yaml.safe_dump(data), base_dir=folder)
     return write_dataset(simulate(loaded).dataset, folder / "calsphere.nc")
 

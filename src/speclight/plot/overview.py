@@ -10,13 +10,15 @@ import xarray as xr
 from speclight.plot.geometry_panels import PANELS, geometry_panels
 from speclight.plot.laser_panels import laser_panel, laser_rows
 from speclight.plot.lightcurve import MAGNITUDES, count_rate_panel, magnitude_panel
+from speclight.plot.polarization_panel import dolp_panel, has_polarization
 from speclight.plot.selection import has_bands, has_spectra
 from speclight.plot.spectrogram import spectrogram_panel
 from speclight.plot.style import format_time_axis, new_figure
 
 
 def overview_figure(ds: xr.Dataset, epoch: int | None = None, magnitude: str = "ab") -> Any:
-    """Light curve per band, spectrogram, laser returns (with lasers) and geometry.
+    """Light curve per band, polarisation (with ``dolp``), spectrogram, laser returns (with
+    lasers) and geometry.
 
     ``magnitude``: the magnitudes shown (:data:`~speclight.plot.lightcurve.MAGNITUDES`: AB at
     the aperture, above the atmosphere, at 1000 km, or Vega V).
@@ -31,6 +33,8 @@ def overview_figure(ds: xr.Dataset, epoch: int | None = None, magnitude: str = "
             rows.append(("count_rate", 2.2))
         if MAGNITUDES[magnitude][0] in ds:
             rows.append(("ab_magnitude", 1.8))
+        if has_polarization(ds):
+            rows.append(("dolp", 1.6))
     if has_spectra(ds):
         rows.append(("spectrogram", 2.4))
     lasers = laser_rows(ds)
@@ -44,6 +48,8 @@ def overview_figure(ds: xr.Dataset, epoch: int | None = None, magnitude: str = "
         count_rate_panel(ds, by_name["count_rate"])
     if "ab_magnitude" in by_name:
         magnitude_panel(ds, by_name["ab_magnitude"], magnitude)
+    if "dolp" in by_name:
+        dolp_panel(ds, by_name["dolp"])
     if "spectrogram" in by_name:
         mesh, label = spectrogram_panel(ds, by_name["spectrogram"])
         cax = by_name["spectrogram"].inset_axes((1.015, 0.0, 0.018, 1.0))

@@ -9,6 +9,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError
 from speclight.progress import stage
+from speclight.render.polarization import rotate_linear, scattering_angle_on_sky
 from speclight.render.result import RenderResult
 from speclight.render.session import RenderMode, RenderSession
 from speclight.target.parts import Target
@@ -49,6 +50,8 @@ def render_intensity(
     on_hits: Callable[..., None] | None = None,
     solar_disk: bool = False,
     session: RenderSession | None = None,
+    polarization: bool = False,
+    pole_body: ArrayLike | None = None,
 ) -> RenderResult:
     """Radiant intensity of a sunlit target toward an observer, per epoch and wavelength.
 
@@ -98,15 +101,32 @@ def render_intensity(
         The run's render session (:class:`~speclight.render.session.RenderSession`: the one
         variant and the ray casters of a run); built from ``mode``, ``variant`` and the
         target's materials when not given.
+    polarization
+        Also compute Stokes Q, U, V (:mod:`speclight.render.polarization`), referenced to
+        the sky's north-east frame given by ``pole_body``.
+    pole_body
+        (N, 3) the celestial pole (GCRS z axis) in the body frame; needed with
+        ``polarization``.
 
     Returns
     -------
     RenderResult
         ``intensity_W_sr_nm`` (N, L) = sum over pixels of radiance x pixel area, NaN rows for
-        epochs whose inputs are not finite.
+        epochs whose inputs are not finite; with ``polarization`` also ``stokes_W_sr_nm``
+        (N, L, 3): Q, U, V.
     """
     if session is None:
-        session = RenderSession.create(mode, variant, target.materials)
+        session = RenderSession.create(mode, variant, target.materials, polarization=polarization)
+    if polarization and pole_body is None:
+        raise InputError(
+            "polarization needs pole_body (the GCRS z axis in the body frame)", field="pole_body"
+        )
+    if polarization and session.mode == "path" and "polarized" not in session.variant:
+        raise InputError(
+            f"polarization in path mode needs a session with a *_spectral_polarized variant "
+            f"(RenderSession.create(..., polarization=True)), got '{session.variant}'",
+            field="render.variant",
+        )
     mode = session.mode
     if int(resolution_px) < MIN_RESOLUTION_PX:
         raise InputError(
@@ -137,6 +157,16 @@ def render_intensity(
     keep_local = [remap[k] for k in keep if k in remap]
     intensity = np.full((len(sun), len(wl)), np.nan)
     std = np.full((len(sun), len(wl)), np.nan)
+    stokes = np.full((len(sun), len(wl), 3), np.nan) if polarization else None
+    stokes_std = np.full((len(sun), len(wl), 3), np.nan) if polarization else None
+    pole = None
+    if polarization:
+        assert pole_body is not None
+        pole, ok_p = _unit_rows(pole_body, "pole_body", len(sun))
+        ok = ok & ok_p
+        valid = np.flatnonzero(ok)
+        remap = {int(g): j for j, g in enumerate(valid)}
+        keep_local = [remap[k] for k in keep if k in remap]
     images = {}
     if mode == "single":
         chosen = session.variant
@@ -145,7 +175,7 @@ def render_intensity(
         if multi and not chosen.startswith(("llvm_", "cuda_")) and len(valid) > 1:
             # Dr.Jit variants already use every core; the numpy caster runs one process per
             # worker on contiguous blocks of epochs (Mitsuba scenes are never pickled).
-            inten, imgs = _single_in_processes(
+            inten, linear, imgs = _single_in_processes(
                 target,
                 sun[valid],
                 obs[valid],
@@ -154,14 +184,15 @@ def render_intensity(
                 int(resolution_px),
                 keep_local,
                 n_workers,
+                polarization,
             )
             used = "numpy"
         else:
             caster = session.caster(target)
-            from speclight.render.single import render_single
+            from speclight.render.single import render_single_polarized
 
             with stage("rendering (single)", len(valid), enabled=progress) as advance:
-                inten, imgs = render_single(
+                inten, linear, imgs = render_single_polarized(
                     target,
                     sun[valid],
                     obs[valid],
@@ -172,16 +203,23 @@ def render_intensity(
                     keep_local,
                     on_batch=advance,
                     on_hits=None if on_hits is None else _global_epochs(on_hits, valid),
+                    polarization=polarization,
                 )
             used = caster.name
         intensity[valid] = inten
         std[valid] = 0.0
+        if stokes is not None and stokes_std is not None and pole is not None:
+            assert linear is not None
+            chi = scattering_angle_on_sky(sun[valid], obs[valid], pole[valid])
+            q, u = rotate_linear(linear, np.zeros_like(linear), chi)
+            stokes[valid] = np.stack([q, u, np.zeros_like(q)], axis=-1)
+            stokes_std[valid] = 0.0
     else:
         chosen = session.variant
         from speclight.render.path import render_path
 
         with stage("rendering (path)", len(valid), enabled=progress) as advance:
-            inten, err, imgs = render_path(
+            inten, err, imgs, st, st_err = render_path(
                 target,
                 sun[valid],
                 obs[valid],
@@ -194,15 +232,19 @@ def render_intensity(
                 keep_local,
                 on_epoch=advance,
                 solar_disk=bool(solar_disk),
+                pole=None if pole is None else pole[valid],
             )
         intensity[valid] = inten
         std[valid] = err
+        if stokes is not None and stokes_std is not None and st is not None:
+            stokes[valid] = st
+            stokes_std[valid] = st_err
         used = chosen
     for j, img in imgs.items():
         g = int(valid[j])
         img.epoch = g
         images[g] = img
-    return RenderResult(intensity, std, ok, used, mode, images)
+    return RenderResult(intensity, std, ok, used, mode, images, stokes, stokes_std)
 
 
 def _global_epochs(on_hits: Callable[..., None], valid: NDArray[np.int64]) -> Callable[..., None]:
@@ -216,10 +258,12 @@ def _global_epochs(on_hits: Callable[..., None], valid: NDArray[np.int64]) -> Ca
 
 def _single_chunk(args: tuple) -> tuple:
     from speclight.render.raycast import NumpyCaster
-    from speclight.render.single import render_single
+    from speclight.render.single import render_single_polarized
 
-    target, sun, obs, e, wl, res, keep = args
-    return render_single(target, sun, obs, e, wl, NumpyCaster(target), res, keep)
+    target, sun, obs, e, wl, res, keep, polarization = args
+    return render_single_polarized(
+        target, sun, obs, e, wl, NumpyCaster(target), res, keep, polarization=polarization
+    )
 
 
 def _single_in_processes(
@@ -231,7 +275,8 @@ def _single_in_processes(
     res: int,
     keep: list[int],
     workers: int,
-) -> tuple[NDArray[np.float64], dict]:
+    polarization: bool = False,
+) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, dict]:
     import itertools
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
@@ -240,14 +285,15 @@ def _single_in_processes(
     jobs = []
     for a, b in itertools.pairwise(bounds):
         local = [k - a for k in keep if a <= k < b]
-        jobs.append((target, sun[a:b], obs[a:b], e[a:b], wl, res, local))
+        jobs.append((target, sun[a:b], obs[a:b], e[a:b], wl, res, local, polarization))
     with ProcessPoolExecutor(len(jobs), mp_context=mp.get_context("spawn")) as pool:
         parts = list(pool.map(_single_chunk, jobs))
     images = {}
-    for a, (_, imgs) in zip(bounds[:-1], parts, strict=True):
+    for a, (_, _, imgs) in zip(bounds[:-1], parts, strict=True):
         for k, img in imgs.items():
             images[int(a) + k] = img
-    return np.concatenate([p[0] for p in parts]), images
+    linear = np.concatenate([p[1] for p in parts]) if polarization else None
+    return np.concatenate([p[0] for p in parts]), linear, images
 
 
 def material_contributions(

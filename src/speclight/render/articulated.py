@@ -67,6 +67,10 @@ def render_articulated(
     images = {}
     variant, mode = session.variant, str(session.mode)
     on_hits = kwargs.pop("on_hits", None)
+    pole = kwargs.pop("pole_body", None)
+    stokes = stokes_std = None
+    if kwargs.get("polarization"):
+        stokes, stokes_std = np.full((n, n_wl, 3), np.nan), np.full((n, n_wl, 3), np.nan)
     for g, pose in enumerate(poses):
         idx = np.flatnonzero(group == g)
         if on_hits is not None:
@@ -81,17 +85,21 @@ def render_articulated(
             wavelength_nm,
             session=session,
             keep_images_for=local_keep or None,
+            pole_body=None if pole is None else np.asarray(pole)[idx],
             **kwargs,  # type: ignore[arg-type]
         )
         session.forget(posed)  # one scene alive at a time
         intensity[idx] = res.intensity_W_sr_nm
         std[idx] = res.intensity_std_W_sr_nm
         ok[idx] = res.ok
+        if stokes is not None and stokes_std is not None:
+            stokes[idx] = res.stokes_W_sr_nm
+            stokes_std[idx] = res.stokes_std_W_sr_nm
         variant, mode = res.variant, res.mode
         for j, img in res.images.items():
             img.epoch = int(idx[j])
             images[int(idx[j])] = img
-    return RenderResult(intensity, std, ok, variant, mode, images)
+    return RenderResult(intensity, std, ok, variant, mode, images, stokes, stokes_std)
 
 
 def _in_group(on_hits: Callable[..., None], idx: NDArray[np.int64]) -> Callable[..., None]:

@@ -20,6 +20,10 @@ with ``solar_disk`` it shows its glint. Flat mirrors then glint with little nois
 sample of the face reaches the disk); a curved mirror's glint covers ~theta_sun^2 / 4 of its
 image (4e-6 for a sphere), so it needs ~1e7 samples per epoch for 10 % noise.
 
+In a ``*_spectral_polarized`` variant (``render.polarization``) each sample's radiance is a
+Mueller matrix; its Stokes vector is rotated to the sky's north and binned like the
+intensity (:class:`.path_sampling.PassSampler`), giving Q, U, V and their standard errors.
+
 Reference: Jakob et al., Mitsuba 3 renderer, https://mitsuba-renderer.org (2022);
 Veach 1997, Robust Monte Carlo methods for light transport simulation, PhD thesis, Stanford.
 """
@@ -32,10 +36,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from speclight.errors import InputError
 from speclight.render.camera import image_axes, primary_rays
 from speclight.render.path_plastic import group_bases, index_groups
 from speclight.render.path_sampling import FREEZE_MIN_LAUNCHES, PassSampler, launch_count
 from speclight.render.path_scene import build_scene, set_epoch
+from speclight.render.polarization import sky_axes
 from speclight.render.raycast import Caster
 from speclight.render.result import RenderImage
 from speclight.target.parts import Target
@@ -62,8 +68,10 @@ def render_path(
     on_epoch: Callable[[int], None] | None = None,
     solar_disk: bool = False,
     coat: str = "spectral",
-) -> tuple[F64, F64, dict[int, RenderImage]]:
-    """Intensity (N, L), its standard error (N, L) [W sr-1 nm-1] and kept images.
+    pole: F64 | None = None,
+) -> tuple[F64, F64, dict[int, RenderImage], F64 | None, F64 | None]:
+    """Intensity (N, L), its standard error (N, L) [W sr-1 nm-1], kept images, and in a
+    ``*_polarized`` variant the Stokes Q, U, V (N, L, 3) and their standard errors.
 
     ``session``: the run's render session (its spectral variant; its ray caster gives the
     kept images' depth maps and part indices). ``on_epoch(1)`` is called after each epoch.
@@ -75,8 +83,11 @@ def render_path(
     bins, one ``mi.render`` per group, epoch and pass; kept as a reference for the tests).
     Scalar variants (no Dr.Jit kernels to trace a Python BSDF or a sample loop into) always
     render the grouped way.
+    ``pole`` (N, 3): the celestial pole in the body frame; the Stokes vectors are referenced
+    to the sky's north (:mod:`speclight.render.polarization`). Needed in a polarised variant.
     """
     mi = session.activate()  # a *_spectral variant (RenderSession.create checks it)
+    polarized = "polarized" in session.variant
     # A single wavelength is rendered as a 1 nm wide bin around it.
     lo, hi = grid_bin_bounds_nm(wavelength_nm)
     width = hi - lo
@@ -90,6 +101,16 @@ def render_path(
     acc = {e: np.zeros((res, res, n_wl)) for e in set(keep)}
     import drjit as dr
 
+    stokes_sums = np.zeros((n_ep, 3, passes, n_wl)) if polarized else None
+    north = None
+    if polarized:
+        if not dr.is_jit_v(mi.Float) or pole is None:
+            raise InputError(
+                f"render.polarization in render.mode 'path' needs an llvm_ad or cuda_ad "
+                f"*_spectral_polarized variant (got '{session.variant}') and the pole",
+                field="render.variant",
+            )
+        north, _ = sky_axes(obs_dir, pole)
     if coat == "grouped" or not dr.is_jit_v(mi.Float):  # scalar variants: the film loop
         _render_grouped(
             mi,
@@ -112,7 +133,11 @@ def render_path(
         sampler = PassSampler(mi, scene, centre, radius, lo, hi, res, spp, passes, freeze)
         for e in range(n_ep):
             set_epoch(mi, params, target, sun_dir[e], obs_dir[e], solar_disk)
-            s, img = sampler.epoch(obs_dir[e], seed, e, image=e in acc)
+            basis = None if north is None else north[e]
+            s, img = sampler.epoch(obs_dir[e], seed, e, image=e in acc, north=basis)
+            if stokes_sums is not None:
+                stokes_sums[e] = s[1:] / spp * pixel_area / width
+                s = s[0]
             sums[e] = s / spp * pixel_area / width
             if img is not None:
                 acc[e] = img / spp
@@ -124,6 +149,12 @@ def render_path(
         err = sums.std(axis=1, ddof=1) / np.sqrt(passes) * irradiance
     else:
         err = np.full((n_ep, n_wl), np.nan)
+    stokes = stokes_err = None
+    if stokes_sums is not None:
+        e3 = irradiance[:, None, :]
+        stokes = np.moveaxis(stokes_sums.mean(axis=2) * e3, 1, 2)
+        spread = stokes_sums.std(axis=2, ddof=1) / np.sqrt(passes) if passes > 1 else np.nan
+        stokes_err = np.moveaxis(np.broadcast_to(spread, (*stokes_sums.shape[:2], n_wl)) * e3, 1, 2)
     images = {
         e: _image(
             e,
@@ -135,7 +166,7 @@ def render_path(
         )
         for e, a_e in acc.items()
     }
-    return mean, err, images
+    return mean, err, images, stokes, stokes_err
 
 
 def _render_grouped(

@@ -83,6 +83,14 @@ class PassSampler:
     freeze
         Freeze the launch (recording it costs about ten traced launches; the replays save
         about half an epoch each): worth it from :data:`FREEZE_MIN_LAUNCHES` launches.
+
+    In a ``*_polarized`` variant the integrator's radiance is a Mueller matrix whose first
+    column is the Stokes vector, referenced to Mitsuba's implicit basis
+    ``mueller.stokes_basis(-ray.d)``; each sample's Stokes vector is rotated to the basis
+    ``north`` given per epoch (Mitsuba's second axis is then ``(-ray.d) x north``: east on the
+    sky, :mod:`speclight.render.polarization`) and its four components binned. No film and
+    no ``stokes`` integrator are used (the latter's AOV channels crash with AOV output and
+    ``specfilm`` breaks with its Stokes output).
     """
 
     def __init__(
@@ -104,6 +112,7 @@ class PassSampler:
         self.centre, self.radius = np.asarray(centre, float), float(radius_m)
         self.res, self.spp, self.passes = int(resolution_px), int(spp), int(passes)
         self.n_bins = len(edges_lo)
+        self.n_stokes = 4 if "polarized" in mi.variant() else 1
         self.lo_nm = float(edges_lo[0])
         self.width_nm = float(edges_hi[-1] - edges_lo[0])
         self.hi_edges = mi.Float(np.asarray(edges_hi, np.float32))
@@ -120,22 +129,29 @@ class PassSampler:
         """Drop the frozen launch (its recordings, and the cycle through ``self``)."""
         self._frozen = None
 
-    def epoch(self, obs: F64, seed: int, epoch: int, image: bool = False) -> tuple[F64, F64 | None]:
+    def epoch(
+        self, obs: F64, seed: int, epoch: int, image: bool = False, north: F64 | None = None
+    ) -> tuple[F64, F64 | None]:
         """Sums (passes, L) over samples of ``L W / n`` per bin, and per pixel (res, res, L)
-        over all passes when ``image``; divide by ``spp`` for the film's pixel values."""
+        over all passes when ``image``; divide by ``spp`` for the film's pixel values.
+
+        Polarised variant: the sums are (4, passes, L), Stokes I, Q, U, V referenced to
+        ``north`` (3,) (the image stays intensity only)."""
         obs = np.asarray(obs, float)
         total = self.passes * self.res * self.res * self.spp
-        sums = np.zeros(self.passes * self.n_bins)
+        sums = np.zeros(self.n_stokes * self.passes * self.n_bins)
         pixels: F64 | None = None  # the first launch's array, then added to
         right, up = image_axes(obs[None, :])
-        frame = (self.centre + 2.0 * self.radius * obs, right[0], up[0], -obs)
+        basis = up[0] if north is None else np.asarray(north, float)
+        frame = (self.centre + 2.0 * self.radius * obs, right[0], up[0], -obs, basis)
         for c, start in enumerate(range(0, total, MAX_LANES)):
             n = min(MAX_LANES, total - start)
             s, px = self._launch(frame, launch_seed(seed, epoch, c), start, n, image)
             sums += s
             if px is not None:
                 pixels = px if pixels is None else pixels + px
-        out = sums.reshape(self.passes, self.n_bins)
+        shape = (self.passes, self.n_bins)
+        out = sums.reshape((self.n_stokes, *shape) if self.n_stokes > 1 else shape)
         img = None if pixels is None else pixels.reshape(self.res, self.res, self.n_bins)
         return out, img
 
@@ -145,7 +161,7 @@ class PassSampler:
         import drjit as dr
 
         mi = self.mi
-        origin, right, up, direction = (dr.opaque(mi.Vector3f, v.tolist()) for v in frame)
+        origin, right, up, direction, basis = (dr.opaque(mi.Vector3f, v.tolist()) for v in frame)
         # 64-bit lane numbers: an epoch may have more than 2^32 samples (4096 px x 256 spp)
         uint64: Any = dr.uint64_array_t(mi.UInt32)
         first = dr.opaque(uint64, start)
@@ -158,6 +174,7 @@ class PassSampler:
             right,
             up,
             direction,
+            basis,
             self.hi_edges,
             n,
             image,
@@ -183,11 +200,12 @@ class PassSampler:
         nb = self.n_bins
         v = np.concatenate([x.numpy() for x in values]).astype(float)
         k = np.concatenate([x.numpy() for x in keys])
-        sums = np.bincount(k, v, self.passes * nb).astype(float)
+        sums = np.bincount(k, v, self.n_stokes * self.passes * nb).astype(float)
         if not image:
             return sums, None
         pk = np.concatenate([x.numpy() for x in pixel_keys])
-        return sums, np.bincount(pk, v, self.res * self.res * nb).astype(float)
+        v0 = v[: len(pk)]  # the first values are the intensity's (Stokes I)
+        return sums, np.bincount(pk, v0, self.res * self.res * nb).astype(float)
 
     def _trace(
         self,
@@ -198,6 +216,7 @@ class PassSampler:
         right: Any,
         up: Any,
         direction: Any,
+        basis: Any,
         hi_edges: Any,
         n: int,
         image: bool,
@@ -219,8 +238,8 @@ class PassSampler:
         x = ((mi.Float(col) + u.x) * (2.0 / res) - 1.0) * self.radius
         y = (1.0 - (mi.Float(row) + u.y) * (2.0 / res)) * self.radius
         u_wl = self.sampler.next_1d()
-        n_wl = dr.size_v(mi.Spectrum)
-        lam = mi.Spectrum(
+        n_wl = dr.size_v(mi.UnpolarizedSpectrum)
+        lam = mi.UnpolarizedSpectrum(
             *[self.lo_nm + self.width_nm * _frac(dr, u_wl + j / n_wl) for j in range(n_wl)]
         )
         ray = mi.Ray3f(mi.Point3f(origin + x * right + y * up), mi.Vector3f(direction), 0.0, lam)
@@ -228,14 +247,25 @@ class PassSampler:
             scene, self.sampler, mi.RayDifferential3f(ray), None, True
         )
         pas = mi.UInt32(idx // (res * res * spp))
+        if self.n_stokes > 1:  # Stokes vector (first column), rotated to the basis
+            forward = -mi.Vector3f(direction)
+            current = mi.mueller.stokes_basis(forward)
+            rotated = mi.mueller.rotate_stokes_basis(forward, current, basis) @ radiance
+            components = [rotated[c][0] for c in range(4)]
+        else:
+            components = [radiance]
         keys, pixel_keys, values = [], [], []
+        bins = []
         for j in range(n_wl):
             wl_j = lam[j]
             b = dr.binary_search(0, nb - 1, lambda i, w=wl_j: dr.gather(mi.Float, hi_edges, i) <= w)
-            keys.append(pas * nb + b)
+            bins.append(b)
             if image:
                 pixel_keys.append(pix * nb + b)
-            values.append(radiance[j] * (self.width_nm / n_wl))
+        for c, comp in enumerate(components):
+            for j in range(n_wl):
+                keys.append((c * self.passes + pas) * nb + bins[j])
+                values.append(comp[j] * (self.width_nm / n_wl))
         return keys, pixel_keys, values
 
 

@@ -78,7 +78,9 @@ def _bsdf(m: Material, lo: float, hi: float, coat: str = "spectral") -> Any:
         if refl.is_fresnel:
             eta = refl.eta(grid)
             inner["eta"] = _spectrum(grid, eta.real)
-            inner["k"] = _spectrum(grid, eta.imag)
+            # an all-zero irregular spectrum is refused by Mitsuba ("no probability mass"):
+            # a dielectric without absorption (k = 0) gets the constant 0
+            inner["k"] = _spectrum(grid, eta.imag) if np.any(eta.imag != 0) else 0.0
         else:
             inner["material"] = "none"
             inner["specular_reflectance"] = _refl_spectrum(refl, lo, hi)

@@ -48,6 +48,11 @@ class RenderResult:
         ``single`` or ``path``.
     images
         Epoch index -> :class:`RenderImage` for the epochs asked for in ``keep_images_for``.
+    stokes_W_sr_nm
+        (N, L, 3) Stokes Q, U, V of the intensity [W sr-1 nm-1] in the sky's north-east
+        frame (:mod:`speclight.render.polarization`); None unless polarisation was asked.
+    stokes_std_W_sr_nm
+        (N, L, 3) their Monte Carlo standard errors (zero in single mode).
     """
 
     intensity_W_sr_nm: NDArray[np.float64]
@@ -56,3 +61,5 @@ class RenderResult:
     variant: str
     mode: str
     images: dict[int, RenderImage] = field(default_factory=dict)
+    stokes_W_sr_nm: NDArray[np.float64] | None = None
+    stokes_std_W_sr_nm: NDArray[np.float64] | None = None

@@ -5,6 +5,7 @@ target's materials, and hands the session to the Sun render, the laser render an
 else, so that no stage can switch it during the run:
 
 * ``path`` mode and RGL measured materials need a spectral variant (``*_spectral``);
+* ``path`` mode with ``render.polarization`` needs ``*_spectral_polarized``;
 * single mode without them casts rays only, and the ``*_rgb`` variant is enough;
 * without Mitsuba (or with ``render.variant: numpy``) single mode casts rays with numpy.
 """
@@ -16,6 +17,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from speclight.errors import InputError
+from speclight.render.polarization import check_polarizable
 from speclight.render.raycast import Caster, make_caster
 from speclight.render.rgl import is_rgl
 from speclight.render.variant import activate, choose_variant
@@ -39,20 +41,37 @@ class RenderSession:
 
     @classmethod
     def create(
-        cls, mode: str, requested: str | None, materials: Iterable[Material]
+        cls,
+        mode: str,
+        requested: str | None,
+        materials: Iterable[Material],
+        polarization: bool = False,
     ) -> RenderSession:
         """Choose the variant for ``mode`` and the target's ``materials``.
 
         ``requested``: the scenario's ``render.variant`` (``None``/``"auto"`` for the best one).
+        ``polarization``: the scenario's ``render.polarization`` (path mode then needs a
+        ``*_spectral_polarized`` variant; the single mode computes polarisation itself).
         """
         if mode not in ("single", "path"):
             raise InputError(
                 f"render.mode = '{mode}' must be 'single' or 'path'", field="render.mode"
             )
+        materials = list(materials)
         rgl = any(is_rgl(m) for m in materials)
-        variant = choose_variant(requested, spectral=mode == "path" or rgl)
+        polarized = polarization and mode == "path"
+        if polarization:
+            check_polarizable(materials, mode)
+        variant = choose_variant(requested, spectral=mode == "path" or rgl, polarized=polarized)
         spectral = variant.endswith("_spectral")
-        if mode == "path" and not spectral:
+        if polarized and not variant.endswith("_spectral_polarized"):
+            raise InputError(
+                f"render.polarization in render.mode 'path' needs a *_spectral_polarized "
+                f"variant, got '{variant}' (use 'auto', llvm_ad_spectral_polarized, "
+                "cuda_ad_spectral_polarized or scalar_spectral_polarized)",
+                field="render.variant",
+            )
+        if mode == "path" and not (spectral or polarized):
             raise InputError(
                 f"render.mode 'path' needs a *_spectral variant, got '{variant}' "
                 "(use 'auto', llvm_ad_spectral, cuda_ad_spectral or scalar_spectral)",

@@ -16,6 +16,12 @@ direction falls inside the disk shows the radiance ``R * E / Omega_sun``. Surfac
 two-sided (thin sheets reflect on both faces with the same material). RGL measured materials
 (``.bsdf``) do not factorise: Mitsuba's ``measured`` plugin is evaluated per pixel at the
 file's wavelength nodes, one channel per node (:mod:`speclight.render.rgl`).
+
+Polarisation (:func:`render_single_polarized`): every polarising reflection of single
+scattering (mirror, microfacet, plastic coat) has the half vector as its facet normal, so
+its plane of incidence is the scattering plane of the epoch; the Stokes Q referenced to that
+plane's normal is ``E sum_c w_c Q_c(lambda)`` with the same weights and the factors
+``(R_s - R_p) / 2`` (:mod:`speclight.render.polarization`), and U = V = 0 in that frame.
 """
 
 from __future__ import annotations
@@ -29,6 +35,7 @@ from numpy.typing import NDArray
 from speclight.render import material_channels as channels
 from speclight.render.camera import image_axes, primary_rays
 from speclight.render.material_channels import ChannelLayout, pixel_contributions
+from speclight.render.polarization import check_polarizable, main_linear_factor
 from speclight.render.raycast import Caster
 from speclight.render.result import RenderImage
 from speclight.render.shading import dot_rows, half_vectors, mirror_in_sun
@@ -137,6 +144,74 @@ def render_single(
     on_hits: Callable[..., None] | None = None,
 ) -> tuple[F64, dict[int, RenderImage]]:
     """Intensity (N, L) [W sr-1 nm-1] of valid epochs and the kept images (see module doc)."""
+    intensity, _, images = _render(
+        target,
+        sun_dir,
+        obs_dir,
+        irradiance,
+        wavelength_nm,
+        caster,
+        resolution_px,
+        keep,
+        on_batch,
+        on_hits,
+        polarization=False,
+    )
+    return intensity, images
+
+
+def render_single_polarized(
+    target: Target,
+    sun_dir: F64,
+    obs_dir: F64,
+    irradiance: F64,
+    wavelength_nm: F64,
+    caster: Caster,
+    resolution_px: int,
+    keep: Iterable[int] = (),
+    on_batch: Callable[[int], None] | None = None,
+    on_hits: Callable[..., None] | None = None,
+    polarization: bool = True,
+) -> tuple[F64, F64 | None, dict[int, RenderImage]]:
+    """Intensity (N, L), its linear polarisation Q_s (N, L) [W sr-1 nm-1] and kept images.
+
+    ``Q_s`` is the Stokes Q referenced to the normal of the scattering plane (the plane of
+    the Sun and observer directions): positive when the light is polarised perpendicular to
+    it. U = V = 0 in that frame: every polarising reflection of single scattering (mirror,
+    microfacet, plastic coat) has its plane of incidence in the scattering plane
+    (:mod:`speclight.render.polarization`); diffuse channels are unpolarised. Without
+    ``polarization``: :func:`render_single`, and ``Q_s`` is None.
+    """
+    if polarization:
+        check_polarizable(target.materials)
+    return _render(
+        target,
+        sun_dir,
+        obs_dir,
+        irradiance,
+        wavelength_nm,
+        caster,
+        resolution_px,
+        keep,
+        on_batch,
+        on_hits,
+        polarization,
+    )
+
+
+def _render(
+    target: Target,
+    sun_dir: F64,
+    obs_dir: F64,
+    irradiance: F64,
+    wavelength_nm: F64,
+    caster: Caster,
+    resolution_px: int,
+    keep: Iterable[int],
+    on_batch: Callable[[int], None] | None,
+    on_hits: Callable[..., None] | None,
+    polarization: bool,
+) -> tuple[F64, F64 | None, dict[int, RenderImage]]:
     channels.check_supported(target.materials)
     keep = list(keep)
     w, kept, pitch, layout = geometric_weights(
@@ -158,6 +233,10 @@ def render_single(
     for k, start in layout.block.items():
         total = total + w[:, start : start + blocks[k].shape[0]] @ blocks[k]
     intensity = irradiance * total
+    linear = None
+    if polarization:  # the block channels (diffuse bases) are unpolarised
+        q = [main_linear_factor(m, cos_half, wavelength_nm) for m in layout.mats]
+        linear = irradiance * sum(w[:, k, None] * q[k] for k in range(n_mat))
     images: dict[int, RenderImage] = {}
     for e, kp in kept.items():
         factor = np.zeros((layout.n_channels, len(wavelength_nm)))
@@ -179,7 +258,7 @@ def render_single(
             right_body=kp.right,
             up_body=kp.up,
         )
-    return intensity, images
+    return intensity, linear, images
 
 
 def material_contributions(

@@ -141,7 +141,9 @@ def available_variants() -> list[str]:
     return out
 
 
-def choose_variant(requested: str | None = None, spectral: bool = True) -> str:
+def choose_variant(
+    requested: str | None = None, spectral: bool = True, polarized: bool = False
+) -> str:
     """Name of the Mitsuba variant to use.
 
     Parameters
@@ -150,6 +152,8 @@ def choose_variant(requested: str | None = None, spectral: bool = True) -> str:
         An explicit variant (must be available) or ``None``/``"auto"`` for the best one.
     spectral
         Prefer ``*_spectral`` (path tracing) over ``*_rgb`` (ray casting only needs geometry).
+    polarized
+        Choose a ``*_spectral_polarized`` variant (polarised path tracing).
 
     Returns
     -------
@@ -173,7 +177,7 @@ def choose_variant(requested: str | None = None, spectral: bool = True) -> str:
             stacklevel=2,
         )
         return "numpy"
-    tail = "spectral" if spectral else "rgb"
+    tail = "spectral_polarized" if polarized else "spectral" if spectral else "rgb"
     for prefix in ("cuda_ad_", "llvm_ad_"):
         if prefix + tail in avail:
             return prefix + tail

@@ -453,6 +453,11 @@ class Render(Strict):
         description="Also write reflectance_factor_material(time, material, band): each "
         "material's share of the band reflectance factors (single mode only)",
     )
+    polarization: bool = Field(
+        default=False,
+        description="Also compute Stokes Q, U, V (north-east sky frame) and the degree and "
+        "angle of linear polarisation per band (modes single and path; docs/polarization.md)",
+    )
 
     @model_validator(mode="after")
     def _samples(self) -> Render:
@@ -463,6 +468,11 @@ class Render(Strict):
             )
         if self.mode == "map" and self.save_images_at:
             raise ValueError("save_images_at needs mode single or path: mode map renders nothing")
+        if self.polarization and self.mode == "map":
+            raise ValueError(
+                "polarization: true needs mode single or path: a reflectivity map (mode: map) "
+                "holds intensity only"
+            )
         if self.per_material and self.mode != "single":
             raise ValueError(
                 f"per_material: true needs mode: single (got mode: {self.mode}); the shares "

@@ -23,6 +23,7 @@ from speclight.simulate.per_material import (
     material_labels,
     solar_material_factors,
 )
+from speclight.simulate.polarimetry import add_polarization
 from speclight.simulate.radiometry import (
     atmosphere_transmission,
     instrument_response,
@@ -120,7 +121,9 @@ def _simulate(
     target = build_target(loaded) if sc.target is not None and not map_mode else None
     # the one render variant of the run, handed to every render (Sun and lasers)
     session = (
-        RenderSession.create(sc.render.mode, sc.render.variant, target.materials)
+        RenderSession.create(
+            sc.render.mode, sc.render.variant, target.materials, sc.render.polarization
+        )
         if target is not None
         else None
     )
@@ -177,6 +180,16 @@ def _simulate(
     ds = geometry_dataset(geo, flags)
     ds = add_spectral(ds, wavelength_nm, reflection, transmission, radiometry)
     ds = add_images(ds, reflection.images, reflection.part_names)
+    if reflection.stokes_W_sr_nm is not None:
+        ds = add_polarization(
+            ds,
+            loaded,
+            wavelength_nm,
+            reflection.stokes_W_sr_nm,
+            transmission,
+            geo.range_m,
+            radiometry,
+        )
     if sc.render.per_material and radiometry is not None and radiometry.band_names:
         assert session is not None and target is not None  # per_material: rendered
         solar = None

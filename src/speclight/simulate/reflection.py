@@ -137,6 +137,10 @@ class Reflection:
     flags: NDArray[np.uint8] | None = None
     #: (N, L) the part of the intensity from Earthshine (``illumination.earthshine``).
     earthshine_W_sr_nm: F64 | None = None
+    #: (N, L, 3) Stokes Q, U, V of the intensity in the sky's north-east frame, and their
+    #: standard errors (``render.polarization``; :mod:`speclight.render.polarization`).
+    stokes_W_sr_nm: F64 | None = None
+    stokes_std_W_sr_nm: F64 | None = None
 
 
 def render_reflection(
@@ -166,11 +170,17 @@ def render_reflection(
     n, n_wl = geo.t_s.size, wavelength_nm.size
     intensity = np.full((n, n_wl), np.nan)
     std = np.full((n, n_wl), np.nan)
+    polarized = sc.render.polarization
+    stokes = np.full((n, n_wl, 3), np.nan) if polarized else None
+    stokes_std = np.full((n, n_wl, 3), np.nan) if polarized else None
     observable = geo.observable
     sunlit = geo.sunlit_fraction if sc.illumination.sun else np.zeros(n)
     lit = observable & (sunlit > 0)
     intensity[observable & ~lit] = 0.0
     std[observable & ~lit] = 0.0
+    if stokes is not None and stokes_std is not None:
+        stokes[observable & ~lit] = 0.0
+        stokes_std[observable & ~lit] = 0.0
     idx = np.flatnonzero(lit)
     flags = np.zeros(n, dtype=np.uint8)
     variant = ""
@@ -181,7 +191,9 @@ def render_reflection(
         if target is None:
             target = build_target(loaded)
         if session is None:
-            session = RenderSession.create(sc.render.mode, sc.render.variant, target.materials)
+            session = RenderSession.create(
+                sc.render.mode, sc.render.variant, target.materials, sc.render.polarization
+            )
     if idx.size:
         from speclight.render import render_intensity
 
@@ -201,6 +213,8 @@ def render_reflection(
             on_hits=None if on_hits is None else on_hits(idx),
             solar_disk=sc.illumination.solar_disk,
         )
+        if polarized:
+            common.update(polarization=True, pole_body=pole_body(geo)[idx])
         sun_b, obs_b = geo.sun_direction_body[idx], geo.observer_direction_body[idx]
         joints = build_joints(loaded, target) if sc.target.articulation else ()
         if joints:
@@ -242,6 +256,10 @@ def render_reflection(
             std[idx] = 0.0
         failed = idx[~(result.ok & np.all(np.isfinite(result.intensity_W_sr_nm), axis=1))]
         flags[failed] |= schema.FLAG_RENDER_FAILED
+        if stokes is not None and stokes_std is not None:
+            assert result.stokes_W_sr_nm is not None and result.stokes_std_W_sr_nm is not None
+            stokes[idx] = result.stokes_W_sr_nm * scale[:, :, None]
+            stokes_std[idx] = result.stokes_std_W_sr_nm * scale[:, :, None]
         variant = result.variant
         images = {int(idx[k]): image for k, image in result.images.items()}
         for epoch, image in images.items():  # penumbra: as the intensity
@@ -249,9 +267,23 @@ def render_reflection(
     earthshine = None
     if earthshine_on:
         assert target is not None and session is not None
-        earthshine = earthshine_intensity(loaded, geo, solar, wavelength_nm, target, session)
+        earthshine, es_stokes = earthshine_intensity(
+            loaded, geo, solar, wavelength_nm, target, session
+        )
         intensity = intensity + np.nan_to_num(earthshine)  # NaN rows stay NaN (failed, unseen)
-    return Reflection(solar, intensity, std, variant, images, part_names, flags, earthshine)
+        if stokes is not None and es_stokes is not None:
+            stokes = stokes + np.nan_to_num(es_stokes)
+    return Reflection(
+        solar, intensity, std, variant, images, part_names, flags, earthshine, stokes, stokes_std
+    )
+
+
+def pole_body(geo: Geometry) -> F64:
+    """(N, 3) the celestial pole (GCRS z axis) in the body frame at each epoch."""
+    from speclight.attitude.quaternion import quat_conjugate, quat_rotate
+
+    q = quat_conjugate(geo.quaternion_body_to_gcrs)
+    return np.asarray(quat_rotate(q, np.broadcast_to([0.0, 0.0, 1.0], (len(q), 3))))
 
 
 def earthshine_intensity(
@@ -261,11 +293,15 @@ def earthshine_intensity(
     wavelength_nm: F64,
     target: Target,
     session: RenderSession,
-) -> F64:
+) -> tuple[F64, F64 | None]:
     """(N, L) intensity from Earthshine (:mod:`speclight.illumination.earthshine`): one
     render per lit cell of the visible Earth cap and observable epoch, the cell as the Sun
     in its direction with the irradiance ``w_k E_sun``. Unobservable epochs get NaN. The
-    target is rendered as built (articulated parts at their reference pose)."""
+    target is rendered as built (articulated parts at their reference pose).
+
+    With ``render.polarization`` also its Stokes Q, U, V (N, L, 3) (else None): the light of
+    each cell is taken as unpolarised (the Rayleigh polarisation of the sky over the Earth
+    is not modelled)."""
     from speclight.attitude.quaternion import quat_conjugate, quat_rotate
     from speclight.illumination.earthshine import earthshine_sources
     from speclight.render import render_intensity
@@ -282,8 +318,12 @@ def earthshine_intensity(
     weights = np.nan_to_num(weights)
     epoch, cell = np.nonzero(weights > 0)
     out[idx] = 0.0
+    polarized = sc.render.polarization
+    stokes = np.full((n, wavelength_nm.size, 3), np.nan) if polarized else None
+    if stokes is not None:
+        stokes[idx] = 0.0
     if epoch.size == 0:
-        return out
+        return out, stokes
     q_inv = quat_conjugate(q[epoch])
     sources_body = quat_rotate(q_inv, dirs[epoch, cell])
     result = render_intensity(
@@ -299,8 +339,14 @@ def earthshine_intensity(
         samples_per_pixel=sc.render.samples_per_pixel,
         seed=sc.render.seed,
         workers=os.cpu_count(),
+        polarization=polarized,
+        pole_body=pole_body(geo)[idx][epoch] if polarized else None,
     )
     total = np.zeros((idx.size, wavelength_nm.size))
     np.add.at(total, epoch, np.nan_to_num(result.intensity_W_sr_nm))
     out[idx] = total
-    return out
+    if stokes is not None and result.stokes_W_sr_nm is not None:
+        total3 = np.zeros((idx.size, wavelength_nm.size, 3))
+        np.add.at(total3, epoch, np.nan_to_num(result.stokes_W_sr_nm))
+        stokes[idx] = total3
+    return out, stokes
