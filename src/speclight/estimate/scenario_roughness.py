@@ -130,7 +130,7 @@ def roughness_problems(rough: list[str], fit: Any) -> list[str]:
             )
         elif min(value - ROUGHNESS_BOUNDS[0], ROUGHNESS_BOUNDS[1] - value) < 1e-6:
             out.append(f"roughness of material '{name}' stopped at a bound ({value:g})")
-        elif np.nanmin(fit.profile[k]) < 1.0:
+        elif np.any(np.isfinite(fit.profile[k])) and np.nanmin(fit.profile[k]) < 1.0:
             side = "below" if fit.profile[k, 0] < fit.profile[k, 1] else "above"
             out.append(
                 f"roughness of material '{name}' is not at a well-defined minimum: chi2 "
