@@ -87,8 +87,10 @@ def _cube(text=ONE):
     return (DATA / "spinning_cube.yaml").read_text().replace(ONE, text)
 
 
-@pytest.mark.parametrize(("materials", "rough", "alpha"), [(ONE, ["*"], [0.12]),
-                                                          (TWO, ["+x", "*"], [0.12, 0.2])])  # fmt: skip
+CASES = [(ONE, ["*"], [0.12]), (TWO, ["+x", "*"], [0.12, 0.2])]
+
+
+@pytest.mark.parametrize(("materials", "rough", "alpha"), CASES)
 def test_count_rate_derivatives_match_central_differences_of_simulate(materials, rough, alpha):
     loaded = replace_fields(
         parse_scenario(_cube(materials), source="t"), {"instrument.noise": None}
@@ -103,7 +105,9 @@ def test_count_rate_derivatives_match_central_differences_of_simulate(materials,
     np.testing.assert_allclose(c[lit], ref[lit], rtol=1e-12)  # the same chain, same sums
 
     def sim(a):
-        values = {f"target.materials.{n}.roughness": float(v) for n, v in zip(rough, a)}
+        values = {
+            f"target.materials.{n}.roughness": float(v) for n, v in zip(rough, a, strict=True)
+        }
         run = simulate(replace_fields(loaded, values), geometry=base.geometry)
         return run.dataset["count_rate"].transpose("time", "band").values
 
