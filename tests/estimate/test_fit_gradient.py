@@ -7,7 +7,10 @@ References:
   truncation error sets: a central difference of step h errs by c h^2, so D(h/2) errs by
   |D(h) - D(h/2)| / 3; the analytic value must lie within half of |D(h) - D(h/2)| of D(h/2);
 * the fit: recovery of the roughness the noisy data were simulated with (Poisson draws,
-  fixed seed) from a start a factor 10 away, to within 3 of the fit's own standard deviations.
+  fixed seed) from a start a factor 10 away, to within 3 of the fit's own standard deviations;
+  on a closed-form glint model, the spread of the fitted roughness over many noise draws
+  (Monte Carlo) against the reported standard deviation, and the projected residuals'
+  Jacobian against central differences of the projected residuals.
 """
 
 from pathlib import Path
@@ -18,6 +21,7 @@ import yaml
 
 from speclight.errors import InputError
 from speclight.estimate import fit_scenario
+from speclight.estimate.gradient_fit import projected_residuals, fit_roughness_gradient
 from speclight.estimate.measured import MeasuredLightCurve
 from speclight.estimate.roughness_gradient import RoughnessRates
 from speclight.render.brdf import microfacet_d, microfacet_weight, smith_g1
@@ -75,6 +79,53 @@ def test_microfacet_derivatives_match_central_differences_of_the_formulas(kind, 
         floor = 1e-12 * np.abs(f(alpha)).max() / h  # rounding of the differences
         ok = _within_truncation(analytic, fd_h, fd_half, floor)
         assert np.all(ok | ~ok_here), np.abs(analytic - fd_half)[~ok & ok_here].max()
+
+
+T = np.linspace(-1.0, 1.0, 201)
+GAIN = np.array([1000.0, 400.0])
+
+
+def _glint(alpha):
+    """A Gaussian glint of width alpha on a baseline in two bands (N, 2), and d/dalpha."""
+    g = np.exp(-0.5 * (T / alpha[0]) ** 2)
+    c = (g + 0.05)[:, None] * GAIN[None, :]
+    dc = (g * T**2 / alpha[0] ** 3)[:, None] * GAIN[None, :]
+    return c, dc[None]
+
+
+def test_projected_jacobian_is_the_derivative_of_the_projected_residuals():
+    rng = np.random.default_rng(3)
+    clean = _glint(np.array([0.12]))[0] * np.array([0.8, 1.3])
+    sigma = np.sqrt(clean)
+    m = clean + sigma * rng.standard_normal(clean.shape)
+    alpha, h = 0.2, 1e-4
+    _, jac, _ = projected_residuals(*_glint(np.array([alpha])), m, sigma, True)
+    fd = []
+    for step in (h, h / 2):
+        up = projected_residuals(*_glint(np.array([alpha + step])), m, sigma, True)[0]
+        down = projected_residuals(*_glint(np.array([alpha - step])), m, sigma, True)[0]
+        fd.append((up - down) / (2 * step))
+    assert np.all(_within_truncation(jac[:, 0], fd[0], fd[1], 1e-9 * np.abs(jac).max()))
+
+
+def test_gradient_fit_std_matches_the_monte_carlo_spread():
+    truth_alpha, truth_scale = 0.12, np.array([0.8, 1.3])
+    clean = _glint(np.array([truth_alpha]))[0] * truth_scale
+    sigma = np.sqrt(clean)
+    rng = np.random.default_rng(7)
+    alphas, stds = [], []
+    for _ in range(40):
+        m = clean + sigma * rng.standard_normal(clean.shape)
+        fit = fit_roughness_gradient(_glint, m, sigma, np.array([0.6]), (0.01, 1.0))
+        assert fit.success, fit.message
+        alphas.append(fit.roughness[0])
+        stds.append(fit.roughness_std[0])
+        assert np.all(np.abs(fit.scales.scale - truth_scale) < 5 * fit.scales.scale_std)
+    alphas, stds = np.array(alphas), np.array(stds)
+    spread = alphas.std(ddof=1)
+    assert abs(alphas.mean() - truth_alpha) < 4 * spread / np.sqrt(40)  # 4 standard errors
+    # the sample std of 40 draws is uncertain by 1/sqrt(2 * 39) = 11 %: 3 of those bound it
+    assert np.median(stds) / spread == pytest.approx(1.0, abs=0.35)
 
 
 def _measured(ds):

@@ -41,7 +41,9 @@ FTOL = 1e-9
 MAX_EVALUATIONS = 60
 
 
-def _projected(c: F64, dc: F64, measured: F64, sigma: F64, fit_scale: bool) -> tuple[F64, F64, F64]:
+def projected_residuals(
+    c: F64, dc: F64, measured: F64, sigma: F64, fit_scale: bool
+) -> tuple[F64, F64, F64]:
     """Residuals (N*B,), their Jacobian in alpha (N*B, K) and the scales (B,) (module doc)."""
     w, cc, m = masked_weights(c, measured, sigma)
     d = np.where(w[None] > 0, np.nan_to_num(dc), 0.0)
@@ -103,16 +105,16 @@ def fit_roughness_gradient(
             c, dc = model(np.array(key))
             cache[key] = (np.asarray(c, float), np.asarray(dc, float))
             if on_iteration is not None:
-                r, _, _ = _projected(*cache[key], measured, sigma, fit_scale)
+                r, _, _ = projected_residuals(*cache[key], measured, sigma, fit_scale)
                 on_iteration(len(cache), np.array(key), float(r @ r))
         return cache[key]
 
     def residuals(x: F64) -> F64:
-        return _projected(*evaluate(np.exp(x)), measured, sigma, fit_scale)[0]
+        return projected_residuals(*evaluate(np.exp(x)), measured, sigma, fit_scale)[0]
 
     def jacobian(x: F64) -> F64:
         alpha = np.exp(x)
-        return _projected(*evaluate(alpha), measured, sigma, fit_scale)[1] * alpha[None, :]
+        return projected_residuals(*evaluate(alpha), measured, sigma, fit_scale)[1] * alpha[None, :]
 
     x0 = np.log(np.clip(np.asarray(start, dtype=float), lo, hi))
     x0 = np.clip(x0, np.log(lo) + 1e-9, np.log(hi) - 1e-9)  # strictly inside for "trf"
@@ -146,7 +148,7 @@ def fit_roughness_gradient(
     )
 
     def chi2(a: F64) -> float:
-        r = _projected(*evaluate(np.clip(a, lo, hi)), measured, sigma, fit_scale)[0]
+        r = projected_residuals(*evaluate(np.clip(a, lo, hi)), measured, sigma, fit_scale)[0]
         return float(r @ r)
 
     profile = chi2_profile(chi2, alpha, std_alpha, (lo, hi), n_data, fit_scale, scales.chi2)
@@ -164,4 +166,4 @@ def fit_roughness_gradient(
     )
 
 
-__all__ = ["MAX_EVALUATIONS", "fit_roughness_gradient"]
+__all__ = ["MAX_EVALUATIONS", "fit_roughness_gradient", "projected_residuals"]
