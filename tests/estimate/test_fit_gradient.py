@@ -21,7 +21,7 @@ import yaml
 
 from speclight.errors import InputError
 from speclight.estimate import fit_scenario
-from speclight.estimate.gradient_fit import projected_residuals, fit_roughness_gradient
+from speclight.estimate.gradient_fit import fit_roughness_gradient, projected_residuals
 from speclight.estimate.measured import MeasuredLightCurve
 from speclight.estimate.roughness_gradient import RoughnessRates
 from speclight.render.brdf import microfacet_d, microfacet_weight, smith_g1
