@@ -217,4 +217,27 @@ def test_gradient_method_refusals_name_the_reason():
     with pytest.raises(InputError, match=r"plastic.*quadrature table"):
         fit_scenario(parse_scenario(yaml.safe_dump(d), source="p"), lc,
                      free=("albedo", "roughness"), method="gradient")  # fmt: skip
-    assert example_text  # the module's other helpers stay importable
+
+
+def test_gradient_fit_reports_a_polished_sphere_roughness_unconstrained():
+    # as the SLSQP test in test_estimate_fit_scenario.py: a Beckmann sphere's light curve
+    # barely changes shape with roughness, so roughness and albedo are degenerate
+    d = yaml.safe_load(example_text("lcs1"))
+    d["time"].update(stop="2020-07-18T01:20:00Z", step_s=4.0)
+    d["render"]["resolution_px"] = 64
+    d["target"]["materials"]["body"]["reflectance"] = 0.8
+    truth = simulate(parse_scenario(yaml.safe_dump(d), source="truth")).dataset
+    d["target"]["materials"]["body"]["roughness"] = 0.3
+    bands = [b["name"] for b in d["instrument"]["bands"]]
+    rate = truth["count_rate_measured"].transpose("time", "band").values
+    n = truth.sizes["time"]
+    lc = MeasuredLightCurve(truth["time"].values, bands, rate, None, np.ones(n, np.int64), "t")
+    start = parse_scenario(yaml.safe_dump(d), source="start")
+    fit = fit_scenario(start, lc, free=("albedo", "roughness"), method="gradient")
+    assert not fit.converged
+    assert "roughness of material 'body' is not constrained" in fit.message
+    # the albedo's std covers the roughness values the solver met that fit as well: the true
+    # albedo (the constant reflectance 0.8) lies within 3 of it, and it is not the useless
+    # joint std of a degenerate pair (hundreds)
+    assert np.all(np.abs(fit.albedo - 0.8) < 3 * fit.albedo_std), (fit.albedo, fit.albedo_std)
+    assert np.all(fit.albedo_std < 0.1)

@@ -140,16 +140,19 @@ def fit_roughness_gradient(
     s = np.where(np.isfinite(scales.scale), scales.scale, 0.0)
     cols = [np.where(w > 0, np.nan_to_num(dc[k]), 0.0) * s[None, :] for k in range(alpha.size)]
     std_alpha, std_scale = joint_std(cols, c, measured, sigma, scales.scale, fit_scale)
-    if fit_scale:
-        scales.scale_std = std_scale
-    top = np.nanmax(np.abs(c)) if np.any(np.isfinite(c)) else 0.0
-    derivative = np.array(
-        [float(np.nanmax(np.abs(dc[k])) / top) if top > 0 else 0.0 for k in range(alpha.size)]
-    )
 
     def chi2(a: F64) -> float:
         r = projected_residuals(*evaluate(np.clip(a, lo, hi)), measured, sigma, fit_scale)[0]
         return float(r @ r)
+
+    if fit_scale and np.all(np.isfinite(std_alpha) & (std_alpha <= hi - lo)):
+        scales.scale_std = std_scale
+    elif fit_scale:  # a roughness the data do not pin: the joint std says nothing useful
+        scales.scale_std = _spread_std(scales, cache, chi2, measured, sigma, n_data)
+    top = np.nanmax(np.abs(c)) if np.any(np.isfinite(c)) else 0.0
+    derivative = np.array(
+        [float(np.nanmax(np.abs(dc[k])) / top) if top > 0 else 0.0 for k in range(alpha.size)]
+    )
 
     profile = chi2_profile(chi2, alpha, std_alpha, (lo, hi), n_data, fit_scale, scales.chi2)
     return RoughnessFit(
@@ -164,6 +167,28 @@ def fit_roughness_gradient(
         derivative=derivative,
         profile=profile,
     )
+
+
+def _spread_std(
+    scales: ScaleFit,
+    cache: dict[tuple[float, ...], tuple[F64, F64]],
+    chi2: Callable[[F64], float],
+    measured: F64,
+    sigma: F64,
+    n_data: int,
+) -> F64:
+    """The scales' std at the fitted roughness, widened to half the spread of the scales over
+    the evaluated roughness values whose chi2 is within one reduced chi2 of the best (those
+    the data cannot tell apart), as the SLSQP fit does over its scan."""
+    values = {key: chi2(np.array(key)) for key in cache}
+    best = min(values.values())
+    n_par = len(next(iter(cache))) + scales.scale.size
+    unit = max(1.0, best / max(n_data - n_par, 1))
+    alike = [fit_scales(cache[k][0], measured, sigma).scale for k, v in values.items()
+             if v - best < unit]  # fmt: skip
+    found = np.array(alike)
+    spread = (found.max(axis=0) - found.min(axis=0)) / 2
+    return np.asarray(np.maximum(scales.scale_std, spread), dtype=float)
 
 
 __all__ = ["MAX_EVALUATIONS", "fit_roughness_gradient", "projected_residuals"]
