@@ -241,3 +241,22 @@ def test_gradient_fit_reports_a_polished_sphere_roughness_unconstrained():
     # joint std of a degenerate pair (hundreds)
     assert np.all(np.abs(fit.albedo - 0.8) < 3 * fit.albedo_std), (fit.albedo, fit.albedo_std)
     assert np.all(fit.albedo_std < 0.1)
+
+
+def test_rates_equal_simulate_in_penumbra_and_shadow():
+    # the calsphere pass leaves the Earth's shadow through 12 penumbra epochs: the pass scales
+    # them by the sunlit fraction as the pipeline does, and shadowed epochs are 0
+    d = yaml.safe_load(example_text("calsphere"))
+    d["render"]["resolution_px"] = 32
+    d["target"]["materials"]["body"] = {"bsdf": "ggx", "roughness": 0.3, "reflectance": 0.7}
+    loaded = replace_fields(
+        parse_scenario(yaml.safe_dump(d), source="x"), {"instrument.noise": None}
+    )
+    base = simulate(loaded)
+    flags = base.dataset["flags"].values
+    assert np.count_nonzero(flags & 8) > 0 and np.count_nonzero(flags & 4) > 0
+    rates = RoughnessRates(loaded, base.geometry, ["body"], np.ones(flags.size, bool))
+    c, _ = rates(np.array([0.3]))
+    ref = base.dataset["count_rate"].transpose("time", "band").values
+    np.testing.assert_array_equal(np.isfinite(c), np.isfinite(ref))
+    np.testing.assert_allclose(c, ref, rtol=1e-12, atol=0)

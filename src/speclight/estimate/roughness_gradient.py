@@ -17,6 +17,8 @@ articulated parts and no Earthshine (:func:`gradient_problems` says what is not)
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -109,8 +111,6 @@ class RoughnessRates:
         self.calls = 0
 
     def _target(self, alpha: F64) -> Target:
-        from dataclasses import replace
-
         values = dict(zip(self.rough, (float(a) for a in alpha), strict=True))
         mats = {
             m.name: replace(m, roughness=values[m.name]) if m.name in values else m
