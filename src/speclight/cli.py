@@ -313,6 +313,14 @@ def fit(
     plot_file: Annotated[
         str | None, typer.Option("--plot", metavar="FIG.png", help="Figure: rates and ratios.")
     ] = None,
+    method: Annotated[
+        str,
+        typer.Option(
+            "--method",
+            help="Roughness fit: slsqp (central differences after a scan) or gradient "
+            "(analytic derivatives; single-scattering render, beckmann/ggx materials).",
+        ),
+    ] = "slsqp",
     force: Annotated[bool, typer.Option("--force", help="Overwrite existing outputs.")] = False,
 ) -> None:
     """Fit per-band albedos (with --free albedo,roughness also the roughness of every rough
@@ -324,18 +332,19 @@ def fit(
 
     def run() -> None:
         from speclight.estimate.measured import read_measured
-        from speclight.estimate.scenario_fit import fit_scenario, parse_free
+        from speclight.estimate.scenario_fit import fit_scenario, parse_free, parse_method
         from speclight.plot.figure_output import claim_outputs
         from speclight.scenario import load_scenario
 
         names = parse_free(free)
+        chosen = parse_method(method)
         if bin_s is not None and not 0 < bin_s < float("inf"):
             raise InputError(f"--bin-s = {bin_s!r} must be a duration > 0 s", field="--bin-s")
         inputs = {"scenario file": scenario, "measurements": measured}
         with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
             result = fit_scenario(
                 load_scenario(scenario), read_measured(measured), free=names, bin_s=bin_s,
-                progress=sys.stderr.isatty(),
+                progress=sys.stderr.isatty(), method=chosen,
             )  # fmt: skip
             _raise_if_signalled()
             claim.write((json.dumps(result.to_json(), indent=2) + "\n").encode())

@@ -15,7 +15,9 @@ command line are built on them:
   :mod:`.endmember_spectra`, :mod:`.unmix_truth`, :mod:`.scenario_bands`): the
   ``speclight upsample`` and ``speclight unmix`` commands;
 * :mod:`.fit`, :mod:`.roughness_fit`, :mod:`.scenario_fit`: band albedos and roughness
-  fitted to measured count rates (``speclight fit``);
+  fitted to measured count rates (``speclight fit``); with ``--method gradient``,
+  :mod:`.gradient_fit` on the analytic derivatives of :mod:`.roughness_gradient`
+  (:mod:`.scenario_roughness` joins them to the scenario);
 * :mod:`.reflection_map` (HEALPix maps in the body frame) and :mod:`.reflection_map_io`
   (``speclight reflection-map``);
 * :mod:`.reflectivity_map` (with :mod:`.reflectivity_map_store`,

@@ -108,6 +108,7 @@ def fit_roughness(
     on_iteration: Callable[[int, F64, float], None] | None = None,
     max_iterations: int = 50,
     start_model: F64 | None = None,
+    scan: bool = True,
 ) -> RoughnessFit:
     """Fit roughness values (and the band scales) by bounded SLSQP with variable projection.
 
@@ -130,6 +131,10 @@ def fit_roughness(
         SLSQP's iteration limit.
     start_model
         ``model(start)`` when already simulated (it is not simulated again).
+    scan
+        Simulate the :data:`SCAN_POINTS` values first and start from the best (one
+        roughness); ``False`` starts SLSQP at ``start`` (to measure how far SLSQP alone
+        converges from, bench/bench_fit_gradient.py).
     """
     cache: dict[tuple[float, ...], F64] = {}
     lo, hi = float(bounds[0]), float(bounds[1])
@@ -179,7 +184,7 @@ def fit_roughness(
     def unit(value: float) -> float:  # the reduced chi2 (at least 1)
         return max(1.0, value / max(n_data - n_par, 1))
 
-    x, flat = _scan_start(x0, chi2, lo, hi, unit)
+    x, flat = _scan_start(x0, chi2, lo, hi, unit) if scan else (x0, "")
     success, message = not flat, "not refined: the scan found chi2 flat" if flat else ""
     if flat:  # the local std of a flat chi2 is noise: none is given (nor simulated)
         lin = _linearise(simulate, x, measured, sigma, fit_scale, (lo, hi), None)
@@ -219,7 +224,7 @@ def fit_roughness(
         fd = np.minimum(fd, step)
     alpha, c, scales = x, lin.model, lin.scales
     std_alpha, derivative = lin.std_alpha, lin.derivative
-    profile = _profile(chi2, alpha, std_alpha, (lo, hi), n_data, fit_scale, scales.chi2)
+    profile = chi2_profile(chi2, alpha, std_alpha, (lo, hi), n_data, fit_scale, scales.chi2)
     return RoughnessFit(
         roughness=alpha,
         roughness_std=std_alpha,
@@ -269,7 +274,7 @@ def _linearise(
     return _Linearised(c, scales, std_alpha, derivative)
 
 
-def _profile(
+def chi2_profile(
     chi2: Callable[[F64], float],
     alpha: F64,
     std: F64,
@@ -407,5 +412,6 @@ __all__ = [
     "ROUGHNESS_STEP",
     "SCAN_POINTS",
     "RoughnessFit",
+    "chi2_profile",
     "fit_roughness",
 ]

@@ -32,14 +32,19 @@ from speclight import schema
 from speclight.errors import InputError
 from speclight.estimate.fit import F64, fit_scales, shot_noise_sigma
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve
-from speclight.estimate.roughness_fit import PROFILE_SIGMAS, fit_roughness
+from speclight.estimate.scenario_roughness import (
+    fit_rough_gradient,
+    fit_rough_slsqp,
+    roughness_problems,
+)
 from speclight.estimate.upsampling import band_albedo
 from speclight.scenario import LoadedScenario
 from speclight.scenario.overrides import replace_fields
 
 FREE_CHOICES = ("albedo", "roughness")
+#: ``--method``: SLSQP with central differences (and a scan), or analytic gradients.
+METHODS = ("slsqp", "gradient")
 ROUGH_BSDFS = ("beckmann", "ggx", "plastic")
-ROUGHNESS_BOUNDS = (0.01, 1.0)
 _SKIP = (
     schema.FLAG_ORBIT_FAILED
     | schema.FLAG_BELOW_MIN_ELEVATION
@@ -113,18 +118,19 @@ def parse_free(text: str) -> tuple[str, ...]:
     return names
 
 
+def parse_method(text: str) -> str:
+    """``--method`` -> the method name, checked."""
+    if text not in METHODS:
+        raise InputError(f"--method = {text!r}: give one of {', '.join(METHODS)}", field="--method")
+    return text
+
+
 def rough_materials(loaded: LoadedScenario) -> list[str]:
     """Names of the scenario's materials with a microfacet roughness."""
     target = loaded.scenario.target
     if target is None:
         return []
     return [n for n, m in target.materials.items() if m.bsdf in ROUGH_BSDFS and m.roughness]
-
-
-def _with_roughness(loaded: LoadedScenario, values: dict[str, float]) -> LoadedScenario:
-    return replace_fields(
-        loaded, {f"target.materials.{name}.roughness": float(v) for name, v in values.items()}
-    )
 
 
 def _for_fitting(loaded: LoadedScenario) -> LoadedScenario:
@@ -139,6 +145,8 @@ def fit_scenario(
     free: tuple[str, ...] = ("albedo",),
     bin_s: float | None = None,
     progress: bool = False,
+    method: str = "slsqp",
+    scan: bool = True,
 ) -> FitResult:
     """Fit the scenario's band albedos (and roughness) to measured count rates.
 
@@ -157,11 +165,19 @@ def fit_scenario(
         mean epoch, and bins holding a flagged or penumbra epoch are left out.
     progress
         Show render progress and the roughness iterations on a terminal.
+    method
+        How the roughness is fitted: ``slsqp`` (central differences, after a scan) or
+        ``gradient`` (analytic derivatives of the single-scattering render,
+        :mod:`speclight.estimate.gradient_fit`). The albedos are in closed form either way.
+    scan
+        ``slsqp`` with one roughness: scan the bounds before SLSQP (``False`` starts SLSQP
+        at the scenario's roughness).
     """
     from speclight.simulate import simulate
 
     for p in free:
         parse_free(p)
+    parse_method(method)
     sc = loaded.scenario
     if sc.target is None:
         raise InputError("the scenario has no target to fit", field="target")
@@ -178,6 +194,15 @@ def fit_scenario(
             f"(bsdf {', '.join(ROUGH_BSDFS)})",
             field="--free",
         )
+    if rough and method == "gradient":
+        from speclight.estimate.roughness_gradient import gradient_problems
+
+        problems = gradient_problems(loaded, rough)
+        if problems:
+            raise InputError(
+                "--method gradient: " + "; ".join(problems) + " (use --method slsqp)",
+                field="--method",
+            )
     base = _for_fitting(loaded)
     show = progress and sys.stderr.isatty()
     first = simulate(base, progress=show, time_utc=lc.time_utc)
@@ -190,14 +215,23 @@ def fit_scenario(
     rho = _band_reflectance(loaded, ds)
     notes: list[str] = []
     if rough:
-        fit = _fit_rough(base, first, m, sigma, rough, "albedo" in free, show)
+        if method == "gradient":
+            fit = fit_rough_gradient(base, first, m, sigma, rough, "albedo" in free, show)
+            method_text = (
+                "gradient: least squares (trust region) over log roughness with the analytic "
+                "Jacobian (variable projection), weighted least squares for scales"
+            )
+        else:
+            fit = fit_rough_slsqp(base, first, m, sigma, rough, "albedo" in free, show, scan)
+            method_text = (
+                "SLSQP over roughness (variable projection), weighted least squares for scales"
+            )
         model, scales = fit.model, fit.scales
         roughness = {
             n: (float(v), float(s))
             for n, v, s in zip(rough, fit.roughness, fit.roughness_std, strict=True)
         }
-        method = "SLSQP over roughness (variable projection), weighted least squares for scales"
-        notes += _roughness_problems(rough, fit)
+        notes += roughness_problems(rough, fit)
         extra = {"n_simulations": fit.n_simulations, "n_iterations": fit.n_iterations}
     else:
         model = ds["count_rate"].transpose("time", "band").values.astype(float)
@@ -205,86 +239,11 @@ def fit_scenario(
         if "albedo" not in free:
             raise InputError("--free must include albedo or roughness", field="--free")
         scales = fit_scales(model, m, sigma)
-        roughness, method, extra = {}, "weighted least squares (closed form; linear in albedo)", {}
+        roughness, extra = {}, {}
+        method_text = "weighted least squares (closed form; linear in albedo)"
     notes += _scale_problems(names, scales.scale, scales.scale_std, scales.n_used)
     fitted = model * scales.scale[None, :]
-    return _result(lc, names, rho, scales, roughness, m, fitted, method, notes, extra)
-
-
-def _fit_rough(
-    base: LoadedScenario,
-    first: Any,
-    m: F64,
-    sigma: F64,
-    rough: list[str],
-    fit_scale: bool,
-    show: bool,
-) -> Any:
-    from speclight.simulate import simulate
-
-    usable: NDArray[np.bool_] = np.asarray(np.isfinite(m).any(axis=1))
-    target = base.scenario.target
-    assert target is not None
-    start = np.array([float(target.materials[n].roughness or 0.0) for n in rough])
-
-    def model(alpha: F64) -> F64:
-        run = simulate(
-            _with_roughness(base, dict(zip(rough, alpha, strict=True))),
-            progress=show,
-            geometry=first.geometry,
-        )
-        c = run.dataset["count_rate"].transpose("time", "band").values.astype(float)
-        return np.where(usable[:, None], c, np.nan)
-
-    on_iteration = None
-    if show:
-        from rich.console import Console
-
-        console = Console(stderr=True)
-
-        def on_iteration(k: int, alpha: F64, chi2: float) -> None:
-            values = ", ".join(f"{n}={a:.4f}" for n, a in zip(rough, alpha, strict=True))
-            console.print(f"fit iteration {k}: roughness {values}, chi2 {chi2:.6g}")
-
-    c0 = first.dataset["count_rate"].transpose("time", "band").values.astype(float)
-    return fit_roughness(
-        model,
-        m,
-        sigma,
-        start,
-        ROUGHNESS_BOUNDS,
-        fit_scale=fit_scale,
-        on_iteration=on_iteration,
-        start_model=np.where(usable[:, None], c0, np.nan),
-    )
-
-
-def _roughness_problems(rough: list[str], fit: Any) -> list[str]:
-    out = []
-    span = ROUGHNESS_BOUNDS[1] - ROUGHNESS_BOUNDS[0]
-    if fit.flat:
-        return [f"roughness of material '{rough[0]}' is not constrained by the data: {fit.flat}"]
-    if not fit.success:
-        out.append(f"SLSQP did not converge: {fit.message}")
-    for k, name in enumerate(rough):
-        value, std = fit.roughness[k], fit.roughness_std[k]
-        if fit.derivative[k] == 0 or not np.isfinite(std) or std > span:
-            out.append(
-                f"roughness of material '{name}' is not constrained by the data "
-                f"(std {std:.3g} for bounds {ROUGHNESS_BOUNDS}: changing it changes the "
-                "light curve not at all or only in brightness, which the albedo absorbs)"
-            )
-        elif min(value - ROUGHNESS_BOUNDS[0], ROUGHNESS_BOUNDS[1] - value) < 1e-6:
-            out.append(f"roughness of material '{name}' stopped at a bound ({value:g})")
-        elif np.nanmin(fit.profile[k]) < 1.0:
-            side = "below" if fit.profile[k, 0] < fit.profile[k, 1] else "above"
-            out.append(
-                f"roughness of material '{name}' is not at a well-defined minimum: chi2 "
-                f"{'falls' if np.nanmin(fit.profile[k]) < 0 else 'barely rises'} "
-                f"{PROFILE_SIGMAS:g} std {side} {value:.4g} (the data may bound it only on "
-                "one side)"
-            )
-    return out
+    return _result(lc, names, rho, scales, roughness, m, fitted, method_text, notes, extra)
 
 
 def _scale_problems(names: list[str], scale: F64, std: F64, n_used: NDArray) -> list[str]:
@@ -379,4 +338,12 @@ def _result(
     )
 
 
-__all__ = ["FREE_CHOICES", "FitResult", "fit_scenario", "parse_free", "rough_materials"]
+__all__ = [
+    "FREE_CHOICES",
+    "METHODS",
+    "FitResult",
+    "fit_scenario",
+    "parse_free",
+    "parse_method",
+    "rough_materials",
+]

@@ -68,14 +68,18 @@ def geometric_weights(
     rays_per_batch: int = 1_000_000,
     on_batch: Callable[[int], None] | None = None,
     on_hits: Callable[..., None] | None = None,
+    layout: ChannelLayout | None = None,
+    contributions: Callable[..., tuple[I64, I64, F64]] = pixel_contributions,
 ) -> tuple[F64, dict[int, _Kept], float, ChannelLayout]:
     """Channel weights w (N, C) [m² sr-1], kept pixel data, pixel pitch [m] and the layout.
 
     ``on_hits(epochs, origin, direction, hits, caster)``, if given, is called after each
     batch's primary ray cast with the batch's epoch indices (so that other lights, e.g.
     lasers for ranging, reuse the rays: :mod:`speclight.render.laser_returns`).
+    ``layout`` and ``contributions`` (same arguments as :func:`pixel_contributions`) add
+    channels of their own, e.g. roughness derivatives (:mod:`speclight.render.single_gradient`).
     """
-    layout = ChannelLayout(target)
+    layout = ChannelLayout(target) if layout is None else layout
     centre, radius = target.bounding_sphere()
     n_ep, n_ch = len(sun_dir), layout.n_channels
     pixels = resolution_px * resolution_px
@@ -107,7 +111,7 @@ def geometric_weights(
         cos_d = dot_rows(s, half)[e_idx]
         mirror_ok = mirror_in_sun(n[idx], cos_o[idx], o[e_idx], s[e_idx])
         mat = layout.part_mat[hits.part[idx]]
-        rows, chans, px_w = pixel_contributions(
+        rows, chans, px_w = contributions(
             layout, mat, cos_i[idx], cos_o[idx], cos_h, cos_d, mirror_ok
         )
         flat = e_idx[rows] * n_ch + chans

@@ -1,0 +1,151 @@
+"""Single-scattering intensity and its derivatives in the roughness, from one ray cast.
+
+In the single-scattering render (:mod:`speclight.render.single`) the ray cast, the shadow
+test and every hit's cosines do not depend on a material's roughness alpha; only the
+per-pixel weight of its main channel does, ``f cos_i / F = D G / (4 cos_o)``, whose spectral
+factor (the Fresnel term at the half angle) does not. So
+
+    dI/dalpha_k (lambda) = E(lambda) * R_k(lambda) * sum_pixels A_pix d(D G / (4 cos_o))/dalpha
+
+over the pixels of material k, with the analytic derivative of
+:func:`speclight.render.brdf_gradient.microfacet_weight_dalpha`. It is computed in the same
+pass as the intensity: one extra channel per differentiated material, accumulated beside the
+others (:func:`~speclight.render.single.geometric_weights`), so that it costs a fraction of
+a render, not the two renders of a central difference.
+
+Materials: ``beckmann`` and ``ggx``. ``plastic`` is refused: the transmittance of its rough
+coat, which weights its diffuse base, depends on alpha through a quadrature table
+(:func:`~speclight.render.material_channels.rough_coat_tables`) that has no derivative here.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from speclight.errors import InputError
+from speclight.render import material_channels as channels
+from speclight.render.brdf_gradient import microfacet_weight_dalpha
+from speclight.render.material_channels import ChannelLayout, pixel_contributions
+from speclight.render.raycast import Caster
+from speclight.render.single import geometric_weights
+from speclight.target.materials import Material
+from speclight.target.parts import Target
+
+F64 = NDArray[np.float64]
+I64 = NDArray[np.int64]
+
+#: BSDFs whose roughness derivative this module computes.
+DIFFERENTIABLE = ("beckmann", "ggx")
+
+
+def gradient_problem(m: Material) -> str:
+    """Why the roughness derivative of material ``m`` is not available ("" when it is)."""
+    if m.bsdf == "plastic":
+        return (
+            f"material '{m.name}' (plastic): the roughness of a plastic's coat also sets the "
+            "transmittance to its diffuse base, a quadrature table without an analytic "
+            "derivative here"
+        )
+    if m.bsdf not in DIFFERENTIABLE or not m.roughness:
+        return f"material '{m.name}' has no microfacet roughness (bsdf '{m.bsdf}')"
+    return ""
+
+
+class _GradientLayout(ChannelLayout):
+    """The render's channels, then one d/dalpha channel per differentiated material."""
+
+    def __init__(self, target: Target, rough: list[int]) -> None:
+        super().__init__(target)
+        self.grad: dict[int, int] = {}
+        for k in rough:
+            self.grad[k] = self.n_channels
+            self.n_channels += 1
+
+
+def _contributions(
+    layout: _GradientLayout,
+    mat: I64,
+    cos_i: F64,
+    cos_o: F64,
+    cos_h: F64,
+    cos_d: F64,
+    mirror_ok: F64,
+) -> tuple[I64, I64, F64]:
+    rows, chans, weights = pixel_contributions(layout, mat, cos_i, cos_o, cos_h, cos_d, mirror_ok)
+    extra_rows, extra_chans, extra_w = [rows], [chans], [weights]
+    for k, channel in layout.grad.items():
+        m = layout.mats[k]
+        sel = np.flatnonzero(mat == k)
+        alpha = float(m.roughness or 0.0)
+        extra_rows.append(sel)
+        extra_chans.append(np.full(sel.size, channel))
+        extra_w.append(
+            microfacet_weight_dalpha(cos_i[sel], cos_o[sel], cos_h[sel], alpha, m.bsdf)  # type: ignore[arg-type]
+        )
+    return np.concatenate(extra_rows), np.concatenate(extra_chans), np.concatenate(extra_w)
+
+
+def render_single_gradient(
+    target: Target,
+    sun_dir: F64,
+    obs_dir: F64,
+    irradiance: F64,
+    wavelength_nm: F64,
+    caster: Caster,
+    resolution_px: int,
+    rough: list[str],
+) -> tuple[F64, F64]:
+    """Intensity (N, L) [W sr-1 nm-1] and its roughness derivatives (K, N, L) [W sr-1 nm-1].
+
+    Parameters
+    ----------
+    target, sun_dir, obs_dir, irradiance, wavelength_nm, caster, resolution_px
+        As :func:`speclight.render.single.render_single` (valid epochs only).
+    rough
+        Names of the K materials (``Material.name``) to differentiate by their roughness.
+
+    Returns
+    -------
+    tuple
+        The intensity, equal to :func:`~speclight.render.single.render_single`'s (the same
+        sums in the same order), and ``d intensity / d alpha_k`` (module doc).
+    """
+    channels.check_supported(target.materials)
+    names = [m.name for m in target.materials]
+    index = []
+    for name in rough:
+        if name not in names:
+            raise InputError(
+                f"no material '{name}' in the target (materials: {', '.join(names)})",
+                field="target.materials",
+            )
+        k = names.index(name)
+        problem = gradient_problem(target.materials[k])
+        if problem:
+            raise InputError(f"no roughness derivative: {problem}", field="target.materials")
+        index.append(k)
+    layout = _GradientLayout(target, index)
+    w, _, _, _ = geometric_weights(
+        target,
+        sun_dir,
+        obs_dir,
+        caster,
+        resolution_px,
+        rays_per_batch=channels.rays_per_batch(target.materials),
+        layout=layout,
+        contributions=_contributions,
+    )
+    cos_half = np.sqrt(np.clip(0.5 * (1.0 + np.einsum("nk,nk->n", sun_dir, obs_dir)), 0.0, 1.0))
+    n_mat = len(layout.mats)
+    main = [channels.main_factor(m, cos_half, wavelength_nm) for m in layout.mats]
+    total = sum(w[:, k, None] * main[k] for k in range(n_mat))
+    for k, start in layout.block.items():
+        block = channels.block_factor(layout.mats[k], wavelength_nm)
+        total = total + w[:, start : start + block.shape[0]] @ block
+    intensity = irradiance * total
+    grad = np.stack([irradiance * w[:, layout.grad[k], None] * main[k] for k in index])
+    return np.asarray(intensity, dtype=float), grad.reshape(len(index), *intensity.shape)
+
+
+__all__ = ["DIFFERENTIABLE", "gradient_problem", "render_single_gradient"]
