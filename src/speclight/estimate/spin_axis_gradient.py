@@ -164,7 +164,10 @@ class SpinMisfit:
         x = np.asarray(x, dtype=float)
         sun, d_sun = self._directions(x, self.geo.sun_gcrs)
         obs, d_obs = self._directions(x, self.geo.observer_gcrs)
-        p, dp = intensity_jacobian(self.bmap, sun, obs, d_sun, d_obs)
+        if jacobian:
+            p, dp = intensity_jacobian(self.bmap, sun, obs, d_sun, d_obs)
+        else:  # the map's own lookup, without the derivatives' cost
+            p, dp = self.bmap.intensity_1au(sun, obs), np.zeros(0)
         n_t, n_b = self.y.shape
         yn = self.y / np.mean(self.y, axis=0)
         m = np.mean(p, axis=0)
@@ -207,7 +210,10 @@ def _ranging_residuals(
 ) -> tuple[F64, F64 | None]:
     """Residuals ``sqrt(W / (n mean(o_meas^2))) (M / R - o_meas)`` (T B,) of the range
     offsets (0 where unmeasured) and their Jacobian (T B, K)."""
-    rm, drm = intensity_jacobian(rg.bmap, obs, obs, d_obs, d_obs)
+    if jacobian:
+        rm, drm = intensity_jacobian(rg.bmap, obs, obs, d_obs, d_obs)
+    else:
+        rm, drm = rg.bmap.intensity_1au(obs, obs), np.zeros((obs.shape[0], 1, 1))
     n_b = rg.n_bands
     rm, drm = np.nan_to_num(rm), np.nan_to_num(drm)
     rate, mom = rm[:, :n_b], rm[:, n_b:]
