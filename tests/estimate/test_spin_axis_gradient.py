@@ -13,23 +13,24 @@ import dataclasses
 
 import numpy as np
 import pytest
+from test_spin_axis import _body_directions, _closed_form_map, _rates
+from test_spin_axis_grid import _geometry, _map
 
+from speclight.errors import InputError
 from speclight.estimate.spin_axis import angular_distance_deg, exact_misfit, spin_axis_search
 from speclight.estimate.spin_axis_gradient import SpinMisfit
 from speclight.estimate.spin_axis_lookup import EpochGeometry, spin_frame_map
 from speclight.estimate.spin_axis_ranging import RangingTerm
 from speclight.estimate.spin_axis_refine import check_refine_options, refine_candidate
-from speclight.errors import InputError
-
-from test_spin_axis import _body_directions, _closed_form_map, _rates
-from test_spin_axis_grid import _geometry, _map
 
 BODY_AXES = [None, [0.0, 1.0, 0.0]]
 
 
 def _central(model: SpinMisfit, x: np.ndarray, h: float = 1e-6) -> np.ndarray:
     e = np.eye(x.size)
-    return np.array([(model.misfit(x + h * e[k]) - model.misfit(x - h * e[k])) / (2 * h) for k in range(x.size)])
+    return np.array(
+        [(model.misfit(x + h * e[k]) - model.misfit(x - h * e[k])) / (2 * h) for k in range(x.size)]
+    )
 
 
 @pytest.mark.parametrize("axis", BODY_AXES)
@@ -42,7 +43,9 @@ def test_misfit_is_the_spin_models_and_gradient_its_differences(axis) -> None:
     for ra, dec, ph in ((30.0, 40.0, 70.0), (200.0, -80.0, 10.0), (10.0, 89.9999, 300.0)):
         model = SpinMisfit.around(bmap, geo, y, axis, ra, dec, free_period=True)
         x0 = np.array([0.0, 0.0, np.radians(ph), 0.0])
-        assert model.misfit(x0) == pytest.approx(exact_misfit(bmap, geo, y, axis, ra, dec, ph), rel=1e-12)
+        assert model.misfit(x0) == pytest.approx(
+            exact_misfit(bmap, geo, y, axis, ra, dec, ph), rel=1e-12
+        )
         for _ in range(4):
             x = rng.normal(size=4) * [0.5, 0.5, 2.0, 0.3]
             # the parameters as the spin model's RA, Dec, phase and period give the same misfit
@@ -119,7 +122,12 @@ def test_search_records_the_method_and_the_period() -> None:
 
 
 def test_refine_options() -> None:
-    for method, bound in (("newton", None), ("gradient", 0.0), ("slsqp", 0.7), ("gradient", np.nan)):
+    for method, bound in (
+        ("newton", None),
+        ("gradient", 0.0),
+        ("slsqp", 0.7),
+        ("gradient", np.nan),
+    ):
         with pytest.raises(InputError):
             check_refine_options(method, bound)
     check_refine_options("slsqp", 0.05)

@@ -229,6 +229,8 @@ def _ranging_residuals(
     r = np.where(ok, off - np.nan_to_num(meas), 0.0) * c
     if not jacobian:
         return r.ravel(), None
-    d_off = (drm[:, n_b:] * safe[:, :, None] - mom[:, :, None] * drm[:, :n_b]) / (safe**2)[..., None]
+    d_off = (drm[:, n_b:] * safe[:, :, None] - mom[:, :, None] * drm[:, :n_b]) / (safe**2)[
+        ..., None
+    ]
     d_off = np.where((pos & ok)[:, :, None], d_off, 0.0) * c
     return r.ravel(), d_off.reshape(meas.size, -1)

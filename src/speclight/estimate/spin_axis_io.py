@@ -152,7 +152,6 @@ def spin_axis_measured(
     """Search the spin axis of a measured pass against a reflectivity map (module doc);
     ``refine_method`` and ``period_bound`` (a free period): :func:`.spin_axis_search`."""
     from speclight.estimate.spin_axis_refine import check_refine_options
-
     from speclight.estimate.unmix_inputs import read_reflectance_factors
     from speclight.render.map_lookup import check_map_matches
     from speclight.simulate.geometry_stage import scenario_geometry

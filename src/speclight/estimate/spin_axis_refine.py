@@ -104,7 +104,10 @@ def refine_candidate(
     if free:
         assert period_bound is not None
         p0 = geo.period_s
-        lo, hi = model.f_for_period(p0 * (1 + period_bound)), model.f_for_period(p0 * (1 - period_bound))
+        lo, hi = (
+            model.f_for_period(p0 * (1 + period_bound)),
+            model.f_for_period(p0 * (1 - period_bound)),
+        )
         x0.append(model.f_for_period(start_period_s) if start_period_s else 0.0)
         bounds.append((lo, hi))
     count = _Counter()

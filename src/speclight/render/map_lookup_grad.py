@@ -78,7 +78,12 @@ def healpix_weight_derivatives(
         ]
     )
     d_lon = np.stack(
-        [-dx1 * (1 - y), dx1 * (1 - y), np.where(polar, 0.0, -dx2 * y), np.where(polar, 0.0, dx2 * y)]
+        [
+            -dx1 * (1 - y),
+            dx1 * (1 - y),
+            np.where(polar, 0.0, -dx2 * y),
+            np.where(polar, 0.0, dx2 * y),
+        ]
     )
     d_lat = np.stack(
         [
