@@ -843,8 +843,8 @@ def spin_axis(
                 f"refined RA {a['refined_ra_deg']:.2f} Dec {a['refined_dec_deg']:.2f} phase "
                 f"{a['refined_phase_deg']:.1f} "
                 + (f"period {a['refined_period_s']:.6g} s " if free_period else "")
-                + f"({a['refine_method']}, {a['refine_misfit_evaluations']} misfit + "
-                f"{a['refine_gradient_evaluations']} gradient evaluations) "
+                + f"by {a['refine_method']} with {a['refine_misfit_evaluations']} misfit and "
+                f"{a['refine_gradient_evaluations']} gradient evaluations "
                 if math.isfinite(float(a["refined_ra_deg"]))
                 else "not refined (--no-refine) "
             )

@@ -125,7 +125,7 @@ def test_cli_run_and_bad_input(folder) -> None:
     grad = [*base, "-o", str(folder / "grad.nc"), *args[7:11], "--refine", "gradient"]
     run = runner.invoke(app, [*grad, "--free-period"])
     assert run.exit_code == 0, run.output
-    assert "(gradient, 0 misfit + " in run.output and "period " in run.output
+    assert "by gradient with 0 misfit and " in run.output and "period " in run.output
     with xr.open_dataset(folder / "grad.nc", engine="h5netcdf") as ds:
         a = ds.attrs
         assert a["refine_method"] == "gradient" and a["period_free"] == 1
