@@ -178,7 +178,7 @@ def _nelder_mead(
     """Nelder-Mead over (RA, Dec, phase [, f]) [deg] on :func:`.spin_axis.exact_misfit`."""
     from scipy.optimize import minimize
 
-    from speclight.estimate.spin_axis import exact_misfit
+    from speclight.estimate.spin_axis_misfit import exact_misfit
 
     free = model.free_period
     z0 = np.array([*start, np.degrees(x0[3])] if free else list(start), dtype=float)
