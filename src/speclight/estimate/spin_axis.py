@@ -35,11 +35,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError
+from speclight.estimate.spin_axis_grid import misfit_from_sums as misfit_from_sums
 from speclight.estimate.spin_axis_lookup import (
     EpochGeometry,
     SpinFrameMap,
 )
-from speclight.estimate.spin_axis_grid import misfit_from_sums as misfit_from_sums
 from speclight.estimate.spin_axis_misfit import exact_misfit as exact_misfit
 from speclight.render.map_lookup import ReflectivityMap
 
