@@ -752,6 +752,24 @@ def spin_axis(
     no_refine: Annotated[
         bool, typer.Option("--no-refine", help="Skip the local refinement.")
     ] = False,
+    refine_method: Annotated[
+        str,
+        typer.Option(
+            "--refine",
+            help="Refinement: nelder-mead, gradient (L-BFGS-B, analytic gradient), "
+            "gauss-newton (least squares, analytic Jacobian) or slsqp (numerical gradient).",
+        ),
+    ] = "nelder-mead",
+    free_period: Annotated[
+        bool,
+        typer.Option("--free-period", help="Refine the period too, within --period-bound."),
+    ] = False,
+    period_bound: Annotated[
+        float,
+        typer.Option(
+            "--period-bound", help="With --free-period: largest relative change of the period."
+        ),
+    ] = 0.05,
     source: Annotated[
         str | None,
         typer.Option(
@@ -776,8 +794,9 @@ def spin_axis(
     """Grid search of the spin axis (RA, Dec in GCRS) and the rotation phase at the scenario
     start: every candidate's band light curves are predicted from the reflectivity map and
     compared with the measured ones (each divided by its mean); then the mirror minimum and
-    a local refinement (Nelder-Mead). Writes AXIS.nc: error(ra, dec), best_phase(ra, dec)
-    and the best, mirror and refined axes in its attributes.
+    a local refinement (--refine; --free-period fits the period too). Writes AXIS.nc:
+    error(ra, dec), best_phase(ra, dec) and the best, mirror and refined axes in its
+    attributes.
 
     Example: speclight spin-axis pass.yaml pass.nc --map map.zarr -o axis.nc --plot axis.png
     """
@@ -786,11 +805,13 @@ def spin_axis(
         from speclight.estimate.source_spectrum import check_light
         from speclight.estimate.spin_axis import check_search_options
         from speclight.estimate.spin_axis_io import axis_dataset, spin_axis_measured
+        from speclight.estimate.spin_axis_refine import check_refine_options
         from speclight.io.netcdf import dataset_bytes
         from speclight.plot.figure_output import claim_outputs
         from speclight.scenario import load_scenario
 
         check_search_options(grid_deg, phases)
+        check_refine_options(refine_method, period_bound if free_period else None)
         check_light(source)
         if period_s is not None and not (period_s > 0 and period_s < float("inf")):
             raise InputError(
@@ -811,6 +832,8 @@ def spin_axis(
                 not no_refine,
                 light=source,
                 ranging_weight=ranging_weight,
+                refine_method=refine_method,
+                period_bound=period_bound if free_period else None,
             )
             ds = axis_dataset(result, str(map_file), str(scenario))
             _raise_if_signalled()
@@ -828,6 +851,9 @@ def spin_axis(
             + (
                 f"refined RA {a['refined_ra_deg']:.2f} Dec {a['refined_dec_deg']:.2f} phase "
                 f"{a['refined_phase_deg']:.1f} "
+                + (f"period {a['refined_period_s']:.6g} s " if free_period else "")
+                + f"by {a['refine_method']} with {a['refine_misfit_evaluations']} misfit and "
+                f"{a['refine_gradient_evaluations']} gradient evaluations "
                 if math.isfinite(float(a["refined_ra_deg"]))
                 else "not refined (--no-refine) "
             )

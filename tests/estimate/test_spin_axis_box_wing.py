@@ -121,6 +121,18 @@ def test_cli_run_and_bad_input(folder) -> None:
         lat = ds["track_lat"].sel(solution="scenario").values
         np.testing.assert_allclose(lat, np.degrees(np.arcsin(p[:, 2])), atol=1e-9)
     assert (folder / "axis.png").stat().st_size > 0
+    # the gradient refinement with a free period: method, evaluations and period recorded
+    grad = [*base, "-o", str(folder / "grad.nc"), *args[7:11], "--refine", "gradient"]
+    run = runner.invoke(app, [*grad, "--free-period"])
+    assert run.exit_code == 0, run.output
+    assert "by gradient with 0 misfit and " in run.output and "period " in run.output
+    with xr.open_dataset(folder / "grad.nc", engine="h5netcdf") as ds:
+        a = ds.attrs
+        assert a["refine_method"] == "gradient" and a["period_free"] == 1
+        assert a["refine_gradient_evaluations"] > 0 and a["refine_misfit_evaluations"] == 0
+        assert abs(a["refined_period_s"] / 120.0 - 1) <= a["period_bound"] == 0.05
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert ds.attrs["refine_method"] == "none" and ds.attrs["period_free"] == 0
     # the same noisy rates as a CSV (eq. 5 applied to them with the scenario's geometry, the
     # scenario run on the map): the same misfits, to the CSV's 7 significant digits
     with xr.open_dataset(measured, engine="h5netcdf") as sim:
@@ -143,6 +155,9 @@ def test_cli_run_and_bad_input(folder) -> None:
     _one_line_error(runner.invoke(app, [*base, *new, "--phases", "0"]), "--phases")
     _one_line_error(runner.invoke(app, [*base, *new, "--period-s", "-3"]), "--period-s")
     _one_line_error(runner.invoke(app, [*base, *new, "--bands", "G-999/1"]), "G-999/1")
+    _one_line_error(runner.invoke(app, [*base, *new, "--refine", "newton"]), "--refine")
+    bad_bound = ["--free-period", "--period-bound", "0.9"]
+    _one_line_error(runner.invoke(app, [*base, *new, *bad_bound]), "--period-bound")
     # no period: a fixed attitude and no --period-s
     fixed = scenario.read_text().replace(
         "  model: spin\n", "  model: fixed\n  quaternion: [1, 0, 0, 0]\n"

@@ -18,8 +18,11 @@ phase. Epochs where a band is not measured (NaN) are left out. With ranging retu
 The **mirror** solution is the lowest local minimum of ``error`` (8 neighbours, RA
 periodic) farther than ``mirror_sep_deg`` from the best cell: for a body symmetric about
 its equatorial plane, the reversed axis with the phase that swaps the halves fits as well.
-**Refinement**: Nelder-Mead (scipy) over (RA, Dec, phase) on the same misfit with the
-map's own interpolation (HEALPix bilinear, no grid), from the best and the mirror cells.
+**Refinement** (:mod:`.spin_axis_refine`): Nelder-Mead (scipy) over (RA, Dec, phase) on
+the same misfit with the map's own interpolation (HEALPix bilinear, no grid), from the best
+and the mirror cells; or L-BFGS-B / least squares with the analytic gradient
+(:mod:`.spin_axis_gradient`), or SLSQP with finite differences; optionally with the period
+free within a bound.
 """
 
 from __future__ import annotations
@@ -31,14 +34,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from speclight.attitude.quaternion import quat_to_matrix
-from speclight.attitude.spin import spin_attitude
 from speclight.errors import InputError
-from speclight.estimate.spin_axis_grid import misfit_from_sums
+from speclight.estimate.spin_axis_grid import misfit_from_sums as misfit_from_sums
 from speclight.estimate.spin_axis_lookup import (
     EpochGeometry,
     SpinFrameMap,
 )
+from speclight.estimate.spin_axis_misfit import exact_misfit as exact_misfit
 from speclight.render.map_lookup import ReflectivityMap
 
 if TYPE_CHECKING:
@@ -67,6 +69,10 @@ class SpinAxisResult:
     n_epochs: int
     band_names: list[str]
     ranging_weight: float = 0.0  # the weight used (0: no ranging term)
+    refine_method: str = "nelder-mead"
+    refined_period_s: float = float("nan")  # the period of ``refined`` [s]
+    refine_n_misfit: int = 0  # misfit evaluations of the refinement (all starts)
+    refine_n_gradient: int = 0  # analytic gradient (Jacobian) evaluations
 
 
 def check_search_options(grid_deg: float, n_phases: int) -> None:
@@ -150,55 +156,6 @@ def angular_distance_deg(ra1: ArrayLike, dec1: ArrayLike, ra2: ArrayLike, dec2: 
     return np.degrees(np.arccos(np.clip(c, -1.0, 1.0)))
 
 
-def exact_misfit(
-    bmap: ReflectivityMap,
-    geo: EpochGeometry,
-    y: F64,
-    spin_body_axis: ArrayLike | None,
-    ra_deg: float,
-    dec_deg: float,
-    phase_deg: float,
-    ranging: RangingTerm | None = None,
-) -> float:
-    """The misfit of one candidate with the map's own interpolation (no spin-frame grid)."""
-    if not -90.0 <= dec_deg <= 90.0:
-        return float("inf")
-    q = spin_attitude(geo.t_s, ra_deg, dec_deg, geo.period_s, phase_deg, spin_body_axis)
-    r = quat_to_matrix(q)
-    s = np.einsum("tji,tj->ti", r, geo.sun_gcrs)
-    o = np.einsum("tji,tj->ti", r, geo.observer_gcrs)
-    p = bmap.intensity_1au(s, o)
-    yn = normalised(y)
-    if not np.all(np.isfinite(p)):
-        return float("inf")
-    s1, s2, sy = p.sum(0)[:, None], (p**2).sum(0)[:, None], (p * yn).sum(0)[:, None]
-    e = float(misfit_from_sums(s1, s2, sy, np.sum(yn**2, axis=0), y.shape[0])[0])
-    if ranging is not None and ranging.weight:
-        from speclight.estimate.spin_axis_ranging import exact_term
-
-        e += ranging.weight * exact_term(ranging, o)
-    return e
-
-
-def refine(
-    fun: Callable[[float, float, float], float], start: tuple[float, float, float], step: float
-) -> tuple[float, float, float, float]:
-    """Nelder-Mead from ``start`` (RA, Dec, phase) with an initial simplex of ``step`` deg."""
-    from scipy.optimize import minimize
-
-    x0 = np.asarray(start, dtype=float)
-    simplex = np.vstack([x0, x0 + np.diag([step, step, step])])
-    simplex[:, 1] = np.clip(simplex[:, 1], -90.0, 90.0)
-    res = minimize(
-        lambda x: fun(float(x[0]), float(x[1]), float(x[2])),
-        x0,
-        method="Nelder-Mead",
-        options={"initial_simplex": simplex, "xatol": 0.05, "fatol": 1e-9, "maxiter": 400},
-    )
-    ra, dec, ph = (float(v) for v in res.x)
-    return ra % 360.0, dec, ph % 360.0, float(res.fun)
-
-
 def spin_axis_search(
     bmap: ReflectivityMap,
     sfm: SpinFrameMap,
@@ -211,6 +168,8 @@ def spin_axis_search(
     progress: Callable[[int, int], None] | None = None,
     do_refine: bool = True,
     ranging: RangingTerm | None = None,
+    refine_method: str = "nelder-mead",
+    period_bound: float | None = None,
 ) -> SpinAxisResult:
     """Grid search, mirror and refinement (module docstring).
 
@@ -229,8 +188,16 @@ def spin_axis_search(
         Measured range offsets (T, B) with their map and weight, or None.
     grid_deg
         RA/Dec grid step [deg], in (0, 90].
+    refine_method
+        :data:`.spin_axis_refine.REFINE_METHODS`.
+    period_bound
+        None: the period ``geo.period_s`` is fixed; else the refinement fits it too, within
+        this fraction of it.
     """
+    from speclight.estimate.spin_axis_refine import check_refine_options, refine_candidate
+
     check_search_options(grid_deg, sfm.n_phases)
+    check_refine_options(refine_method, period_bound)
     ok = np.all(np.isfinite(y), axis=1)
     ok &= np.all(np.isfinite(geo.sun_gcrs), axis=1) & np.all(np.isfinite(geo.observer_gcrs), axis=1)
     if ok.sum() < 3:
@@ -265,15 +232,17 @@ def spin_axis_search(
         i = int(far[0])
         mirror = (float(r_f[i]), float(d_f[i]), float(p_f[i]), float(e_f[i]))
     refined = nan4
+    tries = []
     if do_refine:
-
-        def fun(a: float, d: float, p: float) -> float:
-            return exact_misfit(bmap, geo, y, spin_body_axis, a, d, p, ranging)
-
         step = max(grid_deg, 360.0 / sfm.n_phases) / 2
         starts = [best] + ([mirror] if far.size else [])
-        tries = [refine(fun, s[:3], step) for s in starts]
-        refined = min(tries, key=lambda t: t[3])
+        tries = [
+            refine_candidate(
+                bmap, geo, y, spin_body_axis, s[:3], step, refine_method, period_bound, ranging
+            )
+            for s in starts
+        ]
+        refined = min(tries, key=lambda t: t.error).answer
     return SpinAxisResult(
         ra,
         dec,
@@ -286,4 +255,8 @@ def spin_axis_search(
         int(ok.sum()),
         list(band_names),
         0.0 if ranging is None else float(ranging.weight or 0.0),
+        refine_method,
+        min(tries, key=lambda t: t.error).period_s if tries else float("nan"),
+        sum(t.n_misfit for t in tries),
+        sum(t.n_gradient for t in tries),
     )

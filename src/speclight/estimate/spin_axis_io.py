@@ -65,6 +65,7 @@ class SpinAxisRun:
     ranging_weight: float = 0.0
     time_utc: NDArray[np.datetime64] | None = None
     tracks: dict[str, tuple[F64, F64]] = dataclasses.field(default_factory=dict)
+    period_bound: float | None = None  # None: the period was fixed
 
 
 def phase_vector_track(
@@ -145,14 +146,19 @@ def spin_axis_measured(
     progress: Callable[[int, int], None] | None = None,
     light: str | None = None,
     ranging_weight: float | None = None,
+    refine_method: str = "nelder-mead",
+    period_bound: float | None = None,
 ) -> SpinAxisRun:
-    """Search the spin axis of a measured pass against a reflectivity map (module doc)."""
+    """Search the spin axis of a measured pass against a reflectivity map (module doc);
+    ``refine_method`` and ``period_bound`` (a free period): :func:`.spin_axis_search`."""
+    from speclight.estimate.spin_axis_refine import check_refine_options
     from speclight.estimate.unmix_inputs import read_reflectance_factors
     from speclight.render.map_lookup import check_map_matches
     from speclight.simulate.geometry_stage import scenario_geometry
     from speclight.simulate.radiometry import wavelength_grid_nm
 
     check_search_options(grid_deg, n_phases)
+    check_refine_options(refine_method, period_bound)
     period, body_axis, spin = _spin_model(loaded, period_s)
     map_path = Path(map_path)
     bmap = load_band_map(map_path)
@@ -215,12 +221,27 @@ def spin_axis_measured(
         )
     sfm = spin_frame_map(sub, body_axis, n_phases)
     result = spin_axis_search(
-        sub, sfm, epochs, y, chosen, grid_deg, body_axis, chunk, progress, refine, ranging
+        sub,
+        sfm,
+        epochs,
+        y,
+        chosen,
+        grid_deg,
+        body_axis,
+        chunk,
+        progress,
+        refine,
+        ranging,
+        refine_method,
+        period_bound,
     )
     seconds = time.perf_counter() - t0
+    refined_epochs = epochs
+    if period_bound is not None and np.isfinite(result.refined_period_s):
+        refined_epochs = dataclasses.replace(epochs, period_s=result.refined_period_s)
     tracks = {
         "best": phase_vector_track(epochs, body_axis, *result.best[:3]),
-        "refined": phase_vector_track(epochs, body_axis, *result.refined[:3]),
+        "refined": phase_vector_track(refined_epochs, body_axis, *result.refined[:3]),
     }
     truth = None
     if spin is not None:
@@ -243,6 +264,7 @@ def spin_axis_measured(
         result.ranging_weight,
         rf.time_utc,
         tracks,
+        period_bound,
     )
 
 
@@ -281,6 +303,16 @@ def axis_dataset(run: SpinAxisRun, map_path: str, scenario_source: str) -> xr.Da
         attrs[f"{key}_phase_deg"], attrs[f"{key}_error"] = val[2], val[3]
     if run.scenario_axis is not None:
         attrs["scenario_ra_deg"], attrs["scenario_dec_deg"] = run.scenario_axis
+    refined = bool(np.isfinite(r.refined[0]))
+    attrs.update(
+        refine_method=r.refine_method if refined else "none",
+        refine_misfit_evaluations=r.refine_n_misfit,
+        refine_gradient_evaluations=r.refine_n_gradient,
+        period_free=int(run.period_bound is not None),
+    )
+    if run.period_bound is not None:
+        attrs["period_bound"] = run.period_bound
+        attrs["refined_period_s"] = r.refined_period_s
     attrs.update(
         period_s=run.period_s,
         spin_body_axis=np.asarray(run.spin_body_axis, dtype=float),
