@@ -165,6 +165,15 @@ VARIABLES: dict[str, VariableInfo] = {
         comment=f"{POLARIZATION_FRAME}; V: Mitsuba's sign (not checked against the IAU's), "
         "0 in single mode",
     ),
+    **{
+        f"intensity_{c}_std": V(
+            TW,
+            "W sr-1 nm-1",
+            f"Monte Carlo standard error of intensity_{c} (0 in single mode)",
+            comment=POLARIZATION_FRAME,
+        )
+        for c in "quv"
+    },
     "count_rate_q": V(
         TB,
         "s-1",

@@ -208,3 +208,18 @@ def test_the_geometry_is_built_once_per_worker_for_unchanged_sections(tmp_path):
     run_case(dataclasses.replace(plan.tasks[1]))
     assert len(worker_cache._CACHE) == 1  # the albedo does not change the geometry
     worker_cache.clear()
+
+
+def test_polarised_cases_keep_dolp_and_aolp(tmp_path):
+    metal = "  target.materials.body: {bsdf: ggx, roughness: 0.3, reflectance: {conductor: Al}}\n"
+    plan = _plan(tmp_path, "  render.polarization: [false, true]\n", set_=metal)
+    assert plan.polarization
+    run_sweep(plan, tmp_path / "runs.zarr", scheduler="none")
+    ds = _read(tmp_path / "runs.zarr")
+    assert ds["dolp"].dims == ("case", "time", "band") and ds["aolp"].attrs["units"] == "degree"
+    assert np.isnan(ds["dolp"].values[0]).all()  # the unpolarised case writes no polarisation
+    reference = simulate(parse_scenario(plan.tasks[1].yaml_text)).dataset
+    lit = np.isfinite(reference["dolp"].values)
+    assert lit.any() and (reference["dolp"].values[lit] > 0.01).all()  # Al at phase ~100 deg
+    for name in ("dolp", "aolp"):
+        np.testing.assert_allclose(ds[name].values[1], reference[name].values, rtol=ROUNDING)

@@ -134,3 +134,22 @@ def test_earthshine_adds_its_stokes(tmp_path) -> None:
     lit = np.isfinite(out["dolp"].values).all(axis=1)
     assert lit.sum() >= 3 and np.all(out["dolp"].values[lit] > 0)
     assert np.all(np.isfinite(out["intensity_q"].values[lit]))
+
+
+def test_stokes_standard_errors(tmp_path, ds: xr.Dataset) -> None:
+    # single mode is exact: zero error. Path mode on a convex microfacet sphere: every sample
+    # is one reflection at the same half vector (distant Sun and observer), so each sample's
+    # Q/I and U/I is the same Fresnel ratio and the relative standard errors of Q and U must
+    # be those of I (to the mixing of wavelengths within a bin: 10 %)
+    lit = ds["intensity"].values > 0
+    for c in "quv":
+        assert ds[f"intensity_{c}_std"].attrs["units"] == "W sr-1 nm-1"
+        assert np.all(ds[f"intensity_{c}_std"].values[lit] == 0)
+    data = _scenario(tmp_path, mode="path", samples_per_pixel=4)
+    out = simulate(parse_scenario(yaml.safe_dump(data), base_dir=tmp_path)).dataset
+    assert np.array_equal(out["intensity"].values > 0, lit) and lit.sum() > 100
+    i, i_std = out["intensity"].values[lit], out["intensity_std"].values[lit]
+    for c in "qu":
+        x, x_std = out[f"intensity_{c}"].values[lit], out[f"intensity_{c}_std"].values[lit]
+        ratio = (x_std / np.abs(x)) / (i_std / i)
+        assert np.all((ratio > 0.9) & (ratio < 1.1))

@@ -58,6 +58,8 @@ class SweepPlan:
     wavelength_nm: NDArray[np.float64]
     noise: bool
     sha256: str
+    #: Some case has ``render.polarization``: the store keeps ``dolp`` and ``aolp``.
+    polarization: bool = False
 
 
 def load_base(spec: SweepSpec) -> LoadedScenario:
@@ -95,7 +97,7 @@ def plan_sweep(spec: SweepSpec, base: LoadedScenario | None = None) -> SweepPlan
     varied_sections = {f.path[0] for f in spec.fields}
     tasks: list[CaseTask] = []
     first: Scenario | None = None
-    noise = False
+    noise = polarization = False
     for i, case in enumerate(values):
         data = copy.deepcopy({k: v for k, v in fixed_data.items() if k in varied_sections})
         for f in spec.fields:
@@ -106,6 +108,7 @@ def plan_sweep(spec: SweepSpec, base: LoadedScenario | None = None) -> SweepPlan
         first = first or sc
         _same_axes(spec, first, sc, i, case)
         noise = noise or bool(sc.instrument.noise and sc.instrument.noise.enabled)
+        polarization = polarization or sc.render.polarization
         source = f"{spec.source} case {i}"
         try:
             check_engines(sc, source)
@@ -149,6 +152,7 @@ def plan_sweep(spec: SweepSpec, base: LoadedScenario | None = None) -> SweepPlan
         wavelength_grid_nm(first.spectrum),
         noise,
         sha,
+        polarization,
     )
 
 

@@ -6,7 +6,8 @@ Layout (Zarr format 3, a folder; ``xarray.open_zarr(RUNS.zarr)`` reads it as a d
   with spectra, ``wavelength`` [nm];
 * ``count_rate(case, time, band)`` [s-1] and ``ab_magnitude(case, time, band)`` [mag] as the
   ``simulate`` output has them (float64), ``count_rate_measured(case, time, band)`` where a
-  case has ``instrument.noise``; with spectra ``intensity(case, time, wavelength)``
+  case has ``instrument.noise``, ``dolp(case, time, band)`` [1] and ``aolp(case, time, band)``
+  [deg] where a case has ``render.polarization``; with spectra ``intensity(case, time, wavelength)``
   [W sr-1 nm-1] and ``spectral_flux(case, time, wavelength)`` [W nm-1] (float32);
   one chunk per case;
 * ``param_<field with dots as __>(case)``: each varied field's value (numbers, strings, or
@@ -42,7 +43,7 @@ from speclight.scale.sweep_cases import SweepPlan
 FIELD = "--output"
 FORMAT_NAME = "speclight sweep"
 TODO, DONE, FAILED = 0, 1, 2
-CURVES = ("count_rate", "ab_magnitude", "count_rate_measured")
+CURVES = ("count_rate", "ab_magnitude", "count_rate_measured", "dolp", "aolp")
 SPECTRA = ("intensity", "spectral_flux")
 #: Cases per chunk of the small per-case arrays (parameters, state, error).
 SMALL_CHUNK = 4096
@@ -136,6 +137,13 @@ def _array(group: Any, name: str, shape: tuple[int, ...], dims: tuple[str, ...],
     return arr
 
 
+def _curves(plan: SweepPlan) -> tuple[str, ...]:
+    """The per-band curves the plan's cases write: ``count_rate_measured`` where a case has
+    noise, ``dolp`` and ``aolp`` where one has ``render.polarization``."""
+    extra = ("count_rate_measured",) if plan.noise else ()
+    return (*CURVES[:2], *extra, *(CURVES[3:] if plan.polarization else ()))
+
+
 def _create(group: Any, plan: SweepPlan) -> None:
     from speclight import __version__
 
@@ -149,7 +157,7 @@ def _create(group: Any, plan: SweepPlan) -> None:
         )
         arr[...] = values
     _array(group, "case", (0,), ("case",), dtype="int64", fill_value=-1)
-    for name in CURVES[:2] + (CURVES[2:] if plan.noise else ()):
+    for name in _curves(plan):
         _array(group, name, (0, nt, nb), ("case", "time", "band"), dtype="f8", fill_value=np.nan)
     if plan.spec.spectra:
         wl = plan.wavelength_nm
@@ -223,10 +231,11 @@ def _add_segment(group: Any, plan: SweepPlan) -> int:
     """Resize the per-case arrays for the plan's cases and write their parameters."""
     start = int(group["case"].shape[0])
     stop = start + len(plan.tasks)
-    if plan.noise and "count_rate_measured" not in group:
-        nt, nb = plan.time_utc.size, len(plan.band_names)
-        _array(group, "count_rate_measured", (start, nt, nb), ("case", "time", "band"),
-               dtype="f8", fill_value=np.nan)  # fmt: skip
+    nt, nb = plan.time_utc.size, len(plan.band_names)
+    for name in _curves(plan):  # a noisy or polarised segment appended to a store without
+        if name not in group:
+            _array(group, name, (start, nt, nb), ("case", "time", "band"),
+                   dtype="f8", fill_value=np.nan)  # fmt: skip
     for _, arr in group.arrays():
         dims = arr.metadata.dimension_names or ()
         if dims[:1] == ("case",):

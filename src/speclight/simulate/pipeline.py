@@ -189,6 +189,7 @@ def _simulate(
             transmission,
             geo.range_m,
             radiometry,
+            reflection.stokes_std_W_sr_nm,
         )
     if sc.render.per_material and radiometry is not None and radiometry.band_names:
         assert session is not None and target is not None  # per_material: rendered

@@ -55,10 +55,14 @@ def add_polarization(
     transmission: F64,
     range_m: F64,
     radiometry: Radiometry | None,
+    stokes_std_W_sr_nm: F64 | None = None,
 ) -> xr.Dataset:
-    """Add ``intensity_q/u/v`` and, with bands, ``count_rate_q/u/v``, ``dolp``, ``aolp``."""
+    """Add ``intensity_q/u/v`` (and their standard errors ``intensity_q/u/v_std``: 0 when
+    ``stokes_std_W_sr_nm`` is None) and, with bands, ``count_rate_q/u/v``, ``dolp``, ``aolp``."""
+    std = np.zeros_like(stokes_W_sr_nm) if stokes_std_W_sr_nm is None else stokes_std_W_sr_nm
     for c, name in enumerate(("intensity_q", "intensity_u", "intensity_v")):
         ds[name] = schema.variable(name, stokes_W_sr_nm[..., c])
+        ds[f"{name}_std"] = schema.variable(f"{name}_std", std[..., c])
     ds.attrs["polarization_frame"] = schema.POLARIZATION_FRAME
     if radiometry is None or not radiometry.band_names:
         return ds
