@@ -148,20 +148,29 @@ def render_single(
     on_hits: Callable[..., None] | None = None,
 ) -> tuple[F64, dict[int, RenderImage]]:
     """Intensity (N, L) [W sr-1 nm-1] of valid epochs and the kept images (see module doc)."""
-    intensity, _, images = _render(
-        target,
-        sun_dir,
-        obs_dir,
-        irradiance,
-        wavelength_nm,
-        caster,
-        resolution_px,
-        keep,
-        on_batch,
-        on_hits,
-        polarization=False,
-    )
+    intensity, _, images = render_single_polarized(
+        target, sun_dir, obs_dir, irradiance, wavelength_nm, caster, resolution_px, keep,
+        on_batch, on_hits, polarization=False,
+    )  # fmt: skip
     return intensity, images
+
+
+def channel_sum(
+    w: F64, layout: ChannelLayout, sun_dir: F64, obs_dir: F64, wavelength_nm: F64
+) -> tuple[F64, list[F64], dict[int, F64], F64]:
+    """``sum_c w_c R_c(lambda)`` (N, L) [m² sr-1] from the channel weights ``w`` (N, C).
+
+    Also returns the main channels' spectral factors (per material, (N, L)), the block
+    factors (per plastic material, (nodes, L)) and the cosine of the half-phase angle (N,).
+    """
+    cos_half = np.sqrt(np.clip(0.5 * (1.0 + np.einsum("nk,nk->n", sun_dir, obs_dir)), 0.0, 1.0))
+    n_mat = len(layout.mats)
+    main = [channels.main_factor(m, cos_half, wavelength_nm) for m in layout.mats]
+    blocks = {k: channels.block_factor(layout.mats[k], wavelength_nm) for k in layout.block}
+    total = sum(w[:, k, None] * main[k] for k in range(n_mat))
+    for k, start in layout.block.items():
+        total = total + w[:, start : start + blocks[k].shape[0]] @ blocks[k]
+    return np.asarray(total, dtype=float), main, blocks, cos_half
 
 
 def render_single_polarized(
@@ -188,34 +197,6 @@ def render_single_polarized(
     """
     if polarization:
         check_polarizable(target.materials)
-    return _render(
-        target,
-        sun_dir,
-        obs_dir,
-        irradiance,
-        wavelength_nm,
-        caster,
-        resolution_px,
-        keep,
-        on_batch,
-        on_hits,
-        polarization,
-    )
-
-
-def _render(
-    target: Target,
-    sun_dir: F64,
-    obs_dir: F64,
-    irradiance: F64,
-    wavelength_nm: F64,
-    caster: Caster,
-    resolution_px: int,
-    keep: Iterable[int],
-    on_batch: Callable[[int], None] | None,
-    on_hits: Callable[..., None] | None,
-    polarization: bool,
-) -> tuple[F64, F64 | None, dict[int, RenderImage]]:
     channels.check_supported(target.materials)
     keep = list(keep)
     w, kept, pitch, layout = geometric_weights(
@@ -229,13 +210,8 @@ def _render(
         on_batch=on_batch,
         on_hits=on_hits,
     )
-    cos_half = np.sqrt(np.clip(0.5 * (1.0 + np.einsum("nk,nk->n", sun_dir, obs_dir)), 0.0, 1.0))
+    total, main, blocks, cos_half = channel_sum(w, layout, sun_dir, obs_dir, wavelength_nm)
     n_mat = len(layout.mats)
-    main = [channels.main_factor(m, cos_half, wavelength_nm) for m in layout.mats]
-    blocks = {k: channels.block_factor(layout.mats[k], wavelength_nm) for k in layout.block}
-    total = sum(w[:, k, None] * main[k] for k in range(n_mat))
-    for k, start in layout.block.items():
-        total = total + w[:, start : start + blocks[k].shape[0]] @ blocks[k]
     intensity = irradiance * total
     linear = None
     if polarization:  # the block channels (diffuse bases) are unpolarised

@@ -28,7 +28,7 @@ from speclight.render import material_channels as channels
 from speclight.render.brdf_gradient import microfacet_weight_dalpha
 from speclight.render.material_channels import ChannelLayout, pixel_contributions
 from speclight.render.raycast import Caster
-from speclight.render.single import geometric_weights
+from speclight.render.single import channel_sum, geometric_weights
 from speclight.target.materials import Material
 from speclight.target.parts import Target
 
@@ -136,13 +136,7 @@ def render_single_gradient(
         layout=layout,
         contributions=_contributions,
     )
-    cos_half = np.sqrt(np.clip(0.5 * (1.0 + np.einsum("nk,nk->n", sun_dir, obs_dir)), 0.0, 1.0))
-    n_mat = len(layout.mats)
-    main = [channels.main_factor(m, cos_half, wavelength_nm) for m in layout.mats]
-    total = sum(w[:, k, None] * main[k] for k in range(n_mat))
-    for k, start in layout.block.items():
-        block = channels.block_factor(layout.mats[k], wavelength_nm)
-        total = total + w[:, start : start + block.shape[0]] @ block
+    total, main, _, _ = channel_sum(w, layout, sun_dir, obs_dir, wavelength_nm)
     intensity = irradiance * total
     grad = np.stack([irradiance * w[:, layout.grad[k], None] * main[k] for k in index])
     return np.asarray(intensity, dtype=float), grad.reshape(len(index), *intensity.shape)
