@@ -13,7 +13,7 @@ from speclight.render.map_geometry import (
     nside_for,
     sun_observer,
 )
-from speclight.render.map_lookup import _roll_weights, phase_angle_weights
+from speclight.render.map_lookup import phase_angle_weights, roll_weights
 
 
 @pytest.mark.parametrize(("n", "nside"), [(12, 1), (13, 2), (48, 2), (10_000, 32), (12_288, 32)])
@@ -77,7 +77,7 @@ def test_phase_weights_linear_and_clamped():
 
 
 def test_roll_weights_are_periodic():
-    idx, w = _roll_weights(8, np.radians([337.5, 22.5, 360.0]))
+    idx, w = roll_weights(8, np.radians([337.5, 22.5, 360.0]))
     # 337.5 deg: halfway between roll 7 (315) and roll 0 (360 = 0)
     np.testing.assert_array_equal(idx[:, 0], [7, 0])
     np.testing.assert_allclose(w[:, 0], [0.5, 0.5])

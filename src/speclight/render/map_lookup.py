@@ -146,14 +146,14 @@ class ReflectivityMap:
             lon * u.deg, lat * u.deg, self.header.nside, order="ring"
         )
         j, w_phase = phase_angle_weights(self.header.phase_angle_deg, np.degrees(a[ok]))
-        u = _plane_axis(sun_body, observer_body)[ok]
+        u = plane_axis(sun_body, observer_body)[ok]
         acc = np.zeros((int(ok.sum()), out.shape[1]))
         for i in range(4):
             # the roll in the reference frame of this pixel centre (the frames of neighbouring
             # pixels differ by their longitude difference, much near the poles)
             e_lon, e_lat = roll_reference(self.direction_body[pix[i]])
             roll = np.arctan2(np.sum(u * e_lat, axis=1), np.sum(u * e_lon, axis=1))
-            k, w_roll = _roll_weights(self.header.roll_deg.size, roll)
+            k, w_roll = roll_weights(self.header.roll_deg.size, roll)
             for jj in range(2):
                 for kk in range(2):
                     w = w_pix[i] * w_phase[jj] * w_roll[kk]
@@ -207,7 +207,7 @@ def healpix_weights(
     return ok, np.asarray(pix, dtype=np.int64), np.asarray(w, dtype=float)
 
 
-def _plane_axis(sun: ArrayLike, observer: ArrayLike) -> F64:
+def plane_axis(sun: ArrayLike, observer: ArrayLike) -> F64:
     """``u = normalize(sun - observer)`` (N, 3): the Sun's side of the Sun-observer plane
     (any unit vector at phase angle 0, where the roll does not matter)."""
     s = np.atleast_2d(np.asarray(sun, dtype=float))
@@ -231,7 +231,7 @@ def phase_angle_weights(stored_deg: F64, a_deg: F64) -> tuple[NDArray[np.int64],
     return np.stack([lo, hi]), np.stack([1.0 - t, t])
 
 
-def _roll_weights(n_rolls: int, roll_rad: F64) -> tuple[NDArray[np.int64], F64]:
+def roll_weights(n_rolls: int, roll_rad: F64) -> tuple[NDArray[np.int64], F64]:
     """Indices (2, N) and weights (2, N) of periodic linear interpolation in roll."""
     f = np.mod(roll_rad, 2 * np.pi) / (2 * np.pi / n_rolls)
     lo = np.floor(f).astype(np.int64) % n_rolls

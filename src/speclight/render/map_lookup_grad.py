@@ -39,9 +39,9 @@ from numpy.typing import ArrayLike, NDArray
 from speclight.render.map_geometry import lonlat_deg, roll_reference
 from speclight.render.map_lookup import (
     ReflectivityMap,
-    _plane_axis,
-    _roll_weights,
     phase_angle_weights,
+    plane_axis,
+    roll_weights,
 )
 
 F64 = NDArray[np.float64]
@@ -164,7 +164,7 @@ def intensity_jacobian(
         dt = np.where(inside[:, None], da_deg / (stored[j[1]] - stored[j[0]])[:, None], 0.0)
         dw_phase = np.stack([-dt, dt])
     # roll: u = normalize(sun - observer), 0 derivative at phase angle 0
-    u_vec = _plane_axis(s, o)
+    u_vec = plane_axis(s, o)
     _, du = _unit_derivative(s - o, ds - do)
     n_r = bmap.header.roll_deg.size
     acc = np.zeros((a.size, n_c))
@@ -177,7 +177,7 @@ def intensity_jacobian(
             xr[:, None] * np.einsum("ni,nik->nk", e_lat, du)
             - yr[:, None] * np.einsum("ni,nik->nk", e_lon, du)
         ) / np.maximum(xr**2 + yr**2, 1e-300)[:, None]
-        k, w_roll = _roll_weights(n_r, roll)
+        k, w_roll = roll_weights(n_r, roll)
         dw_roll = np.stack([-d_roll, d_roll]) * (n_r / (2 * np.pi))
         for jj in range(2):
             for kk in range(2):
