@@ -49,11 +49,12 @@ def info_report() -> dict[str, dict[str, str]]:
         from speclight.render.variant import available_variants, find_libllvm
 
         variants = available_variants()
-        single, path = run_variants()
+        single, path, polarized = run_variants()
         report["render"] = {
             "available variants": ", ".join(variants) or "none (numpy ray casting only)",
             "variant in single mode": f"{single} (with RGL measured materials: {path})",
             "variant in path mode": path,
+            "variant in polarised path mode": polarized,
             "gpu (CUDA)": "yes" if any(v.startswith("cuda_") for v in variants) else "none",
             "libLLVM": find_libllvm() or "not found (LLVM variants unavailable)",
         }
@@ -62,12 +63,14 @@ def info_report() -> dict[str, dict[str, str]]:
     return report
 
 
-def run_variants() -> tuple[str, str]:
-    """The render variant a run uses here in single and in path mode (``render.variant: auto``).
+def run_variants() -> tuple[str, str, str]:
+    """The render variant a run uses here in single mode, in path mode and in path mode with
+    ``render.polarization`` (``render.variant: auto``).
 
     Chosen by :meth:`speclight.render.session.RenderSession.create`, as a run chooses it:
     ray casting (single mode) needs only ``*_rgb``; path mode, and RGL measured materials in
-    either mode, need ``*_spectral``. A scenario's ``render.variant`` overrides the choice.
+    either mode, need ``*_spectral``; polarised path mode ``*_spectral_polarized`` (the single
+    mode computes polarisation itself). A scenario's ``render.variant`` overrides the choice.
     """
     import warnings
 
@@ -75,11 +78,11 @@ def run_variants() -> tuple[str, str]:
     from speclight.render.session import RenderSession
 
     chosen = []
-    for mode in ("single", "path"):
+    for mode, polarization in (("single", False), ("path", False), ("path", True)):
         try:
             with warnings.catch_warnings():  # a fallback's notice: the report says it already
                 warnings.simplefilter("ignore")
-                chosen.append(RenderSession.create(mode, None, ()).variant)
-        except InputError as exc:  # path mode without Mitsuba
+                chosen.append(RenderSession.create(mode, None, (), polarization).variant)
+        except InputError as exc:  # path mode without Mitsuba (or its polarised variants)
             chosen.append(f"unavailable ({exc.message})")
-    return chosen[0], chosen[1]
+    return chosen[0], chosen[1], chosen[2]

@@ -114,6 +114,7 @@ def test_info_reports_versions_and_coverage() -> None:
     assert result.exit_code == 0, result.output
     assert "skyfield" in result.stdout and "eop_measured_until" in result.stdout
     assert "variant in single mode" in result.stdout and "variant in path mode" in result.stdout
+    assert "variant in polarised path mode" in result.stdout
     assert "gpu (CUDA)" in result.stdout
 
 

@@ -148,6 +148,9 @@ def test_stokes_standard_errors(tmp_path, ds: xr.Dataset) -> None:
     data = _scenario(tmp_path, mode="path", samples_per_pixel=4)
     out = simulate(parse_scenario(yaml.safe_dump(data), base_dir=tmp_path)).dataset
     assert np.array_equal(out["intensity"].values > 0, lit) and lit.sum() > 100
+    from speclight.info import run_variants
+
+    assert out.attrs["render_variant"] == run_variants()[2]  # what `speclight info` reports
     i, i_std = out["intensity"].values[lit], out["intensity_std"].values[lit]
     for c in "qu":
         x, x_std = out[f"intensity_{c}"].values[lit], out[f"intensity_{c}_std"].values[lit]
