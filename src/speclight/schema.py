@@ -49,6 +49,11 @@ POLARIZATION_FRAME = (
     "(GCRS) north at the target's position, angles from north through east; the atmosphere "
     "is taken as unpolarising"
 )
+#: The sense of Stokes V (checked by tests/render/test_render_polarization_vsign.py).
+V_SIGN = (
+    "V > 0: right-handed in the IAU (IEEE) sense, the electric vector turning "
+    "counter-clockwise (north toward east) as seen by the observer facing the target"
+)
 
 V = VariableInfo
 VARIABLES: dict[str, VariableInfo] = {
@@ -162,8 +167,7 @@ VARIABLES: dict[str, VariableInfo] = {
         TW,
         "W sr-1 nm-1",
         "Stokes V of the intensity, above the atmosphere",
-        comment=f"{POLARIZATION_FRAME}; V: Mitsuba's sign (not checked against the IAU's), "
-        "0 in single mode",
+        comment=f"{POLARIZATION_FRAME}; {V_SIGN}, 0 in single mode",
     ),
     **{
         f"intensity_{c}_std": V(
@@ -187,7 +191,9 @@ VARIABLES: dict[str, VariableInfo] = {
         "at 135 degree",
         comment=POLARIZATION_FRAME,
     ),
-    "count_rate_v": V(TB, "s-1", "Stokes V of the count rate", comment=POLARIZATION_FRAME),
+    "count_rate_v": V(
+        TB, "s-1", "Stokes V of the count rate", comment=f"{POLARIZATION_FRAME}; {V_SIGN}"
+    ),
     "dolp": V(
         TB,
         "1",

@@ -88,7 +88,9 @@ class PassSampler:
     column is the Stokes vector, referenced to Mitsuba's implicit basis
     ``mueller.stokes_basis(-ray.d)``; each sample's Stokes vector is rotated to the basis
     ``north`` given per epoch (Mitsuba's second axis is then ``(-ray.d) x north``: east on the
-    sky, :mod:`speclight.render.polarization`) and its four components binned. No film and
+    sky, :mod:`speclight.render.polarization`), V's sign turned to the IAU's (Mitsuba's
+    positive V is clockwise as seen facing the source, the IAU's counter-clockwise) and its
+    four components binned. No film and
     no ``stokes`` integrator are used (the latter's AOV channels crash with AOV output and
     ``specfilm`` breaks with its Stokes output).
     """
@@ -251,7 +253,11 @@ class PassSampler:
             forward = -mi.Vector3f(direction)
             current = mi.mueller.stokes_basis(forward)
             rotated = mi.mueller.rotate_stokes_basis(forward, current, basis) @ radiance
-            components = [rotated[c][0] for c in range(4)]
+            # Mitsuba's V > 0 is right-handed as optics counts it, clockwise for the observer
+            # facing the source (its polarisation guide); the IAU's V > 0 turns
+            # counter-clockwise (north toward east): V changes sign here, the one place
+            # (tests/render/test_render_polarization_vsign.py).
+            components = [rotated[0][0], rotated[1][0], rotated[2][0], -rotated[3][0]]
         else:
             components = [radiance]
         keys, pixel_keys, values = [], [], []
