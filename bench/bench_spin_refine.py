@@ -15,10 +15,11 @@ then at the truth up to the noise.
    random directions each) with the phase within +-15 deg of the optimum's; the axis at
    the optimum with the phase 10, 20, 45, 90, 135 deg off (both signs); the period free
    (bound 5 %) and started 0.5 % and 2 % off (both signs), axis 10 deg off, phase +-10 deg.
-3. Each method (Nelder-Mead, gradient = L-BFGS-B with the analytic gradient, Gauss-Newton =
-   least squares with the analytic Jacobian, SLSQP with numerical gradients) from each
-   start; **converged**: the axis within 1 deg and the phase within 1 deg of the optimum
-   or of its **twin** (the same axis, the phase + 180 deg: the box-wing turned half a turn
+3. Each method (Nelder-Mead, gradient = L-BFGS-B with the analytic gradient,
+   gradient-continuation = the same on coarsened maps first, Gauss-Newton = least squares
+   with the analytic Jacobian, SLSQP with numerical gradients) from each start;
+   **converged**: the axis within 1 deg and the phase within 1 deg of the optimum or of its
+   **twin** (the same axis, the phase + 180 deg: the box-wing turned half a turn
    about its antenna is the same shape, and the twin's misfit is the optimum's), and the
    period within 0.05 %; ``(k twin)`` counts the starts that ended at the twin. Printed:
    converged / tried, the median misfit and gradient evaluations and the median wall time

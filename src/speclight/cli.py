@@ -757,7 +757,9 @@ def spin_axis(
         typer.Option(
             "--refine",
             help="Refinement: nelder-mead, gradient (L-BFGS-B, analytic gradient), "
-            "gauss-newton (least squares, analytic Jacobian) or slsqp (numerical gradient).",
+            "gradient-continuation (gradient on coarsened maps, then the map: a larger "
+            "basin), gauss-newton (least squares, analytic Jacobian) or slsqp (numerical "
+            "gradient).",
         ),
     ] = "nelder-mead",
     free_period: Annotated[

@@ -133,6 +133,13 @@ def test_cli_run_and_bad_input(folder) -> None:
         assert abs(a["refined_period_s"] / 120.0 - 1) <= a["period_bound"] == 0.05
     with xr.open_dataset(out, engine="h5netcdf") as ds:
         assert ds.attrs["refine_method"] == "none" and ds.attrs["period_free"] == 0
+    cont = [*base, "-o", str(folder / "cont.nc"), *args[7:11]]
+    run = runner.invoke(app, [*cont, "--refine", "gradient-continuation"])
+    assert run.exit_code == 0, run.output
+    assert "by gradient-continuation with 0 misfit and " in run.output
+    with xr.open_dataset(folder / "cont.nc", engine="h5netcdf") as ds:
+        assert ds.attrs["refine_method"] == "gradient-continuation"
+        assert ds.attrs["refine_gradient_evaluations"] > 0
     # the same noisy rates as a CSV (eq. 5 applied to them with the scenario's geometry, the
     # scenario run on the map): the same misfits, to the CSV's 7 significant digits
     with xr.open_dataset(measured, engine="h5netcdf") as sim:

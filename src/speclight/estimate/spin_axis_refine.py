@@ -9,6 +9,10 @@ with ``period_bound = beta``, free within ``[P0 (1 - beta), P0 (1 + beta)]``:
   ``step`` deg; misfit only.
 * ``gradient``: L-BFGS-B (scipy) over the parameters ``x`` of :mod:`.spin_axis_gradient`
   (tangent rotation vector of the axis, phase, ``f``) with the analytic gradient.
+* ``gradient-continuation``: ``gradient`` on the map degraded to HEALPix ``nside`` 2, 4,
+  ... up to half the map's (:mod:`.spin_axis_continuation`), each stage from where the
+  last ended, then on the real map: a larger basin (docs/spin-axis.md) for 2-3 times the
+  evaluations near the optimum.
 * ``gauss-newton``: scipy ``least_squares`` (trust-region reflective) on the residuals with
   their analytic Jacobian.
 * ``slsqp``: SLSQP (scipy) over the same ``x`` with gradients from scipy's forward finite
@@ -22,6 +26,7 @@ each of which also gives the misfit and costs about 2-3 misfit evaluations.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -29,6 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError
+from speclight.estimate.spin_axis_continuation import Stage, continuation_stages, stage_model
 from speclight.estimate.spin_axis_gradient import SpinMisfit
 from speclight.estimate.spin_axis_lookup import EpochGeometry
 from speclight.render.map_lookup import ReflectivityMap
@@ -37,8 +43,9 @@ if TYPE_CHECKING:
     from speclight.estimate.spin_axis_ranging import RangingTerm
 
 F64 = NDArray[np.float64]
-REFINE_METHODS = ("nelder-mead", "gradient", "gauss-newton", "slsqp")
-#: Iteration limits (Nelder-Mead: its 400 of before; the others converge in far fewer).
+REFINE_METHODS = ("nelder-mead", "gradient", "gradient-continuation", "gauss-newton", "slsqp")
+#: Iteration limits (Nelder-Mead: its 400 of before; the others converge in far fewer;
+#: ``gradient-continuation``: ``gradient``'s per stage).
 MAX_ITER = {"nelder-mead": 400, "gradient": 200, "gauss-newton": 200, "slsqp": 200}
 
 
@@ -97,10 +104,65 @@ def refine_candidate(
     ``geo.period_s``, the centre of the bound).
     """
     check_refine_options(method, period_bound)
+    model, x0, bounds = _setup(
+        bmap, geo, y, spin_body_axis, start, period_bound, ranging, start_period_s
+    )
+    count = _Counter()
+    if method == "nelder-mead":
+        return _nelder_mead(model, spin_body_axis, start, x0, bounds, step_deg, count)
+    if method == "gradient-continuation":
+        return _staged(model, x0, bounds, continuation_stages(bmap.header.nside), count)
+    x = _minimise(model, x0, bounds, method, count)
+    ra, dec, phase, period = model.to_spin_model(x)
+    return Refined(ra, dec, phase, model.misfit(x), period, count.misfit, count.gradient)
+
+
+def refine_staged(
+    bmap: ReflectivityMap,
+    geo: EpochGeometry,
+    y: F64,
+    spin_body_axis: ArrayLike | None,
+    start: tuple[float, float, float],
+    stages: Sequence[Stage],
+    period_bound: float | None = None,
+    ranging: RangingTerm | None = None,
+    start_period_s: float | None = None,
+) -> Refined:
+    """The ``gradient`` refinement run on each of ``stages`` in turn
+    (:mod:`.spin_axis_continuation`), each from where the last ended, then on the real
+    misfit; the evaluations of all stages are counted."""
+    check_refine_options("gradient", period_bound)
+    model, x, bounds = _setup(
+        bmap, geo, y, spin_body_axis, start, period_bound, ranging, start_period_s
+    )
+    return _staged(model, x, bounds, stages, _Counter())
+
+
+def _staged(
+    model: SpinMisfit, x: F64, bounds: list, stages: Sequence[Stage], count: _Counter
+) -> Refined:
+    for stage in stages:
+        x = _minimise(stage_model(model, stage), x, bounds, "gradient", count)
+    x = _minimise(model, x, bounds, "gradient", count)
+    ra, dec, phase, period = model.to_spin_model(x)
+    return Refined(ra, dec, phase, model.misfit(x), period, count.misfit, count.gradient)
+
+
+def _setup(
+    bmap: ReflectivityMap,
+    geo: EpochGeometry,
+    y: F64,
+    spin_body_axis: ArrayLike | None,
+    start: tuple[float, float, float],
+    period_bound: float | None,
+    ranging: RangingTerm | None,
+    start_period_s: float | None,
+) -> tuple[SpinMisfit, F64, list]:
+    """The misfit around ``start``, the start ``x0`` and the bounds of ``x``."""
     free = period_bound is not None
     model = SpinMisfit.around(bmap, geo, y, spin_body_axis, start[0], start[1], free, ranging)
     x0 = [0.0, 0.0, float(np.radians(start[2]))]
-    bounds = [(-np.pi, np.pi), (-np.pi, np.pi), (None, None)]
+    bounds: list = [(-np.pi, np.pi), (-np.pi, np.pi), (None, None)]
     if free:
         assert period_bound is not None
         p0 = geo.period_s
@@ -110,12 +172,7 @@ def refine_candidate(
         )
         x0.append(model.f_for_period(start_period_s) if start_period_s else 0.0)
         bounds.append((lo, hi))
-    count = _Counter()
-    if method == "nelder-mead":
-        return _nelder_mead(model, spin_body_axis, start, np.asarray(x0), bounds, step_deg, count)
-    x = _minimise(model, np.asarray(x0), bounds, method, count)
-    ra, dec, phase, period = model.to_spin_model(x)
-    return Refined(ra, dec, phase, model.misfit(x), period, count.misfit, count.gradient)
+    return model, np.asarray(x0), bounds
 
 
 def _minimise(model: SpinMisfit, x0: F64, bounds: list, method: str, count: _Counter) -> F64:
