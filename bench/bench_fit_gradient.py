@@ -23,7 +23,9 @@ geometry) is not counted for either.
 
 ``--cost``: the cost of one render pass with derivatives against one simulation on the same
 geometry, for the ``box-wing`` example (600 epochs, 256 px) with its plastic bus and wings
-made Beckmann (bus, gold) and GGX (wings, silica), three rough materials.
+made Beckmann (bus, gold) and GGX (wings, silica), three rough materials; and for the
+articulated ``starlink-v1.5`` example (128 px) with its array made GGX, without and with
+Earthshine (64 cells).
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from __future__ import annotations
 import argparse
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -85,8 +88,24 @@ def run(truth: list[float], start: list[float], method: str, lc: MeasuredLightCu
     )
 
 
-def cost() -> None:
+def _time_pass(loaded: object, rough: list[str], alpha: list[float]) -> tuple[float, float, Any]:
+    """Seconds of one simulation on a fixed geometry and of one render pass (warm)."""
     from speclight.estimate.roughness_gradient import RoughnessRates
+
+    first = simulate(loaded)  # type: ignore[arg-type]
+    use = np.ones(first.geometry.t_s.size, bool)
+    rates = RoughnessRates(loaded, first.geometry, rough, use)  # type: ignore[arg-type]
+    for _ in range(2):  # the second of each: warm caches
+        t0 = time.perf_counter()
+        simulate(loaded, geometry=first.geometry)  # type: ignore[arg-type]
+        t_sim = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        rates(np.array(alpha))
+        t_pass = time.perf_counter() - t0
+    return t_sim, t_pass, rates.reflection
+
+
+def cost() -> None:
     from speclight.scenario import load_example
     from speclight.scenario.overrides import replace_fields
 
@@ -98,26 +117,25 @@ def cost() -> None:
         values[f"target.materials.{wing}"] = {"bsdf": "ggx", "roughness": 0.05,
                                               "reflectance": {"dielectric": "SiO2"}}  # fmt: skip
     loaded = replace_fields(load_example("box-wing"), values)
-    first = simulate(loaded)
-    use = np.ones(first.geometry.t_s.size, bool)
-    rates = RoughnessRates(loaded, first.geometry, rough, use)
-    alpha = np.array([0.3, 0.05, 0.05])
-    for _ in range(2):  # the second of each: warm caches
-        t0 = time.perf_counter()
-        simulate(loaded, geometry=first.geometry)
-        t_sim = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        rates(alpha)
-        t_pass = time.perf_counter() - t0
-    lit = int(rates.lit.size)
-    print(f"box-wing, {lit} lit epochs, 256 px, variant {rates.session.variant}: simulation "
-          f"{t_sim:.2f} s, render pass with 3 derivatives {t_pass:.2f} s")  # fmt: skip
+    t_sim, t_pass, refl = _time_pass(loaded, rough, [0.3, 0.05, 0.05])
+    print(f"box-wing, {refl.lit.size} lit epochs, 256 px, variant {refl.session.variant}: "
+          f"simulation {t_sim:.2f} s, render pass with 3 derivatives {t_pass:.2f} s")  # fmt: skip
+    array = {"bsdf": "ggx", "roughness": 0.1, "reflectance": 0.3}
+    for earthshine in (None, {"albedo": 0.3, "samples": 64}):
+        values = {"target.materials.array": array, "illumination.earthshine": earthshine}
+        loaded = replace_fields(load_example("starlink-v1.5"), values)
+        t_sim, t_pass, refl = _time_pass(loaded, ["array"], [0.1])
+        cells = 0 if refl.cells is None else refl.cells.epoch.size
+        print(f"starlink-v1.5 (GGX array), {refl.lit.size} lit epochs, 128 px, Earthshine "
+              f"renders {cells}: simulation {t_sim:.2f} s, render pass {t_pass:.2f} s")  # fmt: skip
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="factors 2 and 30 only")
-    parser.add_argument("--cost", action="store_true", help="cost of a pass (box-wing)")
+    parser.add_argument(
+        "--cost", action="store_true", help="cost of a pass (box-wing, starlink-v1.5)"
+    )
     args = parser.parse_args()
     if args.cost:
         cost()

@@ -8,25 +8,22 @@ count rate is the same chain applied to the derivative of the intensity,
 
     dC_tj/dalpha_k = A / r_t^2 * sum_lambda T_t(lambda) dI_t/dalpha_k(lambda) ... (band j)
 
-with the penumbra's sunlit fraction as in the pipeline. The rates equal ``simulate``'s
-``count_rate`` at those epochs (the same sums; tests/estimate/test_fit_gradient.py).
+with the penumbra's sunlit fraction, the articulated parts' poses and the Earthshine cells
+as in the pipeline (:class:`speclight.simulate.reflection_gradient.ReflectionGradient`). The
+rates equal ``simulate``'s ``count_rate`` at those epochs (the same sums;
+tests/estimate/test_fit_gradient.py, tests/estimate/test_fit_gradient_scenes.py).
 
-Supported: single-scattering render of ``beckmann`` and ``ggx`` materials, Sun only, no
-articulated parts and no Earthshine (:func:`gradient_problems` says what is not).
+Supported: single-scattering render of ``beckmann`` and ``ggx`` materials, with the Sun,
+Earthshine and articulated parts (:func:`gradient_problems` says what is not).
 """
 
 from __future__ import annotations
-
-from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
 
 from speclight import instrument
-from speclight.constants import AU_M
-from speclight.illumination import solar_irradiance_W_m2_nm
-from speclight.render.session import RenderSession
-from speclight.render.single_gradient import gradient_problem, render_single_gradient
+from speclight.render.single_gradient import gradient_problem
 from speclight.scenario import LoadedScenario
 from speclight.simulate.geometry_stage import Geometry
 from speclight.simulate.radiometry import (
@@ -35,7 +32,7 @@ from speclight.simulate.radiometry import (
     wavelength_grid_nm,
 )
 from speclight.simulate.reflection import build_target
-from speclight.target.parts import Target
+from speclight.simulate.reflection_gradient import ReflectionGradient
 
 F64 = NDArray[np.float64]
 
@@ -49,10 +46,6 @@ def gradient_problems(loaded: LoadedScenario, rough: list[str]) -> list[str]:
             f"render.mode is '{sc.render.mode}': derivatives exist for the single-scattering "
             "render only (set render.mode: single, or use --method slsqp)"
         )
-    if sc.illumination.earthshine is not None:
-        out.append("illumination.earthshine is on (its render has no derivative here)")
-    if sc.target is not None and sc.target.articulation:
-        out.append("the target has articulated parts (target.articulation)")
     if sc.target is not None:
         target = build_target(loaded)
         for m in target.materials:
@@ -82,24 +75,14 @@ class RoughnessRates:
         sc = loaded.scenario
         geo = geometry
         self.rough = list(rough)
-        self.resolution_px = int(sc.render.resolution_px)
         self.wavelength_nm = wavelength_grid_nm(sc.spectrum)
-        self.target = build_target(loaded)
-        self.session = RenderSession.create("single", sc.render.variant, self.target.materials)
-        self.caster = self.session.caster(self.target)
-        solar = solar_irradiance_W_m2_nm(self.wavelength_nm, geo.sun_distance_m / AU_M)
-        sunlit = geo.sunlit_fraction if sc.illumination.sun else np.zeros(geo.t_s.size)
         self.n = geo.t_s.size
-        self.lit = np.flatnonzero(use & geo.observable & (sunlit > 0))
-        self.dark = np.flatnonzero(use & geo.observable & ~(sunlit > 0))
-        self.sun_dir = geo.sun_direction_body[self.lit]
-        self.obs_dir = geo.observer_direction_body[self.lit]
-        self.irradiance = solar[self.lit]
-        self.sunlit = sunlit[self.lit, None]
+        self.seen = np.flatnonzero(use & geo.observable)
+        self.reflection = ReflectionGradient(loaded, geo, self.wavelength_nm, self.rough, self.seen)
         elevation = np.where(geo.observable, geo.elevation_deg, np.nan)
         transmission = atmosphere_transmission(loaded, self.wavelength_nm, elevation)
-        self.transmission = transmission[self.lit]
-        self.range_m = geo.range_m[self.lit]
+        self.transmission = transmission[self.seen]
+        self.range_m = geo.range_m[self.seen]
         zero = np.zeros((self.n, self.wavelength_nm.size))
         curves = instrument_response(loaded, self.wavelength_nm, zero, transmission, geo.range_m)
         self.kernel = curves.band_response * curves.qe
@@ -109,15 +92,6 @@ class RoughnessRates:
         )
         self.n_bands = self.kernel.shape[0]
         self.calls = 0
-
-    def _target(self, alpha: F64) -> Target:
-        values = dict(zip(self.rough, (float(a) for a in alpha), strict=True))
-        mats = {
-            m.name: replace(m, roughness=values[m.name]) if m.name in values else m
-            for m in self.target.materials
-        }
-        parts = tuple(replace(p, material=mats[p.material.name]) for p in self.target.parts)
-        return Target(parts=parts)
 
     def _rates(self, intensity: F64) -> F64:
         flux = instrument.spectral_flux_W_nm(
@@ -132,23 +106,12 @@ class RoughnessRates:
         k = len(self.rough)
         rates = np.full((self.n, self.n_bands), np.nan)
         jac = np.full((k, self.n, self.n_bands), np.nan)
-        rates[self.dark] = 0.0
-        jac[:, self.dark] = 0.0
-        if self.lit.size == 0:
+        if self.seen.size == 0:
             return rates, jac
-        intensity, d_intensity = render_single_gradient(
-            self._target(np.asarray(alpha, dtype=float)),
-            self.sun_dir,
-            self.obs_dir,
-            self.irradiance,
-            self.wavelength_nm,
-            self.caster,
-            self.resolution_px,
-            self.rough,
-        )
-        rates[self.lit] = self._rates(intensity * self.sunlit)
+        intensity, d_intensity = self.reflection(np.asarray(alpha, dtype=float))
+        rates[self.seen] = self._rates(intensity)
         for j in range(k):
-            jac[j, self.lit] = self._rates(d_intensity[j] * self.sunlit)
+            jac[j, self.seen] = self._rates(d_intensity[j])
         return rates, jac
 
 

@@ -11,7 +11,7 @@ so the shadows between them are those of the render (the shadow rays see every p
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 
 import numpy as np
 from numpy.typing import NDArray
@@ -40,6 +40,19 @@ def pose_groups(angles_rad: F64, angle_step_deg: float) -> tuple[F64, NDArray[np
     return poses, inverse.reshape(-1).astype(np.int64)
 
 
+def posed_groups(
+    target: Target, joints: tuple[Joint, ...], angles_rad: F64, angle_step_deg: float
+) -> Iterator[tuple[NDArray[np.int64], Target]]:
+    """``(epochs, posed target)`` per pose of :func:`pose_groups`, in its order.
+
+    Every renderer of an articulated target (the pipeline's, the roughness-gradient pass's)
+    groups its epochs through this, so that they pose the parts alike.
+    """
+    poses, group = pose_groups(angles_rad, angle_step_deg)
+    for g, pose in enumerate(poses):
+        yield np.flatnonzero(group == g), posed_target(target, joints, pose)
+
+
 def render_articulated(
     target: Target,
     joints: tuple[Joint, ...],
@@ -59,7 +72,6 @@ def render_articulated(
     ``kwargs`` are passed to :func:`render_intensity` (``resolution_px``, ``seed``, ...).
     """
     n, n_wl = len(sun_dir_body), len(wavelength_nm)
-    poses, group = pose_groups(angles_rad, angle_step_deg)
     keep = set(int(k) for k in (keep_images_for or ()))
     intensity = np.full((n, n_wl), np.nan)
     std = np.full((n, n_wl), np.nan)
@@ -71,11 +83,9 @@ def render_articulated(
     stokes = stokes_std = None
     if kwargs.get("polarization"):
         stokes, stokes_std = np.full((n, n_wl, 3), np.nan), np.full((n, n_wl, 3), np.nan)
-    for g, pose in enumerate(poses):
-        idx = np.flatnonzero(group == g)
+    for idx, posed in posed_groups(target, joints, angles_rad, angle_step_deg):
         if on_hits is not None:
             kwargs["on_hits"] = _in_group(on_hits, idx)  # type: ignore[arg-type]
-        posed = posed_target(target, joints, pose)
         local_keep = [j for j, e in enumerate(idx) if int(e) in keep]
         res = render_intensity(
             posed,

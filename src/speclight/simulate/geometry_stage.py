@@ -283,3 +283,11 @@ def scenario_geometry(
         phase_vector_body=phase_b,
         flags=flags,
     )
+
+
+def pole_body(geo: Geometry) -> NDArray[np.float64]:
+    """(N, 3) the celestial pole (GCRS z axis) in the body frame at each epoch."""
+    from speclight.attitude.quaternion import quat_conjugate, quat_rotate
+
+    q = quat_conjugate(geo.quaternion_body_to_gcrs)
+    return np.asarray(quat_rotate(q, np.broadcast_to([0.0, 0.0, 1.0], (len(q), 3))))

@@ -27,9 +27,15 @@ from speclight.scenario.sections_light import (
     ShippedTable,
 )
 from speclight.scenario.sections_light import Material as MaterialModel
-from speclight.simulate.geometry_stage import Geometry
+from speclight.simulate.earthshine_stage import earthshine_intensity
+from speclight.simulate.geometry_stage import Geometry, pole_body
 from speclight.target import Material, Reflectance, Target
-from speclight.target.articulation import Joint, check_joint_parts, read_angle_table
+from speclight.target.articulation import (
+    Joint,
+    check_joint_parts,
+    joint_angles_rad,
+    read_angle_table,
+)
 from speclight.target.brdf_table import load_brdf_table
 from speclight.target.from_values import BUILTIN_SHAPES
 from speclight.target.material_tables import material_table_path
@@ -220,7 +226,7 @@ def render_reflection(
         if joints:
             from speclight.render.articulated import render_articulated
 
-            angles = np.stack([j.angles_rad(sun_b, geo.time_utc[idx]) for j in joints], axis=1)
+            angles = joint_angles_rad(joints, sun_b, geo.time_utc[idx])
             result = render_articulated(
                 target,
                 joints,
@@ -276,77 +282,3 @@ def render_reflection(
     return Reflection(
         solar, intensity, std, variant, images, part_names, flags, earthshine, stokes, stokes_std
     )
-
-
-def pole_body(geo: Geometry) -> F64:
-    """(N, 3) the celestial pole (GCRS z axis) in the body frame at each epoch."""
-    from speclight.attitude.quaternion import quat_conjugate, quat_rotate
-
-    q = quat_conjugate(geo.quaternion_body_to_gcrs)
-    return np.asarray(quat_rotate(q, np.broadcast_to([0.0, 0.0, 1.0], (len(q), 3))))
-
-
-def earthshine_intensity(
-    loaded: LoadedScenario,
-    geo: Geometry,
-    solar: F64,
-    wavelength_nm: F64,
-    target: Target,
-    session: RenderSession,
-) -> tuple[F64, F64 | None]:
-    """(N, L) intensity from Earthshine (:mod:`speclight.illumination.earthshine`): one
-    render per lit cell of the visible Earth cap and observable epoch, the cell as the Sun
-    in its direction with the irradiance ``w_k E_sun``. Unobservable epochs get NaN. The
-    target is rendered as built (articulated parts at their reference pose).
-
-    With ``render.polarization`` also its Stokes Q, U, V (N, L, 3) (else None): the light of
-    each cell is taken as unpolarised (the Rayleigh polarisation of the sky over the Earth
-    is not modelled)."""
-    from speclight.attitude.quaternion import quat_conjugate, quat_rotate
-    from speclight.illumination.earthshine import earthshine_sources
-    from speclight.render import render_intensity
-
-    sc = loaded.scenario
-    es = sc.illumination.earthshine
-    assert es is not None
-    n = geo.t_s.size
-    out = np.full((n, wavelength_nm.size), np.nan)
-    idx = np.flatnonzero(geo.observable)
-    q = geo.quaternion_body_to_gcrs[idx]
-    sun_gcrs = quat_rotate(q, geo.sun_direction_body[idx])
-    dirs, weights = earthshine_sources(geo.r_target_gcrs_m[idx], sun_gcrs, es.albedo, es.samples)
-    weights = np.nan_to_num(weights)
-    epoch, cell = np.nonzero(weights > 0)
-    out[idx] = 0.0
-    polarized = sc.render.polarization
-    stokes = np.full((n, wavelength_nm.size, 3), np.nan) if polarized else None
-    if stokes is not None:
-        stokes[idx] = 0.0
-    if epoch.size == 0:
-        return out, stokes
-    q_inv = quat_conjugate(q[epoch])
-    sources_body = quat_rotate(q_inv, dirs[epoch, cell])
-    result = render_intensity(
-        target,
-        sources_body,
-        geo.observer_direction_body[idx][epoch],
-        solar[idx][epoch] * weights[epoch, cell][:, None],
-        wavelength_nm,
-        mode=session.mode,
-        variant=sc.render.variant,
-        session=session,
-        resolution_px=sc.render.resolution_px,
-        samples_per_pixel=sc.render.samples_per_pixel,
-        seed=sc.render.seed,
-        workers=os.cpu_count(),
-        polarization=polarized,
-        pole_body=pole_body(geo)[idx][epoch] if polarized else None,
-    )
-    total = np.zeros((idx.size, wavelength_nm.size))
-    np.add.at(total, epoch, np.nan_to_num(result.intensity_W_sr_nm))
-    out[idx] = total
-    if stokes is not None and result.stokes_W_sr_nm is not None:
-        total3 = np.zeros((idx.size, wavelength_nm.size, 3))
-        np.add.at(total3, epoch, np.nan_to_num(result.stokes_W_sr_nm))
-        stokes[idx] = total3
-    return out, stokes

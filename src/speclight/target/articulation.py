@@ -94,6 +94,13 @@ class Joint:
         return np.radians(np.interp(at - knots[0], knots - knots[0], self.table_angle_deg))
 
 
+def joint_angles_rad(
+    joints: tuple[Joint, ...], sun_body: F64, time_utc: NDArray[np.datetime64]
+) -> F64:
+    """(N, J) every joint's angle [rad] at each epoch (Sun directions (N, 3), body frame)."""
+    return np.stack([j.angles_rad(sun_body, time_utc) for j in joints], axis=1)
+
+
 def sun_tracking_angle_rad(axis: F64, n0: F64, sun_body: F64) -> F64:
     """Hinge angle [rad] bringing the normal closest to the Sun (see the module doc)."""
     b = np.cross(axis, n0)
