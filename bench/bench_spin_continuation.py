@@ -41,7 +41,15 @@ from speclight.estimate.spin_axis_refine import (
 )
 
 sys.path.insert(0, str(Path(__file__).parent))
-from bench_spin_refine import BOUND, TRUTH, _dphase, _offset_axis, _problem, _whole_search
+from bench_spin_refine import (
+    BOUND,
+    TRUTH,
+    _dphase,
+    _offset_axis,
+    _problem,
+    _whole_search,
+    start_sets,
+)
 
 DEFAULT = (
     "gradient,slsqp,map:4x8,map:2x8/4x8,map:2x2/4x4,map:1x2/2x4/4x8,time:20/5,time:40/15/5,"
@@ -115,27 +123,7 @@ def main() -> None:
             f"{o.error:.6g}"
         )
     # the starts of bench_spin_refine.py: the same draws in the same order
-    sets: list[tuple[str, list, float | None]] = []
-    o = optimum[None]
-    for dist in (5, 10, 20, 40, 60, 90):
-        starts = []
-        for _ in range(args.bearings):
-            ra, dec = _offset_axis(o.ra_deg, o.dec_deg, dist, rng.uniform(0, 2 * np.pi))
-            starts.append(((ra, dec, o.phase_deg + rng.uniform(-15, 15)), None))
-        sets.append((f"axis {dist} deg off", starts, None))
-    for dph in (10, 20, 45, 90, 135):
-        starts = [((o.ra_deg, o.dec_deg, o.phase_deg + s * dph), None) for s in (-1, 1)]
-        sets.append((f"phase {dph} deg off", starts, None))
-    of = optimum[BOUND]
-    for rel in (0.005, 0.02):
-        starts = []
-        for sign in (-1, 1):
-            for _ in range(max(1, args.bearings // 2)):
-                ra, dec = _offset_axis(of.ra_deg, of.dec_deg, 10, rng.uniform(0, 2 * np.pi))
-                ph = of.phase_deg + rng.uniform(-10, 10)
-                starts.append(((ra, dec, ph), 120.0 * (1 + sign * rel)))
-        if not args.no_period:
-            sets.append((f"period {rel * 100:g} % off (free), axis 10 deg off", starts, BOUND))
+    sets = start_sets(optimum, rng, args.bearings, period=not args.no_period)
     names = args.variants.split(",")
     runners = {n: _variant(n, bmap, geo, y) for n in names}
     for name in names:

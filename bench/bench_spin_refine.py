@@ -111,6 +111,36 @@ def _dphase(a: float, b: float) -> float:
     return abs((a - b + 180.0) % 360.0 - 180.0)
 
 
+def start_sets(
+    optimum: dict, rng: np.random.Generator, bearings: int, period: bool = True
+) -> list[tuple[str, list, float | None]]:
+    """The starts, drawn in this order: axis offsets (5-90 deg, ``bearings`` random bearings
+    each), phase offsets, and (``period``) the period 0.5 % / 2 % off with the axis 10 deg
+    off. ``optimum[None]`` / ``optimum[BOUND]``: the optimum with the period fixed / free."""
+    sets: list[tuple[str, list, float | None]] = []
+    o = optimum[None]
+    for dist in (5, 10, 20, 40, 60, 90):
+        starts = []
+        for _ in range(bearings):
+            ra, dec = _offset_axis(o.ra_deg, o.dec_deg, dist, rng.uniform(0, 2 * np.pi))
+            starts.append(((ra, dec, o.phase_deg + rng.uniform(-15, 15)), None))
+        sets.append((f"axis {dist} deg off", starts, None))
+    for dph in (10, 20, 45, 90, 135):
+        starts = [((o.ra_deg, o.dec_deg, o.phase_deg + s * dph), None) for s in (-1, 1)]
+        sets.append((f"phase {dph} deg off", starts, None))
+    of = optimum[BOUND]
+    for rel in (0.005, 0.02):
+        starts = []
+        for sign in (-1, 1):
+            for _ in range(max(1, bearings // 2)):
+                ra, dec = _offset_axis(of.ra_deg, of.dec_deg, 10, rng.uniform(0, 2 * np.pi))
+                ph = of.phase_deg + rng.uniform(-10, 10)
+                starts.append(((ra, dec, ph), 120.0 * (1 + sign * rel)))
+        if period:
+            sets.append((f"period {rel * 100:g} % off (free), axis 10 deg off", starts, BOUND))
+    return sets
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--px", type=int, default=32)
@@ -144,26 +174,7 @@ def main() -> None:
                 for m, r in zip(REFINE_METHODS, res, strict=True)
             )
         )
-    sets: list[tuple[str, list, float | None]] = []
-    o = optimum[None]
-    for dist in (5, 10, 20, 40, 60, 90):
-        starts = []
-        for _ in range(args.bearings):
-            ra, dec = _offset_axis(o.ra_deg, o.dec_deg, dist, rng.uniform(0, 2 * np.pi))
-            starts.append(((ra, dec, o.phase_deg + rng.uniform(-15, 15)), None))
-        sets.append((f"axis {dist} deg off", starts, None))
-    for dph in (10, 20, 45, 90, 135):
-        starts = [((o.ra_deg, o.dec_deg, o.phase_deg + s * dph), None) for s in (-1, 1)]
-        sets.append((f"phase {dph} deg off", starts, None))
-    of = optimum[BOUND]
-    for rel in (0.005, 0.02):
-        starts = []
-        for sign in (-1, 1):
-            for _ in range(max(1, args.bearings // 2)):
-                ra, dec = _offset_axis(of.ra_deg, of.dec_deg, 10, rng.uniform(0, 2 * np.pi))
-                ph = of.phase_deg + rng.uniform(-10, 10)
-                starts.append(((ra, dec, ph), 120.0 * (1 + sign * rel)))
-        sets.append((f"period {rel * 100:g} % off (free), axis 10 deg off", starts, BOUND))
+    sets = start_sets(optimum, rng, args.bearings)
     print("\n| starts | " + " | ".join(REFINE_METHODS) + " |")
     print("|---|" + "---|" * len(REFINE_METHODS))
     for label, starts, bound in sets:
@@ -192,7 +203,7 @@ def main() -> None:
             )
         print(f"| {label} | " + " | ".join(cells) + " |", flush=True)
     _costs(bmap, geo, y)
-    _whole_search(bmap, geo, y, o)
+    _whole_search(bmap, geo, y, optimum[None])
 
 
 def _costs(bmap, geo, y) -> None:
