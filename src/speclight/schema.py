@@ -235,6 +235,18 @@ VARIABLES: dict[str, VariableInfo] = {
     "image_radiance": V(
         (*IMG, "wavelength"), "W m-2 sr-1 nm-1", "reflected spectral radiance per pixel"
     ),
+    "image_radiance_q": V(
+        (*IMG, "wavelength"),
+        "W m-2 sr-1 nm-1",
+        "Stokes Q of the reflected spectral radiance per pixel (render.polarization, single mode)",
+        comment=f"{POLARIZATION_FRAME}; Q > 0: polarised along north",
+    ),
+    "image_radiance_u": V(
+        (*IMG, "wavelength"),
+        "W m-2 sr-1 nm-1",
+        "Stokes U of the reflected spectral radiance per pixel (render.polarization, single mode)",
+        comment=f"{POLARIZATION_FRAME}; U > 0: polarised at position angle 45 degree",
+    ),
     "image_depth": V(
         IMG, "m", "distance along the line of sight behind the plane through the target centre"
     ),

@@ -1,4 +1,4 @@
-"""Saved images: band-integrated radiance and depth map of each saved epoch."""
+"""Saved images: band-integrated radiance, DoLP (when polarised), depth map of each epoch."""
 
 from __future__ import annotations
 
@@ -62,14 +62,49 @@ def _draw_parts(fig: Any, ax: Any, ds: xr.Dataset, k: int) -> str:
     return "part seen (grey: off target)"
 
 
+def _draw_dolp(fig: Any, ax: Any, ds: xr.Dataset, k: int, band: str | None) -> str:
+    """Degree of linear polarisation ``sqrt(Q^2 + U^2) / I`` of the band-integrated Stokes
+    images; pixels off the target or without signal (I <= 0) are masked (grey)."""
+    from matplotlib import colormaps
+
+    dolp = image_dolp(ds, k, band)
+    finite = dolp[np.isfinite(dolp)]
+    vmax = float(finite.max()) if finite.size and finite.max() > 0 else 1.0
+    cmap = colormaps["cividis"].with_extremes(bad="0.85")
+    im = ax.imshow(
+        np.ma.masked_invalid(dolp),
+        cmap=cmap,
+        vmin=0.0,
+        vmax=vmax,
+        interpolation="nearest",
+        extent=_extent_m(ds, k, *dolp.shape),
+        origin="upper",
+    )
+    fig.colorbar(im, ax=ax, label="DoLP [1]", shrink=0.85)
+    where = f"in {band}" if band else "whole grid"
+    return f"degree of linear polarisation, {where} (grey: no signal)"
+
+
+def image_dolp(ds: xr.Dataset, k: int, band: str | None) -> NDArray[np.float64]:
+    """DoLP image (H, W) of saved image ``k`` over ``band`` (or the whole grid); NaN off the
+    target and where the band-integrated radiance is not positive."""
+    i = band_radiance(ds, k, band)
+    q = band_radiance(ds, k, band, "image_radiance_q")
+    u = band_radiance(ds, k, band, "image_radiance_u")
+    ok = _on_target(ds, k, i) & (i > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(ok, np.hypot(q, u) / np.where(ok, i, 1.0), np.nan)
+
+
 def _caption(names: list[str]) -> str:
     words = {"N": "N celestial north", "Z": "Z zenith", "☉": "☉ Sun"}
     return ", ".join(words[n] for n in names)
 
 
 def images_figure(ds: xr.Dataset, band: str | None) -> Any:
-    """One row per saved epoch: radiance in ``band`` (or the whole grid), depth map, and the
-    part seen in each pixel (when the dataset names the parts).
+    """One row per saved epoch: radiance in ``band`` (or the whole grid), its degree of
+    linear polarisation (when the images carry Stokes Q, U: ``render.polarization``),
+    depth map, and the part seen in each pixel (when the dataset names the parts).
 
     Pixel row 0 is the top of the image (the renderer's convention); axes are metres at
     the target, right and up as seen by the observer. The first image of each row carries a
@@ -82,7 +117,10 @@ def images_figure(ds: xr.Dataset, band: str | None) -> Any:
 
     n = ds.sizes["image_time"]
     shown = min(n, MAX_IMAGE_ROWS)
+    polarised = "image_radiance" in ds and {"image_radiance_q", "image_radiance_u"} <= set(ds)
     columns = [c for c in ("image_radiance", "image_depth") if c in ds]
+    if polarised:
+        columns.insert(1, "image_dolp")
     if part_names(ds):
         columns.append("image_part")
     fig = new_figure(height_in=0.8 + 3.6 * shown, width_in=4.6 * len(columns) + 0.6)
@@ -92,8 +130,12 @@ def images_figure(ds: xr.Dataset, band: str | None) -> Any:
     for k in range(shown):
         i = int(np.argmin(np.abs(time - image_epochs[k])))
         for ax, col in zip(axes[k], columns, strict=True):
-            if col == "image_part":
-                what = _draw_parts(fig, ax, ds, k)
+            if col in ("image_part", "image_dolp"):
+                what = (
+                    _draw_parts(fig, ax, ds, k)
+                    if col == "image_part"
+                    else _draw_dolp(fig, ax, ds, k, band)
+                )
                 ax.set_title(f"{what}\n{epoch_summary(ds, i)}", fontsize="small")
                 ax.set_xlabel("right [m]")
                 ax.set_ylabel("up [m]")

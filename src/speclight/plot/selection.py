@@ -140,14 +140,16 @@ def resolve_band(ds: xr.Dataset, band: str | None) -> str | None:
     return band
 
 
-def band_radiance(ds: xr.Dataset, image: int, band: str | None) -> NDArray[np.float64]:
+def band_radiance(
+    ds: xr.Dataset, image: int, band: str | None, variable: str = "image_radiance"
+) -> NDArray[np.float64]:
     """Image radiance of saved image ``image`` integrated over a band [W m-2 sr-1].
 
     :math:`\\int L_\\lambda R_b(\\lambda) d\\lambda` as a bin sum on the wavelength grid,
     with the band's relative response :math:`R_b`; over the whole grid when ``band``
-    is None.
+    is None. ``variable`` names the image (``image_radiance_q`` / ``_u``: its Stokes Q, U).
     """
-    radiance = ds["image_radiance"].isel(image_time=image).transpose("y", "x", "wavelength")
+    radiance = ds[variable].isel(image_time=image).transpose("y", "x", "wavelength")
     weight = _bin_width_nm(ds["wavelength"].values)
     if band is not None:
         weight = weight * np.nan_to_num(ds["band_response"].sel(band=band).values)

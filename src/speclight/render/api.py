@@ -214,6 +214,11 @@ def render_intensity(
             q, u = rotate_linear(linear, np.zeros_like(linear), chi)
             stokes[valid] = np.stack([q, u, np.zeros_like(q)], axis=-1)
             stokes_std[valid] = 0.0
+            for j, img in imgs.items():  # the kept pixels: the same rotation
+                if img.stokes_qu_W_m2_sr_nm is not None:
+                    qs = img.stokes_qu_W_m2_sr_nm
+                    qi, ui = rotate_linear(qs[..., 0], qs[..., 1], chi[j])
+                    img.stokes_qu_W_m2_sr_nm = np.stack([qi, ui], axis=-1)
     else:
         chosen = session.variant
         from speclight.render.path import render_path

@@ -17,7 +17,11 @@ class RenderImage:
     centre that faces the observer (NaN where the pixel misses the target), so the range to a
     pixel is ``range_m + depth_m``; ``part_index`` (H, W) the part seen (-1: none).
     Row 0 is the top of the image; ``up_body`` and ``right_body`` are the body-frame directions
-    of the image axes; ``pixel_size_m`` is the pixel pitch [m].
+    of the image axes; ``pixel_size_m`` is the pixel pitch [m]. ``stokes_qu_W_m2_sr_nm``
+    (H, W, L, 2) is the Stokes Q, U of each pixel's radiance in the sky's north-east frame
+    (as :attr:`RenderResult.stokes_W_sr_nm`), single mode with polarisation only, else None;
+    :func:`speclight.render.single.render_single_polarized` leaves it referenced to the
+    scattering plane's normal (U = 0) and :func:`speclight.render.render_intensity` rotates it.
     """
 
     epoch: int
@@ -27,6 +31,7 @@ class RenderImage:
     pixel_size_m: float
     right_body: NDArray[np.float64]
     up_body: NDArray[np.float64]
+    stokes_qu_W_m2_sr_nm: NDArray[np.float64] | None = None
 
 
 @dataclass

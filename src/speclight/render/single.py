@@ -193,7 +193,8 @@ def render_single_polarized(
     it. U = V = 0 in that frame: every polarising reflection of single scattering (mirror,
     microfacet, plastic coat) has its plane of incidence in the scattering plane
     (:mod:`speclight.render.polarization`); diffuse channels are unpolarised. Without
-    ``polarization``: :func:`render_single`, and ``Q_s`` is None.
+    ``polarization``: :func:`render_single`, and ``Q_s`` is None. With it, each kept image's
+    ``stokes_qu_W_m2_sr_nm`` holds the per-pixel (Q_s, 0) in the same frame.
     """
     if polarization:
         check_polarizable(target.materials)
@@ -227,6 +228,15 @@ def render_single_polarized(
         pixels = resolution_px * resolution_px
         spec = np.zeros((pixels, len(wavelength_nm)))
         np.add.at(spec, kp.pixel, kp.weight[:, None] * factor[kp.channel])
+        qu = None
+        if polarization:  # Q_s per pixel, as for the total; U = 0 in this frame
+            lin = np.zeros((layout.n_channels, len(wavelength_nm)))
+            for k in range(n_mat):
+                lin[k] = q[k][e]
+            q_px = np.zeros((pixels, len(wavelength_nm)))
+            np.add.at(q_px, kp.pixel, kp.weight[:, None] * lin[kp.channel])
+            qu = np.stack([q_px, np.zeros_like(q_px)], axis=-1) * irradiance[e][:, None] / pitch**2
+            qu = qu.reshape(resolution_px, resolution_px, len(wavelength_nm), 2)
         images[e] = RenderImage(
             epoch=e,
             radiance_W_m2_sr_nm=(spec * irradiance[e] / pitch**2).reshape(
@@ -237,6 +247,7 @@ def render_single_polarized(
             pixel_size_m=pitch,
             right_body=kp.right,
             up_body=kp.up,
+            stokes_qu_W_m2_sr_nm=qu,
         )
     return intensity, linear, images
 

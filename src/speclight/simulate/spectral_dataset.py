@@ -66,6 +66,9 @@ def add_spectral(
 def add_images(ds: xr.Dataset, images: dict[int, RenderImage], part_names: list[str]) -> xr.Dataset:
     """Add saved hyperspectral images and depth maps on an ``image_time`` dimension.
 
+    With per-pixel Stokes Q, U (single mode, ``render.polarization``) also
+    ``image_radiance_q`` and ``image_radiance_u``.
+
     ``image_part`` carries the part names as CF ``flag_values`` / ``flag_meanings``.
     """
     if not images:
@@ -75,6 +78,11 @@ def add_images(ds: xr.Dataset, images: dict[int, RenderImage], part_names: list[
     ds = ds.assign_coords(image_time=("image_time", ds["time"].values[epochs]))
     ds["image_time"].attrs.update(schema.COORDINATES["image_time"])
     ds["image_radiance"] = schema.variable("image_radiance", radiance)
+    stokes = [images[e].stokes_qu_W_m2_sr_nm for e in epochs]
+    if all(s is not None for s in stokes):  # single mode with render.polarization
+        qu = np.stack([s for s in stokes if s is not None]).astype(np.float32)
+        ds["image_radiance_q"] = schema.variable("image_radiance_q", qu[..., 0])
+        ds["image_radiance_u"] = schema.variable("image_radiance_u", qu[..., 1])
     depth = np.stack([images[e].depth_m for e in epochs]).astype(np.float32)
     ds["image_depth"] = schema.variable("image_depth", depth)
     ds["image_part"] = schema.variable(
