@@ -40,10 +40,7 @@ def fit_rough_slsqp(
 ) -> Any:
     from speclight.simulate import simulate
 
-    usable: NDArray[np.bool_] = np.asarray(np.isfinite(m).any(axis=1))
-    target = base.scenario.target
-    assert target is not None
-    start = np.array([float(target.materials[n].roughness or 0.0) for n in rough])
+    usable, start = _usable_and_start(base, m, rough)
 
     def model(alpha: F64) -> F64:
         run = simulate(
@@ -54,16 +51,7 @@ def fit_rough_slsqp(
         c = run.dataset["count_rate"].transpose("time", "band").values.astype(float)
         return np.where(usable[:, None], c, np.nan)
 
-    on_iteration = None
-    if show:
-        from rich.console import Console
-
-        console = Console(stderr=True)
-
-        def on_iteration(k: int, alpha: F64, chi2: float) -> None:
-            values = ", ".join(f"{n}={a:.4f}" for n, a in zip(rough, alpha, strict=True))
-            console.print(f"fit iteration {k}: roughness {values}, chi2 {chi2:.6g}")
-
+    on_iteration = _printer(rough, "iteration") if show else None
     c0 = first.dataset["count_rate"].transpose("time", "band").values.astype(float)
     return fit_roughness(
         model,
@@ -90,25 +78,33 @@ def fit_rough_gradient(
     from speclight.estimate.gradient_fit import fit_roughness_gradient
     from speclight.estimate.roughness_gradient import RoughnessRates
 
-    usable: NDArray[np.bool_] = np.asarray(np.isfinite(m).any(axis=1))
-    target = base.scenario.target
-    assert target is not None
-    start = np.array([float(target.materials[n].roughness or 0.0) for n in rough])
+    usable, start = _usable_and_start(base, m, rough)
     rates = RoughnessRates(base, first.geometry, rough, usable)
     return fit_roughness_gradient(
         rates, m, sigma, start, ROUGHNESS_BOUNDS, fit_scale=fit_scale,
-        on_iteration=_printer(rough) if show else None,
+        on_iteration=_printer(rough, "evaluation") if show else None,
     )  # fmt: skip
 
 
-def _printer(rough: list[str]) -> Any:
+def _usable_and_start(
+    base: LoadedScenario, m: F64, rough: list[str]
+) -> tuple[NDArray[np.bool_], F64]:
+    """Epochs with any measurement (N,), and the scenario's roughness of ``rough`` (K,)."""
+    usable: NDArray[np.bool_] = np.asarray(np.isfinite(m).any(axis=1))
+    target = base.scenario.target
+    assert target is not None
+    return usable, np.array([float(target.materials[n].roughness or 0.0) for n in rough])
+
+
+def _printer(rough: list[str], step: str) -> Any:
+    """A progress line per fit ``step`` ("iteration", "evaluation") on stderr."""
     from rich.console import Console
 
     console = Console(stderr=True)
 
     def on_iteration(k: int, alpha: F64, chi2: float) -> None:
         values = ", ".join(f"{n}={a:.4f}" for n, a in zip(rough, alpha, strict=True))
-        console.print(f"fit evaluation {k}: roughness {values}, chi2 {chi2:.6g}")
+        console.print(f"fit {step} {k}: roughness {values}, chi2 {chi2:.6g}")
 
     return on_iteration
 
