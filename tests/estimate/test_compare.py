@@ -101,6 +101,28 @@ def _write(path: Path, rows: list[str], header: str = "time,magnitude,magnitude_
     return path
 
 
+def _observed_rows(tmp_path: Path, epochs: list[str]):
+    """Observations at Stuttgart (0 m) placing the TLE satellite where skyfield puts it:
+    azimuth, elevation and range per row (magnitudes are placeholders); also skyfield's
+    elevations [deg] and ranges [m]."""
+    ts = load_timescale()
+    name, l1, l2 = _tle()
+    sat = EarthSatellite(l1, l2, name, ts)
+    lat, lon, _ = STUTTGART
+    t = ts.from_datetimes([datetime.fromisoformat(e).replace(tzinfo=UTC) for e in epochs])
+    el, az, dist = (sat - wgs84.latlon(lat, lon, elevation_m=0.0)).at(t).altaz()
+    header = "time,magnitude,magnitude_sigma,band,latitude_deg,longitude_deg,"
+    header += "elevation_deg,azimuth_deg,range_m"
+    rows = [
+        f"{e}Z,10.0,0.05,G-600/40,{lat},{lon},{a!r},{z!r},{d!r}"
+        for e, a, z, d in zip(
+            epochs, el.degrees.tolist(), az.degrees.tolist(), dist.m.tolist(), strict=True
+        )
+    ]
+    obs = read_observations(_write(tmp_path / "obs.csv", rows, header))
+    return obs, el.degrees, dist.m
+
+
 @pytest.fixture(scope="module")
 def two_sites(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("compare")
@@ -208,28 +230,14 @@ def test_observed_positions_replace_the_orbit(tmp_path) -> None:
     # and range of the TLE satellite; the magnitudes then agree with the TLE run's (the
     # light time moves the target ~40 m of ~1000 km: < 1e-4 mag; the render is the same)
     # and the output's elevation and range are the placed ones.
-    ts = load_timescale()
-    name, l1, l2 = _tle()
-    sat = EarthSatellite(l1, l2, name, ts)
-    lat, lon, _ = STUTTGART
-    t = ts.from_datetimes([datetime.fromisoformat(e).replace(tzinfo=UTC) for e in EPOCHS])
-    el, az, dist = (sat - wgs84.latlon(lat, lon, elevation_m=0.0)).at(t).altaz()
-    header = "time,magnitude,magnitude_sigma,band,latitude_deg,longitude_deg,"
-    header += "elevation_deg,azimuth_deg,range_m"
-    rows = [
-        f"{e}Z,10.0,0.05,G-600/40,{lat},{lon},{a!r},{z!r},{d!r}"
-        for e, a, z, d in zip(
-            EPOCHS, el.degrees.tolist(), az.degrees.tolist(), dist.m.tolist(), strict=True
-        )
-    ]
-    obs = read_observations(_write(tmp_path / "obs.csv", rows, header))
+    obs, elevation_deg, range_m = _observed_rows(tmp_path, EPOCHS)
     data = yaml.safe_load(_scenario(tmp_path).read_text())
     data["observer"]["altitude_m"] = 0.0  # the rows' sites have no altitude_m: 0 m
     tle_run = compare(parse_scenario(yaml.safe_dump(data)), obs).dataset
     data["orbit"] = {"observed": True}
     placed = compare(parse_scenario(yaml.safe_dump(data)), obs).dataset
-    np.testing.assert_allclose(placed["elevation"].values, el.degrees, atol=1e-6)
-    np.testing.assert_allclose(placed["range"].values, dist.m, atol=1e-3)
+    np.testing.assert_allclose(placed["elevation"].values, elevation_deg, atol=1e-6)
+    np.testing.assert_allclose(placed["range"].values, range_m, atol=1e-3)
     np.testing.assert_allclose(
         placed["magnitude_simulated"].values, tle_run["magnitude_simulated"].values, atol=1e-4
     )
@@ -270,22 +278,8 @@ def test_observed_positions_give_a_nadir_attitude_its_velocity(tmp_path) -> None
     data["attitude"] = {"model": "nadir"}
     data["render"]["resolution_px"] = 64
     data["observer"]["altitude_m"] = 0.0
-    ts = load_timescale()
-    name, l1, l2 = _tle()
-    sat = EarthSatellite(l1, l2, name, ts)
-    lat, lon, _ = STUTTGART
     epochs = [f"2020-02-29T21:16:{s:02d}" for s in range(0, 40, 10)] + ["2020-02-29T21:17:30"]
-    t = ts.from_datetimes([datetime.fromisoformat(e).replace(tzinfo=UTC) for e in epochs])
-    el, az, dist = (sat - wgs84.latlon(lat, lon, elevation_m=0.0)).at(t).altaz()
-    header = "time,magnitude,magnitude_sigma,band,latitude_deg,longitude_deg,"
-    header += "elevation_deg,azimuth_deg,range_m"
-    rows = [
-        f"{e}Z,10.0,0.05,G-600/40,{lat},{lon},{a!r},{z!r},{d!r}"
-        for e, a, z, d in zip(
-            epochs, el.degrees.tolist(), az.degrees.tolist(), dist.m.tolist(), strict=True
-        )
-    ]
-    obs = read_observations(_write(tmp_path / "obs.csv", rows, header))
+    obs, _, _ = _observed_rows(tmp_path, epochs)
     tle_run = compare(parse_scenario(yaml.safe_dump(data)), obs).dataset
     data["orbit"] = {"observed": True}
     placed = compare(parse_scenario(yaml.safe_dump(data)), obs).dataset
