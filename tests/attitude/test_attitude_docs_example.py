@@ -3,25 +3,19 @@
 from __future__ import annotations
 
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "scenario.md"
 
 
-def test_profile_example_runs(tmp_path: Path) -> None:
+def test_profile_example_runs(run_python) -> None:
     text = DOC.read_text()
     section = text.split("### Operational attitude profiles", 1)[1].split("\n## ", 1)[0]
     blocks = re.findall(r"```python\n(.*?)```", section, flags=re.S)
     assert len(blocks) == 1
-    run = subprocess.run(
-        [sys.executable], input=blocks[0], cwd=tmp_path, capture_output=True, text=True,
-        timeout=300,
-    )  # fmt: skip
-    assert run.returncode == 0, run.stderr
+    stdout = run_python(blocks[0])
     # the yaw-steering law the example shows: the Sun in the body x-z plane, on the +x side
     largest_y, smallest_x = re.search(
-        r"largest \|sun_y\| (\S+), smallest sun_x (\S+)", run.stdout
+        r"largest \|sun_y\| (\S+), smallest sun_x (\S+)", stdout
     ).groups()
     assert float(largest_y) < 1e-12 and float(smallest_x) > 0.0

@@ -3,25 +3,19 @@
 from __future__ import annotations
 
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "polarization.md"
 
 
-def test_polarization_page_runs_as_written(tmp_path: Path) -> None:
+def test_polarization_page_runs_as_written(tmp_path: Path, run_python) -> None:
     text = DOC.read_text()
-    code = "\n".join(re.findall(r"```python\n(.*?)```", text, flags=re.S))
-    run = subprocess.run(
-        [sys.executable], input=code, cwd=tmp_path, capture_output=True, text=True, timeout=300
-    )
-    assert run.returncode == 0, run.stderr
+    stdout = run_python("\n".join(re.findall(r"```python\n(.*?)```", text, flags=re.S)))
     shown = re.findall(r"```text\n(.*?)```", text, flags=re.S)
-    assert shown[0].strip() == run.stdout.split("Stokes frame")[0].strip()
-    assert shown[1].strip() == "Stokes frame" + run.stdout.split("Stokes frame")[1].rstrip()
+    assert shown[0].strip() == stdout.split("Stokes frame")[0].strip()
+    assert shown[1].strip() == "Stokes frame" + stdout.split("Stokes frame")[1].rstrip()
     # the single mode's DoLP of a microfacet sphere is the Fresnel ratio at the half angle
-    for line in run.stdout.splitlines()[1:13]:
+    for line in stdout.splitlines()[1:13]:
         _, _, dolp, fresnel, _ = line.split()
         assert dolp == fresnel, line
     assert (tmp_path / "calsphere-polarization.png").stat().st_size > 10_000
