@@ -285,6 +285,9 @@ def _describe(exc: ValidationError, data: dict[str, Any], root: Any) -> str:
             path = [*path, loc[-1]] if path[-1:] != [loc[-1]] else path
         else:
             msg = err["msg"].removeprefix("Value error, ")
+            section, _, rest = msg.partition(": ")
+            if not loc and section in Scenario.model_fields:  # a rule between sections
+                path, msg = [section], rest  # names the section it is about first
             shown = "" if isinstance(value, dict) else f" = {value!r}"
             message = f"{shown}: {msg}" if shown else f": {msg}"
         field = ".".join(str(p) for p in path) or "(top level)"

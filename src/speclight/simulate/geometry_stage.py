@@ -95,9 +95,12 @@ def _orientation(o: AxesOrientation) -> NDArray[np.float64]:
 
 
 def attitude_quaternions(
-    cfg: FixedAttitude | SpinAttitude | TorqueFreeAttitude, t_s: NDArray[np.float64]
+    cfg: FixedAttitude | SpinAttitude | TorqueFreeAttitude | None, t_s: NDArray[np.float64]
 ) -> NDArray[np.float64]:
-    """Body-to-GCRS quaternions (N, 4) for the scenario's attitude model."""
+    """Body-to-GCRS quaternions (N, 4) for the scenario's attitude model (None, a
+    geometry-only scenario without one: the identity, the body frame is the GCRS)."""
+    if cfg is None:
+        return np.broadcast_to([1.0, 0.0, 0.0, 0.0], (t_s.size, 4)).copy()
     if isinstance(cfg, FixedAttitude):
         return np.broadcast_to(_orientation(cfg), (t_s.size, 4)).copy()
     if isinstance(cfg, SpinAttitude):
