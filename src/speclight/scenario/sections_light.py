@@ -169,6 +169,7 @@ _SHAPE_SIZES: dict[str, tuple[str, ...]] = {
         "wing_gap_m",
         "dish_radius_m",
         "dish_depth_m",
+        "dish",
     ),
     "bus_array": ("bus_size_m", "array_size_m", "array_gap_m"),
 }
@@ -199,6 +200,7 @@ class Shape(Strict):
     wing_gap_m: float | None = Field(default=None, ge=0)
     dish_radius_m: float | None = Field(default=None, gt=0)
     dish_depth_m: float | None = Field(default=None, gt=0)
+    dish: bool | None = Field(default=None, description="box_wing: false leaves out the dish")
     array_size_m: Annotated[list[float], Field(min_length=2, max_length=2)] | None = None
     array_gap_m: float | None = Field(default=None, ge=0)
 
@@ -225,6 +227,8 @@ class Shape(Strict):
                 f"builtin '{self.builtin}' takes {', '.join(_SHAPE_SIZES[self.builtin])}, "
                 f"not {', '.join(extra)}"
             )
+        if self.dish is False and (self.dish_radius_m or self.dish_depth_m):
+            raise ValueError("dish: false leaves out the dish; drop dish_radius_m, dish_depth_m")
         _check_scale(self.builtin, {k: getattr(self, k) for k in sizes})
         return self
 
