@@ -72,3 +72,30 @@ def test_chain_at_an_eclipsed_epoch_says_so_and_shows_no_sunlight() -> None:
     fig = chain_figure(ds, LIT)
     assert "[" not in fig._suptitle.get_text()
     np.testing.assert_allclose(_sun_panel_curve(fig), solar[LIT], rtol=1e-12)
+
+
+def test_one_kind_asked_for_is_written_to_exactly_the_file_named(
+    full_file: Path, tmp_path: Path
+) -> None:
+    # issue 22 item 9: `plot -o bw-chain.png --kind chain` wrote the overview to
+    # bw-chain.png and the chain to bw-chain-chain.png
+    from matplotlib.image import imread
+
+    plot_files(full_file, tmp_path / "all.png")  # the overview and, beside it, the chain
+    out = tmp_path / "bw-chain.png"
+    result = CliRunner().invoke(app, ["plot", str(full_file), "-o", str(out), "--kind", "chain"])
+    assert result.exit_code == 0, result.output
+    assert result.stdout == f"wrote {out}\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "all-chain.png",
+        "all.png",
+        "bw-chain.png",
+        "full.nc",
+    ]
+    # the chain figure (its size), not the overview
+    chain, overview = imread(tmp_path / "all-chain.png"), imread(tmp_path / "all.png")
+    assert chain.shape != overview.shape
+    assert imread(out).shape == chain.shape
+    # several kinds: the first goes to the file named, the others beside it
+    written = plot_files(full_file, tmp_path / "two.png", kinds=["chain", "overview"])
+    assert [p.name for p in written] == ["two.png", "two-chain.png"]
