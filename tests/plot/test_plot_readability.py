@@ -151,3 +151,28 @@ def test_images_figure_draws_the_compass() -> None:
     # without attitude or image axes: no compass, the figure still draws
     plain = images_figure(image_dataset(), None)
     assert not [t for t in plain.axes[0].texts if t.get_text()]
+
+
+def _overlapping_tick_labels(fig, ax) -> list[tuple[str, str]]:  # type: ignore[no-untyped-def]
+    """Pairs of neighbouring x tick labels of ``ax`` whose drawn boxes intersect."""
+    fig.canvas.draw()  # layout and ticks as they are saved
+    renderer = fig.canvas.get_renderer()
+    labels = [t for t in ax.get_xticklabels() if t.get_visible() and t.get_text()]
+    boxes = sorted(((t.get_window_extent(renderer), t.get_text()) for t in labels),
+                   key=lambda box: box[0].x0)  # fmt: skip
+    return [(a, b) for (p, a), (q, b) in zip(boxes, boxes[1:], strict=False) if p.x1 > q.x0]
+
+
+@pytest.mark.parametrize("span_s", [20.0, 600.0, 6 * 3600.0])
+def test_time_tick_labels_do_not_run_together(span_s: float) -> None:
+    # issue 22 item 9: the box-wing pass (600 s) read "02:20:0002:21:00..."
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    ds = _with_bands(full_dataset(), TEN_BANDS_NM)  # ten bands: a colour bar, narrow axes
+    step = np.timedelta64(int(span_s / (N_TIME - 1) * 1e9), "ns")
+    ds = ds.assign_coords(time=ds["time"].values[0] + np.arange(N_TIME) * step)
+    fig = overview_figure(ds)
+    FigureCanvasAgg(fig)
+    bottom = next(ax for ax in fig.axes if ax.get_xlabel().startswith("time [UTC]"))
+    assert _overlapping_tick_labels(fig, bottom) == []
+    assert len([t for t in bottom.get_xticklabels() if t.get_text()]) >= 3
