@@ -7,6 +7,7 @@ current figure) of the caller.
 
 from __future__ import annotations
 
+import warnings
 from typing import Any
 
 import numpy as np
@@ -92,8 +93,10 @@ def set_time_ticks(ax: Any) -> None:
                 width_pt = axes.get_window_extent().width * 72.0 / axes.get_figure().dpi
                 font = FontProperties(size=rcParams["xtick.labelsize"])
                 fitting = int(width_pt / (TIME_LABEL_PITCH_EM * font.get_size_in_points()))
-                self.maxticks = dict.fromkeys(self.maxticks, max(fitting, 2))
-            return super().__call__()
+                self.maxticks = dict.fromkeys(self.maxticks, max(fitting, self.minticks))
+            with warnings.catch_warnings():  # too narrow for any step: it takes the longest
+                warnings.filterwarnings("ignore", "AutoDateLocator was unable", UserWarning)
+                return super().__call__()
 
     locator = FittingLocator(minticks=3)
     # steps of 2 and 20 besides matplotlib's 1, 5, 10, 15, 30: 5 ticks on a 10-min pass
