@@ -47,15 +47,11 @@ def site_index(ds: xr.Dataset) -> tuple[np.ndarray, list[str]]:
 def _legend_handles(bands: list[str], colours: dict[str, Any], site_labels: list[str]) -> list:
     from matplotlib.lines import Line2D
 
-    handles = [
-        Line2D([], [], color=colours[b], marker="o", ls="", ms=5, label=b) for b in bands
-    ]
+    handles = [Line2D([], [], color=colours[b], marker="o", ls="", ms=5, label=b) for b in bands]
     if len(site_labels) > 1:
-        handles += [
-            Line2D([], [], color="0.3", marker=SITE_MARKERS[k % len(SITE_MARKERS)], ls="",
-                   ms=5, label=label)  # fmt: skip
-            for k, label in enumerate(site_labels)
-        ]
+        for k, label in enumerate(site_labels):
+            marker = SITE_MARKERS[k % len(SITE_MARKERS)]
+            handles.append(Line2D([], [], color="0.3", marker=marker, ls="", ms=5, label=label))
     return handles
 
 

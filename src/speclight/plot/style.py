@@ -88,9 +88,9 @@ def set_time_ticks(ax: Any) -> None:
 
     class FittingLocator(mdates.AutoDateLocator):
         def __call__(self) -> Any:
-            if self.axis is not None:
-                axes = self.axis.axes
-                width_pt = axes.get_window_extent().width * 72.0 / axes.get_figure().dpi
+            axes = getattr(self.axis, "axes", None)  # None before the locator is on an axis
+            if axes is not None:
+                width_pt = axes.get_window_extent().width * 72.0 / axes.figure.dpi
                 font = FontProperties(size=rcParams["xtick.labelsize"])
                 fitting = int(width_pt / (TIME_LABEL_PITCH_EM * font.get_size_in_points()))
                 self.maxticks = dict.fromkeys(self.maxticks, max(fitting, self.minticks))
