@@ -99,3 +99,20 @@ def test_one_kind_asked_for_is_written_to_exactly_the_file_named(
     # several kinds: the first goes to the file named, the others beside it
     written = plot_files(full_file, tmp_path / "two.png", kinds=["chain", "overview"])
     assert [p.name for p in written] == ["two.png", "two-chain.png"]
+
+
+def test_a_missing_or_unreadable_dataset_is_a_one_line_error(tmp_path: Path) -> None:
+    # issue 22 item 9: `speclight plot missing.nc` printed h5py's errno message
+    junk = tmp_path / "junk.nc"
+    junk.write_bytes(b"\x00" * 4096)
+    cases = {
+        tmp_path / "missing.nc": "cannot read dataset: no such file: it does not exist",
+        tmp_path: "cannot read dataset: it is a folder; give the path of a file in it",
+        junk: "cannot read it as a NetCDF dataset: it is not a NetCDF4 (HDF5) file; give a "
+        "file written by `speclight simulate`",
+    }
+    for path, message in cases.items():
+        result = CliRunner().invoke(app, ["plot", str(path), "-o", str(tmp_path / "f.png")])
+        assert result.exit_code == 2, result.output
+        assert result.stderr == f"error: {path}: {message}\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["junk.nc"]

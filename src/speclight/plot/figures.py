@@ -24,6 +24,7 @@ from typing import Any
 import xarray as xr
 
 from speclight.errors import InputError, did_you_mean
+from speclight.input_files import check_user_file
 from speclight.io.output import create_new_file
 from speclight.plot.chain import chain_figure
 from speclight.plot.images import images_figure
@@ -177,12 +178,22 @@ def _check_output(output: Path) -> None:
         raise InputError(f"folder {output.parent} does not exist", field="--output")
 
 
+#: What h5py's messages about an unreadable file mean, for a one-line error.
+_HDF5_PROBLEMS = {
+    "file signature not found": "it is not a NetCDF4 (HDF5) file",
+    "truncated file": "it is cut short (truncated)",
+}
+
+
 def _load(dataset: Path) -> xr.Dataset:
+    check_user_file(dataset, what="dataset", max_bytes=None)  # missing, a folder, a FIFO...
     try:
         ds = xr.load_dataset(dataset, engine="h5netcdf")
     except (OSError, ValueError, TypeError, KeyError) as exc:
+        said = " ".join(str(exc).split())  # h5py's can span lines
+        why = next((w for key, w in _HDF5_PROBLEMS.items() if key in said), said)
         raise InputError(
-            f"cannot read it as a NetCDF dataset ({exc}); give a file written by "
+            f"cannot read it as a NetCDF dataset: {why}; give a file written by "
             "`speclight simulate`",
             source=str(dataset),
         ) from exc
