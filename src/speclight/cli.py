@@ -1195,9 +1195,38 @@ def _one_line_notice(
     return f"notice: {message}\n"
 
 
+#: Notices printed by this process: their text, or the category of those said once whatever
+#: their text (the Earth-orientation table's).
+_shown_notices: set[object] = set()
+
+
+def _show_notice_once(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: Any = None,
+    line: str | None = None,
+) -> None:
+    """Print a warning as a one-line notice, once per process (Python's own "once per
+    place" starts over whenever a library changes the warning filters)."""
+    from speclight.orbit.staleness import EarthOrientationWarning
+
+    key = category if issubclass(category, EarthOrientationWarning) else (category, str(message))
+    if key in _shown_notices:
+        return
+    _shown_notices.add(key)
+    stream = sys.stderr if file is None else file
+    try:
+        stream.write(_one_line_notice(message, category, filename, lineno, line))
+    except OSError:  # stderr closed: a notice is not worth failing for
+        pass
+
+
 def main() -> None:
     """Console-script entry point."""
     warnings.formatwarning = _one_line_notice  # fallbacks are notices, not tracebacks
+    warnings.showwarning = _show_notice_once
     app(prog_name="speclight")
 
 
