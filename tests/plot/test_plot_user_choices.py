@@ -116,3 +116,12 @@ def test_a_missing_or_unreadable_dataset_is_a_one_line_error(tmp_path: Path) -> 
         assert result.exit_code == 2, result.output
         assert result.stderr == f"error: {path}: {message}\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["junk.nc"]
+
+
+def test_the_band_panel_says_what_g_names_mean() -> None:
+    # issue 22 item 9: G-420/26 reads like a FWHM of 26 nm; it is a sigma
+    ds = full_dataset()  # bands G-450/30, G-650/30, G-850/30
+    title = chain_figure(ds, LIT).axes[-1].get_title(loc="left")
+    assert "G-c/s: Gaussian, centre c, sigma s [nm], not FWHM" in title
+    renamed = ds.assign_coords(band=["blue", "red", "nir"])
+    assert "sigma" not in chain_figure(renamed, LIT).axes[-1].get_title(loc="left")
