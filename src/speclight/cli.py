@@ -223,7 +223,7 @@ def plot(
         typer.Option(
             "--kind",
             help="Figures to write: overview, chain, images, ranging (repeatable; default: all "
-            "that the data can fill; the overview is always written).",
+            "that the data can fill). OUTPUT is the first of them, the others go beside it.",
         ),
     ] = None,
     magnitude: Annotated[
@@ -237,7 +237,8 @@ def plot(
     force: Annotated[bool, typer.Option("--force", help="Overwrite existing figures.")] = False,
 ) -> None:
     """Plot a dataset: light curves, spectrogram and geometry in OUTPUT; the one-epoch chain,
-    images and ranging figures beside it (OUTPUT-chain.png, ...).
+    images and ranging figures beside it (OUTPUT-chain.png, ...). With --kind, OUTPUT holds
+    the first figure asked for: `--kind chain -o chain.png` writes chain.png alone.
 
     OUTPUT is claimed as `simulate` claims its output; none of the figures may be DATASET.
     """
@@ -250,7 +251,7 @@ def plot(
         chosen: int | str | None = epoch
         if epoch is not None and epoch.strip().lstrip("-").isdigit():
             chosen = int(epoch)
-        kinds = None if not kind else ["overview", *[k for k in kind if k != "overview"]]
+        kinds = kind or None
         with OutputClaim(output, force=force, inputs={"dataset": dataset}) as claim:
             for figure in figure_paths(claim.path, KINDS).values():
                 if figure.exists() and figure.samefile(dataset):
@@ -1194,9 +1195,38 @@ def _one_line_notice(
     return f"notice: {message}\n"
 
 
+#: Notices printed by this process: their text, or the category of those said once whatever
+#: their text (the Earth-orientation table's).
+_shown_notices: set[object] = set()
+
+
+def _show_notice_once(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: Any = None,
+    line: str | None = None,
+) -> None:
+    """Print a warning as a one-line notice, once per process (Python's own "once per
+    place" starts over whenever a library changes the warning filters)."""
+    from speclight.orbit.staleness import EarthOrientationWarning
+
+    key = category if issubclass(category, EarthOrientationWarning) else (category, str(message))
+    if key in _shown_notices:
+        return
+    _shown_notices.add(key)
+    stream = sys.stderr if file is None else file
+    try:
+        stream.write(_one_line_notice(message, category, filename, lineno, line))
+    except OSError:  # stderr closed: a notice is not worth failing for
+        pass
+
+
 def main() -> None:
     """Console-script entry point."""
     warnings.formatwarning = _one_line_notice  # fallbacks are notices, not tracebacks
+    warnings.showwarning = _show_notice_once
     app(prog_name="speclight")
 
 
