@@ -1025,7 +1025,8 @@ def sweep(
     on a Dask cluster and store every case's light curves in one Zarr store with a `case`
     dimension (docs/sweep.md). Every case is validated before any runs. Rerunning the same
     command resumes an interrupted sweep (done cases are skipped, failed ones retried); a
-    failed case is recorded in error(case) and the others go on.
+    failed case is recorded in error(case) and the others go on. Exit code 3 when some cases
+    failed (the others are stored), 1 when every case failed.
 
     Example: speclight sweep docs/examples/sweep-calsphere.yaml -o runs.zarr --workers 2
     """
@@ -1054,20 +1055,24 @@ def sweep(
             announce=not quiet,
         )
         _raise_if_signalled()
-        if quiet:
-            return
         last = result.first_case + result.n_cases - 1
-        typer.echo(
-            f"cases {result.first_case}..{last}: ran {result.ran}, skipped {result.skipped} "
-            f"done before, in {result.seconds:.1f} s"
-        )
-        if result.failed:
+        if not quiet:
+            typer.echo(
+                f"cases {result.first_case}..{last}: ran {result.ran}, skipped {result.skipped} "
+                f"done before, in {result.seconds:.1f} s"
+            )
+        if result.failed:  # docs/sweep.md, "Failures": exit 1 if all failed, 3 if some
             index, message = next(iter(result.failed.items()))
             typer.echo(
-                f"{len(result.failed)} case(s) failed (case {index}: {message}); their rows "
-                "are NaN and error(case) holds the message: rerun the same command to retry them"
+                f"error: {len(result.failed)} of {result.n_cases} case(s) failed (case {index}: "
+                f"{message}); their rows are NaN and error(case) holds the message: rerun the "
+                "same command to retry them",
+                err=True,
             )
-        typer.echo(f"wrote {output}")
+        if not quiet:
+            typer.echo(f"wrote {output}")
+        if result.exit_code:
+            raise typer.Exit(result.exit_code)
 
     _guarded(run)
 

@@ -240,7 +240,8 @@ def reflectivity_map(
                     task, chunks, label="reflectivity map", progress=progress
                 ):
                     write_chunk(group, outcome)
-                    run.rendered += 1
+                    if outcome.error is None:  # a failed chunk is counted in run.failed
+                        run.rendered += 1
         states = store.chunk_states(group)
         run.failed = dict(group.attrs.get("failed_chunks", {}))
         run.complete = bool(np.all(states == store.DONE))

@@ -33,6 +33,9 @@ from speclight.scenario import LoadedScenario, parse_scenario
 GEOMETRY_SECTIONS = {"time", "observer", "orbit", "attitude"}
 
 Task = Callable[[CaseTask], dict[str, np.ndarray]]
+#: Exit code of ``speclight sweep`` when some of its cases failed and the others are stored
+#: (every case failed: 1; none: 0).
+SOME_FAILED_EXIT = 3
 
 
 @dataclass
@@ -48,6 +51,14 @@ class SweepRun:
     complete: bool = False
     seconds: float = 0.0
     where: str = ""
+
+    @property
+    def exit_code(self) -> int:
+        """0 when no case of the sweep file failed, 1 when every one did (nothing to read),
+        :data:`SOME_FAILED_EXIT` when some did (their rows are NaN, the others stored)."""
+        if not self.failed:
+            return 0
+        return 1 if len(self.failed) >= self.n_cases else SOME_FAILED_EXIT
 
 
 def _geometry_key(loaded: LoadedScenario) -> str:
