@@ -710,6 +710,12 @@ def reflectivity_map(
             announce=True,
         )
         _raise_if_signalled()
+        if result.damaged:
+            typer.echo(
+                f"notice: {len(result.damaged)} chunk(s) marked done did not read back "
+                f"(chunk {result.damaged[0]}: a file cut short or deleted): rendered again",
+                err=True,
+            )
         typer.echo(
             f"{result.n_directions} directions in {result.n_chunks} chunks: rendered "
             f"{result.rendered}, skipped {result.skipped} done before, in {result.seconds:.1f} s"
@@ -1056,6 +1062,12 @@ def sweep(
         )
         _raise_if_signalled()
         last = result.first_case + result.n_cases - 1
+        if result.damaged:
+            typer.echo(
+                f"notice: {len(result.damaged)} case(s) marked done did not read back (case "
+                f"{result.damaged[0]}: a file cut short): run again",
+                err=True,
+            )
         if not quiet:
             typer.echo(
                 f"cases {result.first_case}..{last}: ran {result.ran}, skipped {result.skipped} "

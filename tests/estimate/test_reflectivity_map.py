@@ -223,4 +223,3 @@ def test_single_mode_map_after_a_path_mode_map_in_the_same_process(tmp_path):
     got = m.intensity_W_sr_nm[:, 0, 0, :]
     # 64 px: pixel sampling within 1 % (0.2 % at 256 px, TOLERANCE's source)
     np.testing.assert_allclose(got, np.broadcast_to(lambert(0.0) * e, got.shape), rtol=0.01)
-
