@@ -164,6 +164,16 @@ def test_a_refused_run_leaves_the_holders_lock_in_place(tmp_path):
     assert not lock.exists()
 
 
+def test_a_lock_file_on_a_full_disk_is_one_write_error(tmp_path, monkeypatch):
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(store_io.os, "open", full)
+    with pytest.raises(OutputWriteError, match=r"cannot write .*runs\.zarr: No space left"):
+        with store_io.store_lock(tmp_path / "runs.zarr"):
+            pass
+
+
 def test_a_sweep_file_of_a_million_cases_is_refused_with_its_estimate(tmp_path):
     path = tmp_path / "big.yaml"
     path.write_text(

@@ -114,7 +114,7 @@ def render_map_chunk(job: MapJob, chunk: MapChunk) -> dict[str, F32]:
         job.solar_W_m2_nm,
         engine.kernel,
         chunk.k,
-        workers=os.cpu_count(),  # numpy caster: capped to this process's share (one in Dask)
+        workers=os.cpu_count() or 1,  # numpy caster: this process's share (one in Dask)
     )
     out = {"intensity": inten.astype(np.float32)}
     if band_names:

@@ -145,9 +145,14 @@ def engine_versions() -> dict[str, str]:
             out[pkg] = version(pkg)
         except PackageNotFoundError:
             out[pkg] = "not installed"
-    missing = f"hidden by {HIDE_LLVM_ENV}" if llvm_hidden() else "not found"
-    out["libllvm"] = find_libllvm() or f"{missing} (LLVM variants unavailable)"
+    out["libllvm"] = libllvm_status()
     return out
+
+
+def libllvm_status() -> str:
+    """The libLLVM used, or why there is none (for ``speclight info``)."""
+    missing = f"hidden by {HIDE_LLVM_ENV}" if llvm_hidden() else "not found"
+    return find_libllvm() or f"{missing} (LLVM variants unavailable)"
 
 
 def available_variants() -> list[str]:
