@@ -171,8 +171,9 @@ def reflectivity_map(
 
     dirs = healpix_directions(nside)
     size = min(int(chunk), len(dirs))  # a chunk larger than the map is the whole map
+    n_geoms = sum(1 if a == 0 else n_rolls for a in angles)  # as _geometries lists them
+    task_bytes = check_chunk_memory(loaded, size, n_geoms, asked=int(chunk))  # up front
     geoms = _geometries(angles, n_rolls)
-    task_bytes = check_chunk_memory(loaded, size, len(geoms), asked=int(chunk))  # up front
     engine = map_engine(loaded, sc.render.variant)  # also the serial run's (cached)
     band_names = engine.kernel.band_names
     wl = wavelength_grid_nm(sc.spectrum)

@@ -49,13 +49,13 @@ def check_chunk_memory(
             fits = mid
         else:
             too_many = mid
-    accepted = f"at most {fits} for this map" if fits else "none fits: lower the render cost"
+    accepted = f"at most {fits} for this map" if fits else "none: fewer phase angles x rolls"
     raise InputError(
         f"--chunk = {asked or chunk}: a chunk renders {chunk} directions x {n_geometries} "
         f"geometries = {chunk * n_geometries} at once, about {need / 1024**3:.3g} GiB of "
         f"memory, more than the limit of {limit / 1024**3:.3g} GiB (half the physical "
         f"memory, or the process limit); accepted: {accepted} (render.resolution_px and "
-        "spectrum.step_nm set the cost of each)",
+        "spectrum.step_nm set the cost of each geometry)",
         field="--chunk",
     )
 
