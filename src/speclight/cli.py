@@ -711,6 +711,12 @@ def reflectivity_map(
             announce=True,
         )
         _raise_if_signalled()
+        if result.damaged:
+            typer.echo(
+                f"notice: {len(result.damaged)} chunk(s) marked done did not read back "
+                f"(chunk {result.damaged[0]}: a file cut short or deleted): rendered again",
+                err=True,
+            )
         typer.echo(
             f"{result.n_directions} directions in {result.n_chunks} chunks: rendered "
             f"{result.rendered}, skipped {result.skipped} done before, in {result.seconds:.1f} s"
@@ -1026,7 +1032,8 @@ def sweep(
     on a Dask cluster and store every case's light curves in one Zarr store with a `case`
     dimension (docs/sweep.md). Every case is validated before any runs. Rerunning the same
     command resumes an interrupted sweep (done cases are skipped, failed ones retried); a
-    failed case is recorded in error(case) and the others go on.
+    failed case is recorded in error(case) and the others go on (a warning says how many;
+    exit code 0); exit code 1 when every case failed.
 
     Example: speclight sweep docs/examples/sweep-calsphere.yaml -o runs.zarr --workers 2
     """
@@ -1055,20 +1062,31 @@ def sweep(
             announce=not quiet,
         )
         _raise_if_signalled()
-        if quiet:
-            return
         last = result.first_case + result.n_cases - 1
-        typer.echo(
-            f"cases {result.first_case}..{last}: ran {result.ran}, skipped {result.skipped} "
-            f"done before, in {result.seconds:.1f} s"
-        )
-        if result.failed:
-            index, message = next(iter(result.failed.items()))
+        if result.damaged:
             typer.echo(
-                f"{len(result.failed)} case(s) failed (case {index}: {message}); their rows "
-                "are NaN and error(case) holds the message: rerun the same command to retry them"
+                f"notice: {len(result.damaged)} case(s) marked done did not read back (case "
+                f"{result.damaged[0]}: a file cut short): run again",
+                err=True,
             )
-        typer.echo(f"wrote {output}")
+        if not quiet:
+            typer.echo(
+                f"cases {result.first_case}..{last}: ran {result.ran}, skipped {result.skipped} "
+                f"done before, in {result.seconds:.1f} s"
+            )
+        if result.failed:  # docs/sweep.md, "Failures": exit 1 if all failed, else 0
+            index, message = next(iter(result.failed.items()))
+            level = "error" if result.exit_code else "warning"
+            typer.echo(
+                f"{level}: {len(result.failed)} of {result.n_cases} case(s) failed (case {index}: "
+                f"{message}); their rows are NaN and error(case) holds the message: rerun the "
+                "same command to retry them",
+                err=True,
+            )
+        if not quiet:
+            typer.echo(f"wrote {output}")
+        if result.exit_code:
+            raise typer.Exit(result.exit_code)
 
     _guarded(run)
 
