@@ -57,8 +57,8 @@ class SweepRun:
     @property
     def exit_code(self) -> int:
         """1 when every case of the sweep file failed (nothing to read), else 0: failed cases
-        are data (their rows are NaN, ``error(case)`` says why; SPEC.md section 2 has only
-        0, 1 and 2, and a partly failed batch is flagged row by row, not by the exit code)."""
+        are data (their rows are NaN, ``error(case)`` says why; the command line has only
+        exit codes 0, 1 and 2: a partly failed batch is flagged row by row, not by its code)."""
         return 1 if self.failed and len(self.failed) >= self.n_cases else 0
 
 
