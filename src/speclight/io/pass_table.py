@@ -174,7 +174,7 @@ def print_passes(search: PassSearch, title: str) -> None:
             _spans(p.observable),
             f"{p.observable_s:.0f}",
         )
-    console = Console(width=None if sys.stdout.isatty() else 160)
+    console = Console(width=None if sys.stdout.isatty() else 200)
     if not search.passes:
         console.print(f"no pass above {search.min_elevation_deg:g} deg elevation in the window")
         return
