@@ -2,12 +2,11 @@
 sky position, for any orbit source (the pipeline's geometry stage and ``speclight passes``).
 
 A trajectory is the orbit source read once, ``t -> (r_gcrs_m (N, 3), ok (N,))``
-(:func:`speclight.simulate.geometry_stage.scenario_trajectory`).
+(:func:`speclight.orbit.orbit_sources.orbit_trajectory`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -17,11 +16,10 @@ from numpy.typing import NDArray
 from speclight import orbit
 from speclight.constants import C_M_S
 from speclight.orbit.observer import site_velocity_gcrs_m_s
+from speclight.orbit.orbit_sources import Trajectory
 from speclight.orbit.sky_position import SkyPosition, sky_position
 from speclight.orbit.timescale import time_from_utc
 from speclight.scenario.sections_geometry import Observer
-
-Trajectory = Callable[[Any], tuple[NDArray[np.float64], NDArray[np.bool_]]]
 
 #: Fixed-point iterations of the light-time equation; each gains a factor v/c ~ 3e-5, so two
 #: leave < 1e-9 s (0.3 mm) for targets up to GEO.

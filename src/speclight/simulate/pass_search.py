@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
+from speclight.orbit.orbit_sources import no_position_message
 from speclight.orbit.pass_finder import Pass, PassSamples, find_passes
 from speclight.orbit.staleness import warn_past_tables
 from speclight.orbit.timescale import time_from_utc
@@ -123,10 +124,7 @@ def scenario_passes(
     _, ok = trajectory(time_from_utc(np.arange(t0, t1 + step, step)))
     if not np.any(ok):
         raise InputError(
-            "the orbit gives no valid position in the search window: outside the span of "
-            "its file, inside a gap of the table, or SGP4 failed at every epoch",
-            source=loaded.source,
-            field="orbit",
+            no_position_message(sc.orbit.model_dump()), source=loaded.source, field="start_utc"
         )
 
     def sample(time_utc: NDArray[np.datetime64]) -> PassSamples:
