@@ -1141,6 +1141,55 @@ def compare(
 
 
 @app.command()
+def passes(
+    scenario: Annotated[Path, typer.Argument(help="Scenario YAML: its orbit and observer.")],
+    output: Annotated[
+        str | None,
+        typer.Option("--output", "-o", metavar="FILE", help="Also write PASSES.csv or .json."),
+    ] = None,
+    start: Annotated[
+        str | None,
+        typer.Option(help="Search from this UTC time (ISO 8601); default the scenario's start."),
+    ] = None,
+    end: Annotated[
+        str | None,
+        typer.Option(help="Search until this UTC time (ISO 8601); default the scenario's stop."),
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite an existing output.")] = False,
+) -> None:
+    """Rise, culmination and set of every pass of the target above observer.min_elevation_deg,
+    with the parts where it is sunlit, the sky is dark (the Sun at or below
+    observer.max_sun_elevation_deg) and both (observable). See docs/passes.md.
+
+    Example: speclight passes calsphere.yaml --start 2020-02-29T18:00Z --end 2020-03-01T06:00Z
+    """
+
+    def run() -> None:
+        from speclight.io.output import OutputClaim
+        from speclight.io.pass_table import check_passes_output, passes_file_bytes, print_passes
+        from speclight.scenario import load_scenario
+        from speclight.simulate.pass_search import parse_utc, scenario_passes
+
+        start_utc = parse_utc(start, "--start") if start is not None else None
+        end_utc = parse_utc(end, "--end") if end is not None else None
+        if output is None:
+            loaded = load_scenario(scenario)
+            result = scenario_passes(loaded, start_utc, end_utc)
+        else:
+            suffix = check_passes_output(output)
+            with OutputClaim(output, force=force, inputs={"scenario file": scenario}) as claim:
+                loaded = load_scenario(scenario)
+                result = scenario_passes(loaded, start_utc, end_utc)
+                _raise_if_signalled()
+                claim.write(passes_file_bytes(result, loaded.scenario.name, suffix))
+        print_passes(result, f"passes of {loaded.scenario.name}")
+        if output is not None:
+            typer.echo(f"wrote {output}")
+
+    _guarded(run)
+
+
+@app.command()
 def info() -> None:
     """Versions of speclight and its engines, render variants, and data coverage."""
 

@@ -183,13 +183,20 @@ class OutputClaim:
         self.path = check_output_path(self.output, self.force, self.inputs)
         lock = lock_path(self.path)
         try:
-            fd = _take_lock(lock)
+            # held: a signal between creating the lock and keeping its descriptor would
+            # leave the lock behind (the signal acts when the block ends, and is caught below)
+            with hold_signals():
+                fd = _take_lock(lock)
+                self._lock_fd = fd
         except OSError as exc:
             raise InputError(
                 f"cannot write in folder {self.path.parent} ({exc.strerror}); "
                 "choose another folder",
                 field=FIELD,
             ) from exc
+        except BaseException:
+            self._release()
+            raise
         if fd is None:
             pid = _lock_owner(lock)
             who = f"another speclight run (PID {pid})" if pid else "another speclight run"
@@ -198,7 +205,6 @@ class OutputClaim:
                 "another name",
                 field=FIELD,
             )
-        self._lock_fd = fd
         try:
             os.ftruncate(fd, 0)
             os.write(fd, f"{os.getpid()}\n".encode())
