@@ -3,7 +3,8 @@
 ``DIR/frame_NNNN_BAND.fits``: the image in ADU (16-bit unsigned when the ADC fits,
 else 32-bit; 32-bit floats for noiseless frames), its WCS (astropy; ICRS, TAN, CD matrix)
 and the exposure's keywords (``DATE-OBS``, ``DATE-AVG``, ``EXPTIME``, ``FILTER``, ``GAIN``,
-``RDNOISE``, ``SATURATE``, the site as ``OBSGEO-X/Y/Z`` and ``SITELAT/SITELONG/SITEELEV``). ``DIR/truth.json``: per frame the
+``RDNOISE``, ``SATURATE``, the site as ``SITELAT``, ``SITELONG``, ``SITEELEV`` (not
+``OBSGEO-*``, which astropy's WCS re-derives on every read with a warning)). ``DIR/truth.json``: per frame the
 target's centroid, electrons and streak ends and the stars on it, in 0-based pixel
 coordinates (numpy's and astropy's: the first pixel's centre is (0, 0); FITS's is (1, 1)).
 ``DIR/frames.csv``: one row per frame. Every file is written to a temporary name and
@@ -134,11 +135,6 @@ def fits_bytes(
         ("SITEELEV", site[2], "site height above WGS84 [m]"),
         ("TRUTH", TRUTH_FILE, "target and stars of this frame"),
     ]
-    from astropy.coordinates import EarthLocation
-
-    geocentric = EarthLocation.from_geodetic(site[1], site[0], site[2]).to_geocentric()
-    for axis, value in zip("XYZ", geocentric, strict=True):  # FITS WCS paper VII
-        cards.append((f"OBSGEO-{axis}", float(value.to_value("m")), "site, ITRS [m]"))
     for key, value, comment in cards:
         header[key] = (value, comment)
     data = exp.adu
