@@ -95,7 +95,7 @@ def _streak_frame(rate_arcsec_s: float, pa_deg: float, tracking: str = "sidereal
 
 
 def test_streak_photometry_equals_rate_times_exposure() -> None:
-    imaging, track, f, e = _streak_frame(90.0, 130.0)
+    imaging, _track, f, e = _streak_frame(90.0, 130.0)
     t = f.exposure.truth["target"]
     length = np.hypot(t["end_x"] - t["start_x"], t["end_y"] - t["start_y"])
     theta = np.arctan2(t["end_y"] - t["start_y"], t["end_x"] - t["start_x"])
@@ -108,7 +108,7 @@ def test_streak_photometry_equals_rate_times_exposure() -> None:
 @pytest.mark.parametrize("pa_deg", [40.0, 250.0])
 def test_streak_length_and_direction_equal_rate_times_exposure(pa_deg) -> None:
     imaging, track, f, e = _streak_frame(90.0, pa_deg)
-    _, _, point, p = _streak_frame(0.0, pa_deg)
+    _, _, _point, p = _streak_frame(0.0, pa_deg)
     # second moments: a uniform line of length L blurred by the PSF has, along the line,
     # sigma^2 = L^2 / 12 + sigma_psf^2, and the PSF's sigma^2 is that of the point frame
     streak = data_properties(e)
@@ -132,7 +132,7 @@ def test_streak_length_and_direction_equal_rate_times_exposure(pa_deg) -> None:
 
 
 def test_target_tracking_keeps_the_target_still_and_streaks_the_stars() -> None:
-    imaging, _, f, e = _streak_frame(90.0, 40.0, tracking="target")
+    _, _, f, e = _streak_frame(90.0, 40.0, tracking="target")
     t = f.exposure.truth["target"]
     x0, y0 = f.exposure.pointing.reference_px
     assert np.hypot(t["start_x"] - x0, t["start_y"] - y0) < 1e-6
@@ -214,5 +214,7 @@ def test_frame_variance_is_poisson_plus_read_noise() -> None:
     stderr = expected * np.sqrt(2.0 / (n - 1))
     assert abs(adu.var(ddof=1) - expected) < 3.0 * stderr
     mean_stderr = np.sqrt(expected / n)
-    assert adu.mean() == pytest.approx(det.bias_adu + mean_e / det.gain_e_per_adu, abs=3 * mean_stderr)
+    assert adu.mean() == pytest.approx(
+        det.bias_adu + mean_e / det.gain_e_per_adu, abs=3 * mean_stderr
+    )
     assert mean_e > 50.0  # a sky bright enough that the Poisson term dominates

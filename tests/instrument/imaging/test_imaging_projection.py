@@ -10,7 +10,9 @@ from speclight.instrument.imaging.sky_projection import Pointing, frame_wcs, sky
 from speclight.instrument.imaging.streak_raster import add_source, splat_bilinear
 
 
-@pytest.mark.parametrize(("ra", "dec", "pa"), [(10.0, 5.0, 0.0), (250.0, -60.0, 33.0), (0.1, 89.5, 170.0)])
+@pytest.mark.parametrize(
+    ("ra", "dec", "pa"), [(10.0, 5.0, 0.0), (250.0, -60.0, 33.0), (0.1, 89.5, 170.0)]
+)
 def test_projection_matches_astropy_wcs(ra, dec, pa) -> None:
     from astropy.coordinates import SkyCoord
 
@@ -27,7 +29,9 @@ def test_projection_matches_astropy_wcs(ra, dec, pa) -> None:
 
 def test_north_is_up_and_east_left_at_position_angle_zero() -> None:
     pointing = Pointing(unit_vector_from_radec(100.0, 10.0), 1.0, 0.0, 101, 101)
-    x, y = sky_to_pixel(unit_vector_from_radec([100.0, 100.0 + 1 / 3600], [10.0 + 1 / 3600, 10.0]), pointing)
+    x, y = sky_to_pixel(
+        unit_vector_from_radec([100.0, 100.0 + 1 / 3600], [10.0 + 1 / 3600, 10.0]), pointing
+    )
     assert y[0] == pytest.approx(51.0, abs=1e-6) and x[0] == pytest.approx(50.0, abs=1e-6)
     assert x[1] < 50.0  # east to the left
 

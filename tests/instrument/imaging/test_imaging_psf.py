@@ -13,8 +13,8 @@ from speclight.instrument.imaging.streak_raster import add_source
 
 pytest.importorskip("galsim")
 pytest.importorskip("photutils")
-from astropy.modeling import fitting, models  # noqa: E402
-from photutils.aperture import CircularAperture  # noqa: E402
+from astropy.modeling import fitting, models
+from photutils.aperture import CircularAperture
 
 ARCSEC_PER_RAD = 180.0 / np.pi * 3600.0
 

@@ -169,7 +169,7 @@ def expose(
     -------
     Exposure
     """
-    start = np.asarray(start, dtype="datetime64[ns]")
+    start = start.astype("datetime64[ns]")
     n = substep_count(track, start, exposure_s, camera)
     dt = exposure_s / n
     t = _mid_times(start, exposure_s, n)

@@ -3,12 +3,12 @@
 ``DIR/frame_NNNN_BAND.fits``: the image in ADU (16-bit unsigned when the ADC fits,
 else 32-bit; 32-bit floats for noiseless frames), its WCS (astropy; ICRS, TAN, CD matrix)
 and the exposure's keywords (``DATE-OBS``, ``DATE-AVG``, ``EXPTIME``, ``FILTER``, ``GAIN``,
-``RDNOISE``, ``SATURATE``, the site as ``SITELAT``, ``SITELONG``, ``SITEELEV`` (not
-``OBSGEO-*``, which astropy's WCS re-derives on every read with a warning)). ``DIR/truth.json``: per frame the
-target's centroid, electrons and streak ends and the stars on it, in 0-based pixel
-coordinates (numpy's and astropy's: the first pixel's centre is (0, 0); FITS's is (1, 1)).
-``DIR/frames.csv``: one row per frame. Every file is written to a temporary name and
-moved into place.
+``RDNOISE``, ``SATURATE``; the site as ``SITELAT``, ``SITELONG``, ``SITEELEV``, not
+``OBSGEO-*``, which astropy's WCS re-derives on every read with a warning).
+``DIR/truth.json``: per frame the target's centroid, electrons and streak ends and the stars
+on it, in 0-based pixel coordinates (numpy's and astropy's: the first pixel's centre is
+(0, 0); FITS's is (1, 1)). ``DIR/frames.csv``: one row per frame. Every file is written to a
+temporary name and moved into place.
 """
 
 from __future__ import annotations
@@ -94,7 +94,7 @@ def _atomic_write(path: Path, data: bytes) -> None:
 
 
 def _time(t: np.datetime64) -> str:
-    return str(np.datetime_as_string(np.datetime64(t, "ms"), unit="ms"))
+    return str(np.datetime_as_string(np.asarray(t, dtype="datetime64[ms]"), unit="ms"))
 
 
 def fits_bytes(

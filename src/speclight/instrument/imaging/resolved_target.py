@@ -82,7 +82,9 @@ def target_shape(
     max_gap_s
         Largest accepted time between the render and ``time_utc`` [s].
     """
-    gap_s = np.abs((images.time_utc - np.datetime64(time_utc, "ns")) / np.timedelta64(1, "s"))
+    gap_s = np.abs(
+        (images.time_utc - np.asarray(time_utc, dtype="datetime64[ns]")) / np.timedelta64(1, "s")
+    )
     m = int(np.argmin(gap_s))
     if gap_s[m] > max_gap_s:
         return None
