@@ -8,6 +8,7 @@ frames with stars, sky, PSF and noise (:mod:`speclight.instrument.imaging`).
 
 from __future__ import annotations
 
+import math
 from datetime import UTC, datetime
 from typing import Literal
 
@@ -89,7 +90,7 @@ class Detector(Strict):
         if self.plate_scale_arcsec is not None:
             return self.plate_scale_arcsec
         assert self.pixel_size_um is not None and self.focal_length_m is not None
-        return float(self.pixel_size_um * 1e-6 / self.focal_length_m * 206_264.80624709636)
+        return math.degrees(self.pixel_size_um * 1e-6 / self.focal_length_m) * 3600.0
 
 
 class Seeing(Strict):
