@@ -35,7 +35,7 @@ def test_the_documented_section_validates() -> None:
                 "psf": {"diffraction": False, "defocus_waves": 1},
             },
             "needs diffraction",
-        ),  # fmt: skip
+        ),
         ({"detector": {"plate_scale_arcsec": 1}, "sky": {"model": "fixed"}}, "v_mag_arcsec2"),
     ],
 )
@@ -51,3 +51,13 @@ def test_plate_scale_from_pixel_and_focal_length() -> None:
     import astropy.units as u
 
     assert d.scale_arcsec == pytest.approx((9e-6 / 0.93 * u.rad).to_value(u.arcsec), rel=1e-12)
+
+
+def test_a_missing_galsim_says_what_to_install(monkeypatch) -> None:
+    from speclight import engine_packages
+    from speclight.errors import InputError
+    from speclight.instrument.imaging.psf import PsfSpec, psf_kernel
+
+    monkeypatch.setattr(engine_packages, "missing_modules", lambda engine: ["galsim"])
+    with pytest.raises(InputError, match=r"pip install 'speclight\[frames\]'"):
+        psf_kernel(PsfSpec(), 550.0, 0.5)

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
 from pydantic import ValidationError
 
@@ -70,6 +71,18 @@ def imaging_from(data: Any, source: str) -> Imaging:
         raise InputError(
             f"{first['msg']} (got {first.get('input')!r})", source=source, field=where
         ) from None
+
+
+def _daylight_frames(inputs: Any, records: list[dict[str, Any]]) -> int:
+    """How many frames have the Sun above the twilight model's top at mid-exposure."""
+    from speclight.instrument.imaging.sky_brightness import TWILIGHT_TOP_DEG
+    from speclight.instrument.imaging.target_path import values_at
+
+    track = inputs.track
+    if track.sun_elevation_deg is None or not records:
+        return 0
+    mids = np.array([r["mid_utc"] for r in records], dtype="datetime64[ns]")
+    return int(np.sum(values_at(track, track.sun_elevation_deg, mids) > TWILIGHT_TOP_DEG))
 
 
 def make_frame_files(
@@ -133,4 +146,10 @@ def make_frame_files(
         notes.append(f"{skipped} exposures skipped: the target below the horizon or no geometry")
     if not records:
         notes.append("no frame written: no exposure fits where the target is above the horizon")
+    day = _daylight_frames(inputs, records)
+    if day:
+        notes.append(
+            f"{day} frames with the Sun above -0.9 deg: the sky model is held at its twilight "
+            "value there (a daylight sky is not modelled; docs/frames.md, Sky)"
+        )
     return FramesResult(out, records, kept, notes)
