@@ -86,13 +86,6 @@ def frames_figure(frames: list[Any], records: list[dict[str, Any]]) -> Any:
         scaled, low, high = _stretch(adu)
         ax.imshow(scaled, origin="lower", cmap="gray", interpolation="nearest")
         t = record["target"]
-        ax.plot(
-            [t["start_x"], t["end_x"]],
-            [t["start_y"], t["end_y"]],
-            color="tab:orange",
-            lw=0.8,
-            alpha=0.7,
-        )
         ax.plot(t["start_x"], t["start_y"], "o", mfc="none", color="tab:orange", ms=14, mew=0.8)
         if np.hypot(t["end_x"] - t["start_x"], t["end_y"] - t["start_y"]) > 1.0:
             ax.plot(t["end_x"], t["end_y"], "x", color="tab:orange", ms=10, mew=0.8)

@@ -3,10 +3,9 @@
 The pipeline gives, per epoch, the target's topocentric astrometric right ascension and
 declination (ICRS) with their rates, and the count rate per band. Inside an exposure the
 direction is the cubic Hermite interpolant of the unit vectors with their time derivatives
-``du/dt = (d(RA)/dt cos(Dec) e + d(Dec)/dt n)`` (exact to third order in the step; a great
-circle at a constant rate is followed to ~(omega h)^4 / 384 rad, 1e-6 of a pixel for a LEO
-pass sampled at 1 s), normalised; the count rate is interpolated linearly (a glint shorter
-than the pipeline's step is not resolved: make ``time.step_s`` short where it matters).
+``du/dt = (d(RA)/dt cos(Dec) e + d(Dec)/dt n)``, normalised (its error falls as the fourth
+power of the step); the count rate is interpolated linearly (a glint shorter than the
+pipeline's step is not resolved: make ``time.step_s`` short where it matters).
 """
 
 from __future__ import annotations
