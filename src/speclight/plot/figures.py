@@ -175,14 +175,9 @@ def _check_output(output: Path) -> None:
 
 
 def _load(dataset: Path) -> xr.Dataset:
-    try:
-        ds = xr.load_dataset(dataset, engine="h5netcdf")
-    except (OSError, ValueError, TypeError, KeyError) as exc:
-        raise InputError(
-            f"cannot read it as a NetCDF dataset ({exc}); give a file written by "
-            "`speclight simulate`",
-            source=str(dataset),
-        ) from exc
+    from speclight.io.user_dataset import read_user_dataset
+
+    ds = read_user_dataset(dataset, "DATASET", what="dataset", require_time=False)
     check_dataset(ds, source=str(dataset))
     return ds
 
