@@ -198,6 +198,8 @@ def measured_from_dataset(ds: xr.Dataset, src: str, source: str = "sun") -> Meas
             source=src,
             field=FIELD,
         )
+    if ds.sizes["time"] == 0:
+        raise InputError("the dataset holds no epochs ('time' is empty)", source=src, field=FIELD)
     bands = [str(b) for b in ds["band"].values]
     _check_band_names(bands, src)
     t_in = ds["time"].values

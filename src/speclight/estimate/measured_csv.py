@@ -113,15 +113,15 @@ def read_csv_columns(path: Path) -> CsvLightCurve:
 
 
 def _csv_rows(numbered: list[tuple[int, str]], src: str) -> list[list[str]]:
-    """The cells of every line (RFC 4180: a cell may be quoted), each stripped of spaces."""
-    reader = csv.reader((line for _, line in numbered), strict=True)
+    """The cells of every line (RFC 4180: a cell may be quoted, but not span lines), each
+    stripped of spaces."""
     rows = []
-    try:
-        for cells in reader:
-            rows.append([c.strip() for c in cells])
-    except csv.Error as exc:
-        k = numbered[len(rows)][0]
-        raise InputError(f"line {k}: not a CSV row ({exc})", source=src, field=FIELD) from None
+    for k, line in numbered:
+        try:
+            cells = next(csv.reader([line], skipinitialspace=True))
+        except csv.Error as exc:
+            raise InputError(f"line {k}: not a CSV row ({exc})", source=src, field=FIELD) from None
+        rows.append([c.strip() for c in cells])
     return rows
 
 

@@ -114,6 +114,14 @@ def reflection_map_measured(
         loaded = dataset_scenario(head, str(p))
     data = read_reflectance_factors(p, loaded, bin_s, progress, light)
     direction, offset, origin = _directions(p, is_nc, data, loaded, bin_s)
+    mappable = np.all(np.isfinite(direction), axis=1) & np.any(np.isfinite(data.factor), axis=1)
+    if not np.any(mappable):
+        raise InputError(
+            f"no epoch has both a reflectance factor and a direction ({origin}): the map "
+            "would be empty; the directions are NaN where the factors are known",
+            source=str(p),
+            field="MEASURED",
+        )
     rmap = reflection_map(direction, data.factor, nside)
     ds = _dataset(data, rmap, direction, origin)
     if offset is not None:

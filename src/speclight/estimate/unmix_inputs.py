@@ -41,7 +41,7 @@ from speclight.estimate.measured import (
     measured_from_dataset,
     read_measured,
 )
-from speclight.estimate.measured_checks import check_rates, dataset_namers
+from speclight.estimate.measured_checks import check_rates, dataset_namers, no_usable_epochs
 from speclight.estimate.scenario_bands import BandResponses, dataset_band_responses
 from speclight.estimate.source_spectrum import (
     Light,
@@ -272,14 +272,7 @@ def _factors_from_rates(
         bands.response,
     )
     if not np.any(np.isfinite(factor)):
-        raise InputError(
-            f"no reflectance factor at any of the {lc.time_utc.size} measured epochs: the "
-            f"scenario {loaded.source} has the target below the minimum elevation, unlit or "
-            "without an orbit at every one of them; check the file's times against the "
-            "scenario's orbit and site",
-            source=lc.source,
-            field=FIELD,
-        )
+        raise no_usable_epochs(lc.time_utc.size, loaded.source, lc.source)
     return ReflectanceFactors(
         lc.time_utc,
         factor,

@@ -139,8 +139,8 @@ def check_output_path(
 def _same_file(a: Path, b: Path) -> bool:
     try:
         return os.path.samefile(a, b)
-    except OSError:  # one of them does not exist (yet)
-        return a.resolve() == b.resolve()
+    except OSError:  # one of them does not exist (yet), or is a loop of symbolic links
+        return os.path.realpath(a) == os.path.realpath(b)  # never raises, loops included
 
 
 class OutputClaim:
@@ -200,8 +200,15 @@ class OutputClaim:
             )
         self._lock_fd = fd
         try:
-            os.ftruncate(fd, 0)
-            os.write(fd, f"{os.getpid()}\n".encode())
+            try:
+                os.ftruncate(fd, 0)
+                os.write(fd, f"{os.getpid()}\n".encode())
+            except OSError as exc:  # a full disk or quota: the empty lock file was created
+                raise InputError(
+                    f"cannot write in folder {self.path.parent} ({exc.strerror or exc}); "
+                    "free some space or choose another folder",
+                    field=FIELD,
+                ) from exc
             check_output_path(self.output, self.force, self.inputs)  # a run may just have ended
             _sweep(self.path.parent, own=self.path.name)
         except BaseException:

@@ -23,7 +23,7 @@ from typing import Any
 import xarray as xr
 
 from speclight.errors import InputError, did_you_mean
-from speclight.io.output import create_new_file
+from speclight.io.output import OutputWriteError, create_new_file
 from speclight.plot.chain import chain_figure
 from speclight.plot.images import images_figure
 from speclight.plot.lightcurve import MAGNITUDES
@@ -250,6 +250,8 @@ def plot_files(
     InputError
         Bad options or dataset, an existing figure without ``force``, or matplotlib not
         installed (checked first).
+    OutputWriteError
+        A figure could not be written (full disk...); none was written.
     """
     _require_matplotlib()
     dataset, output = Path(dataset), Path(output)
@@ -274,10 +276,15 @@ def plot_files(
             target = paths[kind.name]
             fig = kind.build(ds, choices)
             temp = target.with_name(f".{target.name}.{secrets.token_hex(4)}{target.suffix}")
-            fd = create_new_file(temp)  # mode 0666 less the umask, like any new file
-            temporaries.append((temp, target))
-            with os.fdopen(fd, "wb") as f:
-                fig.savefig(f, dpi=dpi, format=target.suffix.lstrip(".").lower())
+            try:
+                fd = create_new_file(temp)  # mode 0666 less the umask, like any new file
+                temporaries.append((temp, target))
+                with os.fdopen(fd, "wb") as f:
+                    fig.savefig(f, dpi=dpi, format=target.suffix.lstrip(".").lower())
+            except OSError as exc:  # a full disk, a quota, an I/O error
+                raise OutputWriteError(
+                    f"cannot write {target}: {exc.strerror or exc}; no figure was written"
+                ) from exc
         for temp, target in temporaries:
             os.replace(temp, target)
     finally:
