@@ -6,10 +6,11 @@ References: files written here with known values; the binning against sums worke
 
 import numpy as np
 import pytest
+import xarray as xr
 import yaml
 
 from speclight.errors import InputError
-from speclight.estimate.measured import bin_light_curve, read_measured
+from speclight.estimate.measured import bin_light_curve, measured_from_dataset, read_measured
 from speclight.io.netcdf import write_dataset
 from speclight.scenario import example_text, parse_scenario
 from speclight.simulate import simulate
@@ -148,3 +149,34 @@ def test_binning_averages_rates_and_combines_sigmas(tmp_path):
     np.testing.assert_array_equal(binned.time_utc, expected)
     with pytest.raises(InputError, match="--bin-s"):
         bin_light_curve(lc, 0.0)
+
+
+def _rates_dataset(rate, t=None, bands=("B", "R")):
+    n = len(rate)
+    t = (
+        np.datetime64("2020-01-01T00:00:00", "ns") + np.arange(n) * np.timedelta64(1, "s")
+        if t is None
+        else t
+    )
+    return xr.Dataset(
+        {"count_rate": (("time", "band"), np.asarray(rate, dtype=float))},
+        coords={"time": t, "band": list(bands)},
+    )
+
+
+@pytest.mark.parametrize(
+    ("ds", "match"),
+    [
+        (_rates_dataset([[1.0, 2.0], [np.inf, 1.0]]),
+         r"time index 1 \(2020-01-01T00:00:01.000000000\), band 'B': rate inf is infinite"),
+        (_rates_dataset([[1.0, 2.0]], bands=("B", "B")), "band 2 .* the name 'B' of an earlier"),
+        (_rates_dataset([[1.0, 2.0]], bands=("B", " ")), "band 2 .* an empty name"),
+        (_rates_dataset(np.zeros((0, 2))), "holds no epochs"),
+        (_rates_dataset([[1.0, 2.0]], t=np.array(["2100-01-01"], "datetime64[s]")),
+         r"time index 0 .* is outside what the shipped Sun ephemeris"),
+        (_rates_dataset([[1.0, 0.0], [2.0, np.nan]]), "band 'R' has no rate above 0"),
+    ],
+)  # fmt: skip
+def test_a_dataset_s_rates_get_the_checks_of_a_csv(ds, match):
+    with pytest.raises(InputError, match=match):
+        measured_from_dataset(ds, "pass.nc")

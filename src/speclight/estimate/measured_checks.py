@@ -163,10 +163,12 @@ def check_signal(rate: F64, names: list[str], src: str, field: str, what: str = 
         )
 
 
-def no_usable_epochs(n_epochs: int, scenario: str, src: str, field: str = "MEASURED") -> InputError:
+def no_usable_epochs(
+    n_epochs: int, scenario: str, src: str, field: str = "MEASURED", what: str = "measured"
+) -> InputError:
     """The error for measurements none of whose epochs the scenario can model."""
     return InputError(
-        f"none of the {n_epochs} measured epochs is usable: the scenario {scenario} has the "
+        f"none of the {n_epochs} {what} epochs is usable: the scenario {scenario} has the "
         "target below the minimum elevation, unlit or without an orbit at every one of them; "
         "check the file's times against the scenario's orbit, site and time span",
         source=src,
