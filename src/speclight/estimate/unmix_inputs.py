@@ -168,7 +168,6 @@ def read_reflectance_factors(
         return _factors_from_rates(lc, loaded, bin_s, progress, light)
     ds = read_user_dataset(p, FIELD, what="measurements", variables=DATASET_VARIABLES)
     chosen: Light = default_light(ds) if light is None else light  # type: ignore[assignment]
-    checked = measured_from_dataset(ds, src, chosen)  # the checks of every MEASURED reader
     var = "laser_reflectance_factor" if chosen == "laser" else "reflectance_factor"
     if var not in ds:
         raise InputError(
@@ -180,8 +179,6 @@ def read_reflectance_factors(
         )
     bands = dataset_band_responses(ds, src)
     factor = values(ds, var, ("time", "band"), src, FIELD)
-    row, column = dataset_namers(checked.time_utc, checked.band_names)
-    check_rates(factor, row, column, src, FIELD, max_abs=None, what=var)
     if not np.any(np.isfinite(factor)):
         other = "sun" if chosen == "laser" else "laser"
         raise InputError(
@@ -190,6 +187,9 @@ def read_reflectance_factors(
             source=src,
             field="--source",
         )
+    checked = measured_from_dataset(ds, src, chosen)  # the checks of every MEASURED reader
+    row, column = dataset_namers(checked.time_utc, checked.band_names)
+    check_rates(factor, row, column, src, FIELD, max_abs=None, what=var)
     what = var
     if chosen == "sun":
         source = sun_source_W_m2_nm(ds)
