@@ -3,10 +3,12 @@
 ``speclight.simulate`` writes its dataset through this module (:func:`variable`,
 :func:`coordinate`), and the readers (``speclight.plot``, the coming ``speclight.estimate``)
 read names, units and flag bits from it, so that a variable is described once.
-Units follow CF / UDUNITS spelling (``W sr-1 nm-1``). Magnitudes are logarithmic and have no
-UDUNITS unit: they are written with units ``1`` (CF-1.10 section 3.1: dimensionless) and a
-``comment`` that names the magnitude system (``units_metadata`` is not for them: CF-1.11
-allows it only on temperatures).
+Units follow CF / UDUNITS spelling (``W sr-1 nm-1``), except magnitudes: they are
+logarithmic and UDUNITS has no unit for them, so they are written with units ``mag`` (the
+spelling of the IAU, FITS, VOUnits and astropy, which xarray and plots print on their axes)
+and a ``comment`` that names the magnitude system. A CF checker reports ``mag`` as not
+recognised by UDUNITS; that is the one CF finding speclight accepts (``units = "1"`` would
+pass but label magnitude axes ``[1]``).
 """
 
 from __future__ import annotations
@@ -32,12 +34,12 @@ class VariableInfo:
 
 #: The magnitude system of the AB magnitudes (for their ``comment``).
 AB_COMMENT = (
-    "magnitude (logarithmic, units 1): -2.5 log10 of the photon-weighted in-band irradiance "
+    "magnitude (logarithmic): -2.5 log10 of the photon-weighted in-band irradiance "
     "over that of a 3631 Jy flat f_nu source (Oke & Gunn 1983)"
 )
 #: The magnitude system of the Vega V magnitudes (for their ``comment``).
 VEGA_V_COMMENT = (
-    "magnitude (logarithmic, units 1): the AB magnitude in speclite's bessell-V band minus "
+    "magnitude (logarithmic): the AB magnitude in speclite's bessell-V band minus "
     "0.02, the AB - Vega offset of V (Blanton & Roweis 2007, AJ 133, 734, table 1; V zero "
     "points of different realisations differ by about 0.01-0.02 mag); absent when the "
     "wavelength grid does not cover the V band"
@@ -54,6 +56,9 @@ V_SIGN = (
     "V > 0: right-handed in the IAU (IEEE) sense, the electric vector turning "
     "counter-clockwise (north toward east) as seen by the observer facing the target"
 )
+
+#: Units of magnitudes (see the module docstring).
+MAG = "mag"
 
 V = VariableInfo
 VARIABLES: dict[str, VariableInfo] = {
@@ -84,6 +89,45 @@ VARIABLES: dict[str, VariableInfo] = {
         ("time", "wxyz"), "1", "body-to-GCRS rotation quaternion, scalar first (w, x, y, z)"
     ),
     "flags": V(T, "1", "why an epoch is not fully observable (bit mask)"),
+    # where to point (speclight.orbit.sky_position)
+    "sun_elevation_site": V(
+        T,
+        "degree",
+        "elevation of the Sun's centre above the observer's horizon",
+        comment="geometric (no refraction), as the twilight limits are defined: civil -6, "
+        "nautical -12, astronomical -18 degree",
+    ),
+    "ra": V(
+        T,
+        "degree",
+        "topocentric right ascension of the target, astrometric, ICRS",
+        comment="light-time corrected (barycentric), no aberration: comparable with star "
+        "catalogue (Gaia) positions",
+    ),
+    "dec": V(T, "degree", "topocentric declination of the target, astrometric, ICRS"),
+    "ra_apparent": V(
+        T,
+        "degree",
+        "topocentric apparent right ascension of the target, true equator and equinox of date",
+        comment="aberration by the observer's velocity (Earth and site rotation) applied: "
+        "where a telescope points",
+    ),
+    "dec_apparent": V(
+        T,
+        "degree",
+        "topocentric apparent declination of the target, true equator and equinox of date",
+    ),
+    "angular_rate": V(
+        T,
+        "degree s-1",
+        "angular rate of the target across the sky",
+        comment="of the astrometric direction; a streak on a sidereally tracking telescope "
+        "is the rate times the exposure",
+    ),
+    "ra_cos_dec_rate": V(
+        T, "degree s-1", "rate of right ascension times cos(declination), ICRS, east positive"
+    ),
+    "dec_rate": V(T, "degree s-1", "rate of declination, ICRS, north positive"),
     # the observer's site (scalars; also the global attributes observer_*)
     "observer_latitude": V(
         (), "degrees_north", "geodetic latitude of the observer (WGS84)", "latitude"
@@ -99,6 +143,12 @@ VARIABLES: dict[str, VariableInfo] = {
     ),
     "min_elevation": V(
         (), "degree", "minimum elevation: epochs below it are flagged below_min_elevation"
+    ),
+    "max_sun_elevation": V(
+        (),
+        "degree",
+        "highest elevation of the Sun at the site for a dark sky: epochs above it are "
+        "flagged daylight",
     ),
     # spectra and bands
     "solar_irradiance": V(
@@ -119,20 +169,20 @@ VARIABLES: dict[str, VariableInfo] = {
     "count_rate": V(TB, "s-1", "detected photo-electrons per second in each band"),
     "ab_magnitude": V(
         TB,
-        "1",
+        MAG,
         "AB magnitude of the in-band irradiance at the aperture",
         comment=f"{AB_COMMENT}; through the atmosphere",
     ),
     "ab_magnitude_exo": V(
         TB,
-        "1",
+        MAG,
         "exo-atmospheric AB magnitude: the in-band irradiance at the aperture without the "
         "atmosphere's transmission",
         comment=f"{AB_COMMENT}; above the atmosphere (transmission 1)",
     ),
     "ab_magnitude_standard": V(
         TB,
-        "1",
+        MAG,
         "standard AB magnitude: ab_magnitude_exo moved to a range of 1000 km, "
         "m - 5 log10(range / 1000 km)",
         comment=f"{AB_COMMENT}; above the atmosphere, range-normalised to 1000 km as SSA "
@@ -140,13 +190,13 @@ VARIABLES: dict[str, VariableInfo] = {
     ),
     "vega_v_magnitude": V(
         T,
-        "1",
+        MAG,
         "Vega magnitude in the Bessell V band of the irradiance at the aperture",
         comment=VEGA_V_COMMENT + "; through the atmosphere",
     ),
     "vega_v_magnitude_standard": V(
         T,
-        "1",
+        MAG,
         "standard Vega V magnitude: above the atmosphere, range-normalised to 1000 km",
         comment=VEGA_V_COMMENT + "; above the atmosphere, m - 5 log10(range / 1000 km)",
     ),
@@ -322,6 +372,8 @@ FLAG_LASER_BELOW_HORIZON = 32
 #: The attitude model gives no attitude: an epoch outside an attitude table, or a pointing
 #: profile whose two directions are parallel there.
 FLAG_ATTITUDE_UNDEFINED = 64
+#: The Sun is above ``observer.max_sun_elevation_deg`` at the site: no dark sky.
+FLAG_DAYLIGHT = 128
 
 FLAG_MEANINGS = {
     FLAG_ORBIT_FAILED: "orbit_failed",
@@ -331,6 +383,7 @@ FLAG_MEANINGS = {
     FLAG_RENDER_FAILED: "render_failed",
     FLAG_LASER_BELOW_HORIZON: "laser_below_horizon",
     FLAG_ATTITUDE_UNDEFINED: "attitude_undefined",
+    FLAG_DAYLIGHT: "daylight",
 }
 #: Epochs with any of these bits have no measurement of the Sun's reflection.
 NOT_OBSERVABLE = (
@@ -339,6 +392,7 @@ NOT_OBSERVABLE = (
     | FLAG_IN_SHADOW
     | FLAG_RENDER_FAILED
     | FLAG_ATTITUDE_UNDEFINED
+    | FLAG_DAYLIGHT
 )
 
 

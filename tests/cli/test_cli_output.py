@@ -195,21 +195,22 @@ def test_plot_to_a_figure_another_run_is_writing_fails_at_once(tmp_path: Path) -
     assert f"being written by another speclight run (PID {first.pid})" in result.stderr
 
 
-def test_a_full_disk_when_the_lock_is_written_is_one_line_and_exit_2(
+def test_a_full_disk_when_the_lock_is_written_is_one_line_and_exit_1(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     scenario = _geometry_scenario(tmp_path)
+    out = tmp_path / "out.nc"
 
     def disk_full(fd: int, data: bytes) -> int:
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
     monkeypatch.setattr(os, "write", disk_full)
-    result = runner.invoke(app, ["simulate", str(scenario), "-o", str(tmp_path / "out.nc")])
+    result = runner.invoke(app, ["simulate", str(scenario), "-o", str(out)])
     monkeypatch.undo()
-    assert result.exit_code == 2
+    assert result.exit_code == 1
     assert result.stderr.splitlines() == [
-        f"error: --output: cannot write in folder {tmp_path} (No space left on device); free "
-        "some space or choose another folder"
+        f"error: cannot write {out}: No space left on device (its lock file in {tmp_path}); "
+        "nothing was written"
     ]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["scenario.yaml"]
 

@@ -73,9 +73,9 @@ def test_cf_times_are_decoded_from_their_units(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("content", "fragment"),
     [
-        (b"", "it starts with b'', not with the signature of NetCDF-4"),
+        (b"", "it is not a NetCDF4 (HDF5) file; give a file written by `speclight simulate`"),
         (b"CDF\x01" + bytes(100), "it is NetCDF-3 (classic)"),
-        (bytes(range(256)), "not with the signature of NetCDF-4 (HDF5)"),
+        (bytes(range(256)), "it is not a NetCDF4 (HDF5) file"),
         (b"\x89HDF\r\n\x1a\n" + bytes(range(256)) * 8, "the file is damaged (OSError"),
     ],
 )

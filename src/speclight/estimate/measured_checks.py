@@ -169,8 +169,8 @@ def no_usable_epochs(
     """The error for measurements none of whose epochs the scenario can model."""
     return InputError(
         f"none of the {n_epochs} {what} epochs is usable: the scenario {scenario} has the "
-        "target below the minimum elevation, unlit or without an orbit at every one of them; "
-        "check the file's times against the scenario's orbit, site and time span",
+        "target below the minimum elevation, in daylight, unlit or without an orbit at every "
+        "one of them; check the file's times against the scenario's orbit and site",
         source=src,
         field=field,
     )

@@ -51,6 +51,7 @@ _SKIP = (
     | schema.FLAG_BELOW_MIN_ELEVATION
     | schema.FLAG_IN_SHADOW
     | schema.FLAG_RENDER_FAILED
+    | schema.FLAG_DAYLIGHT
 )
 
 

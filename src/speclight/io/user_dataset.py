@@ -39,12 +39,17 @@ HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 NETCDF3_SIGNATURE = b"CDF"
 #: Dimensions whose size is fixed: the components of vectors and quaternions.
 FIXED_SIZES = {"xyz": 3, "wxyz": 4}
+#: What h5py's messages about an unreadable file mean, for a one-line error.
+HDF5_PROBLEMS = {
+    "file signature not found": "it is not a NetCDF4 (HDF5) file",
+    "truncated file": "it is cut short (truncated)",
+}
 FIXED_SIZES_WHY = {"xyz": ("x", "y", "z"), "wxyz": ("w", "x", "y", "z")}
 
 
 def read_user_dataset(
     path: str | Path,
-    field: str,
+    field: str | None,
     *,
     what: str = "NetCDF dataset",
     variables: Collection[str] | None = None,
@@ -57,7 +62,7 @@ def read_user_dataset(
     path
         The file.
     field
-        The command-line argument that names it (``MEASURED``, ``DATASET``), for messages.
+        The command-line argument that names it (``MEASURED``), for messages, or None.
     what
         What the file is, for messages.
     variables
@@ -84,12 +89,7 @@ def read_user_dataset(
             field,
         )
     if head != HDF5_SIGNATURE:
-        raise _error(
-            f"cannot read it as a NetCDF dataset: it starts with {head!r}, not with the "
-            "signature of NetCDF-4 (HDF5); give a dataset written by `speclight simulate`",
-            src,
-            field,
-        )
+        raise _unreadable(HDF5_PROBLEMS["file signature not found"], src, field)
     try:
         with xr.open_dataset(path, engine="h5netcdf") as opened:
             chosen = opened if variables is None else opened[[v for v in variables if v in opened]]
@@ -97,18 +97,16 @@ def read_user_dataset(
     # HDF5 reports damaged bytes as KeyError, RuntimeError, OSError, UnicodeDecodeError...;
     # only the file's own opening and reading run here, not speclight's code
     except Exception as exc:
-        raise _error(
-            f"cannot read it as a NetCDF dataset: the file is damaged ({type(exc).__name__}: "
-            f"{exc})",
-            src,
-            field,
-        ) from None
+        said = " ".join(str(exc).split())  # h5py's can span lines
+        why = next((w for key, w in HDF5_PROBLEMS.items() if key in said), None)
+        why = why or f"the file is damaged ({type(exc).__name__}: {said})"
+        raise _unreadable(why, src, field) from None
     _check_layout(ds, src, field, require_time)
     return ds
 
 
 def values(
-    ds: xr.Dataset, name: str, dims: tuple[str, ...], src: str, field: str
+    ds: xr.Dataset, name: str, dims: tuple[str, ...], src: str, field: str | None
 ) -> NDArray[np.float64]:
     """``ds[name]`` as floats on ``dims`` (in that order), checked.
 
@@ -125,7 +123,7 @@ def values(
     return np.asarray(da.transpose(*dims).values, dtype=np.float64)
 
 
-def _check_layout(ds: xr.Dataset, src: str, field: str, require_time: bool) -> None:
+def _check_layout(ds: xr.Dataset, src: str, field: str | None, require_time: bool) -> None:
     from speclight.schema import VARIABLES
 
     for name, da in ds.data_vars.items():
@@ -193,5 +191,13 @@ def _not_numbers(name: str, dtype: np.dtype) -> str:
     return f"{name} holds {dtype} values, not numbers; a speclight dataset stores numbers"
 
 
-def _error(message: str, src: str, field: str) -> InputError:
+def _unreadable(why: str, src: str, field: str | None) -> InputError:
+    return _error(
+        f"cannot read it as a NetCDF dataset: {why}; give a file written by `speclight simulate`",
+        src,
+        field,
+    )
+
+
+def _error(message: str, src: str, field: str | None) -> InputError:
     return InputError(message, source=src, field=field)

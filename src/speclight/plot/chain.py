@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import numpy as np
@@ -12,7 +13,9 @@ from speclight import schema as v
 from speclight.constants import HC_J_M
 from speclight.plot.style import band_styles, epoch_summary, flags, new_figure
 
-# Planck constant x speed of light [J m] (CODATA 2018, exact), for photons per joule.
+#: The name ``G-<centre_nm>/<sigma_nm>`` of a Gaussian band (``instrument.bands``): the second
+#: number is the standard deviation, not the FWHM, which the band panel's title says.
+GAUSSIAN_NAME = re.compile(r"^G-\d+(\.\d*)?/\d+(\.\d*)?$")
 
 
 def _row(ds: xr.Dataset, name: str, i: int) -> NDArray[np.float64]:
@@ -77,7 +80,8 @@ def epoch_status(ds: xr.Dataset, i: int) -> str:
     """Why epoch ``i`` is not (fully) observed, from its flags: "" when it is.
 
     "eclipsed (in the Earth's shadow)", "in the penumbra (x % of the solar disk)", "below the
-    minimum elevation", "no orbit position", "render failed", joined by "; ".
+    minimum elevation", "in daylight (...)", "no orbit position", "render failed", joined by
+    "; ".
     """
     bits = int(flags(ds)[i])
     reasons = [
@@ -85,6 +89,7 @@ def epoch_status(ds: xr.Dataset, i: int) -> str:
         for bit, text in (
             (v.FLAG_ORBIT_FAILED, "no orbit position"),
             (v.FLAG_BELOW_MIN_ELEVATION, "below the minimum elevation"),
+            (v.FLAG_DAYLIGHT, "in daylight (the Sun above observer.max_sun_elevation_deg)"),
             (v.FLAG_IN_SHADOW, "eclipsed (in the Earth's shadow)"),
             (v.FLAG_RENDER_FAILED, "render failed"),
         )
@@ -201,8 +206,10 @@ def _bands(ds: xr.Dataset, ax: Any, w: NDArray[np.float64], i: int) -> None:
         ax.fill_between(w, 0.0, dn, color=styles[b]["color"], alpha=0.25, lw=0)
         ax.plot(w, dn, lw=1.2, label=f"{name}: {rate:.3g} s$^{{-1}}$", **styles[b])
     ax.set_ylabel("photo-electron rate\ndensity [s$^{-1}$ nm$^{-1}$]")
+    gaussian = any(GAUSSIAN_NAME.match(str(name)) for name in ds["band"].values)
     ax.set_title(
-        "5. each band: flux × optics × QE × response × λ/hc (legend: count rate)",
+        "5. each band: flux × optics × QE × response × λ/hc (legend: count rate"
+        + ("; G-c/s: Gaussian, centre c, sigma s [nm], not FWHM)" if gaussian else ")"),
         loc="left",
         fontsize="medium",
     )

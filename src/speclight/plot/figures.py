@@ -4,9 +4,10 @@
 spectrogram, geometry: all on one UTC time axis) and, beside it, one file per other
 figure the dataset can fill: ``pass-chain.png`` (one epoch through the radiometric
 chain, on a wavelength axis), ``pass-images.png`` (saved images) and
-``pass-ranging.png`` (range histograms and offsets). Every file is rendered to a
-temporary name first and moved into place only when all have rendered; none is
-written if any target exists and ``force`` is not set.
+``pass-ranging.png`` (range histograms and offsets). The file named always holds the
+first figure written: with ``kinds=["chain"]`` the chain goes to ``pass.png`` itself.
+Every file is rendered to a temporary name first and moved into place only when all
+have rendered; none is written if any target exists and ``force`` is not set.
 
 To add a figure, append a :class:`FigureKind` to :data:`FIGURES`.
 """
@@ -119,12 +120,8 @@ def _kinds(kinds: Sequence[str] | None) -> list[FigureKind]:
                 f"unknown figure {k!r}{did_you_mean(k, KINDS)} (choices: {', '.join(KINDS)})",
                 field="--kind",
             )
-    if "overview" not in kinds:
-        raise InputError(
-            "the overview figure is always written (it is the main output file); "
-            f"add 'overview' to the figures asked for (choices: {', '.join(KINDS)})",
-            field="--kind",
-        )
+    if not kinds:
+        raise InputError(f"no figure asked for (choices: {', '.join(KINDS)})", field="--kind")
     return [f for f in FIGURES if f.name in kinds]
 
 
@@ -154,9 +151,15 @@ def plot_dataset(ds: xr.Dataset, *, epoch: int | str | None = None) -> Any:
 
 
 def figure_paths(output: Path, names: Sequence[str]) -> dict[str, Path]:
-    """File of each figure: the main ``output`` and ``<stem><suffix><ext>`` beside it."""
+    """File of each figure: ``output`` itself for the first of ``names``, and
+    ``<stem><suffix><ext>`` beside it for the others (``pass-chain.png``...)."""
     by_name = {f.name: f for f in FIGURES}
-    return {n: output.with_name(f"{output.stem}{by_name[n].suffix}{output.suffix}") for n in names}
+    return {
+        n: output
+        if i == 0
+        else output.with_name(f"{output.stem}{by_name[n].suffix}{output.suffix}")
+        for i, n in enumerate(names)
+    }
 
 
 def _check_output(output: Path) -> None:
@@ -177,7 +180,7 @@ def _check_output(output: Path) -> None:
 def _load(dataset: Path) -> xr.Dataset:
     from speclight.io.user_dataset import read_user_dataset
 
-    ds = read_user_dataset(dataset, "DATASET", what="dataset", require_time=False)
+    ds = read_user_dataset(dataset, None, what="dataset", require_time=False)
     check_dataset(ds, source=str(dataset))
     return ds
 
@@ -225,8 +228,9 @@ def plot_files(
     dataset
         NetCDF file written by ``speclight simulate``.
     output
-        Main figure file (``.png``, ``.pdf``, ``.svg``...); the other figures go beside it
-        as ``<stem>-chain``, ``<stem>-images``, ``<stem>-ranging`` with the same extension.
+        Main figure file (``.png``, ``.pdf``, ``.svg``...): the first figure written (the
+        overview, unless ``kinds`` leaves it out); the others go beside it as
+        ``<stem>-chain``, ``<stem>-images``, ``<stem>-ranging`` with the same extension.
     force
         Overwrite existing files; otherwise an existing target is an error and nothing is
         written.
@@ -237,8 +241,9 @@ def plot_files(
         Band of the radiance images (default: the first band; the whole wavelength grid
         when the dataset has no bands).
     kinds
-        Figures to write (names in :data:`KINDS`); None for all that apply. A figure asked
-        for that the dataset cannot fill (images of a run that saved none...) is an error.
+        Figures to write (names in :data:`KINDS`, written in that order); None for all that
+        apply. A figure asked for that the dataset cannot fill (images of a run that saved
+        none...) is an error.
     dpi
         Resolution of raster formats [dots per inch].
     magnitude
@@ -308,6 +313,6 @@ def plot_file(
     Returns
     -------
     Path
-        The main (overview) figure file.
+        The main figure file, ``output`` (the overview unless ``kinds`` leaves it out).
     """
     return plot_files(dataset, output, force, epoch=epoch, band=band, kinds=kinds, dpi=dpi)[0]

@@ -10,6 +10,7 @@ from numpy.typing import ArrayLike, NDArray
 from speclight.errors import InputError
 from speclight.progress import stage
 from speclight.render.polarization import rotate_linear, scattering_angle_on_sky
+from speclight.render.raycast import numpy_processes
 from speclight.render.result import RenderResult
 from speclight.render.session import RenderMode, RenderSession
 from speclight.target.parts import Target
@@ -80,8 +81,9 @@ def render_intensity(
         ``"numpy"`` or a ``scalar_*`` variant casts single-mode rays with numpy. Ignored when
         ``session`` is given.
     workers
-        Single mode with the numpy caster: number of processes over blocks of epochs.
-        Dr.Jit variants are already parallel over all cores and ignore it.
+        Single mode with the numpy caster: number of processes over blocks of epochs (fewer
+        where :func:`~speclight.render.raycast.numpy_processes` says so: one inside a Dask
+        worker). Dr.Jit variants are already parallel over all cores and ignore it.
     progress
         Show a progress bar (on a terminal).
     keep_images_for
@@ -170,7 +172,7 @@ def render_intensity(
     images = {}
     if mode == "single":
         chosen = session.variant
-        n_workers = int(workers or 1)
+        n_workers = numpy_processes(int(workers or 1))  # one inside a Dask worker
         multi = n_workers > 1 and on_hits is None
         if multi and not chosen.startswith(("llvm_", "cuda_")) and len(valid) > 1:
             # Dr.Jit variants already use every core; the numpy caster runs one process per

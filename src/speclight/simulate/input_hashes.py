@@ -26,15 +26,15 @@ from typing import Any
 from pydantic import BaseModel
 
 from speclight.orbit.iers_files import finals_path
+from speclight.orbit.orbit_sources import file_keys
 from speclight.scenario import LoadedScenario
 
-#: Scenario fields (by their last name) whose string values may name a file or folder.
+#: Scenario fields (by their last name) whose string values may name a file or folder: the
+#: orbit sources that read a file come from their registry
+#: (:data:`speclight.orbit.orbit_sources.ORBIT_SOURCES`), so a new source is hashed too.
 FILE_FIELDS = frozenset(
     {
         "file",
-        "tle_file",
-        "cpf_file",
-        "ephemeris_file",
         "mesh_file",
         "spectrum_file",
         "table_file",
@@ -43,6 +43,7 @@ FILE_FIELDS = frozenset(
         "detector_qe",
         "optics_transmission",
     }
+    | file_keys()
 )
 _CHUNK = 1 << 20
 
