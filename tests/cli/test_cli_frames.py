@@ -115,3 +115,15 @@ def test_frames_refuses_a_dataset_without_imaging_and_a_full_folder(simulated, t
     )
     assert result.exit_code == 2 and "plate scale" in result.output
     assert "Traceback" not in result.output
+
+
+def test_a_failed_run_leaves_no_folder(simulated, tmp_path) -> None:
+    imaging = tmp_path / "imaging.yaml"
+    section = {"detector": {"plate_scale_arcsec": 2.0}, "bands": ["Vee"], "frames": 1}
+    imaging.write_text(yaml.safe_dump(section))
+    out = tmp_path / "never"
+    result = CliRunner().invoke(
+        app, ["frames", str(simulated), "-o", str(out), "--imaging", str(imaging)]
+    )
+    assert result.exit_code == 2 and "did you mean 'V'" in result.output
+    assert not out.exists()

@@ -8,7 +8,7 @@ and the exposure's keywords (``DATE-OBS``, ``DATE-AVG``, ``EXPTIME``, ``FILTER``
 ``DIR/truth.json``: per frame the target's centroid, electrons and streak ends and the stars
 on it, in 0-based pixel coordinates (numpy's and astropy's: the first pixel's centre is
 (0, 0); FITS's is (1, 1)). ``DIR/frames.csv``: one row per frame. Every file is written to a
-temporary name and moved into place.
+hidden folder and moved into place when all are written.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ import csv
 import io
 import json
 import os
+import shutil
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
@@ -31,6 +32,8 @@ from speclight.scenario.sections_imaging import Imaging
 
 #: Name of the truth file.
 TRUTH_FILE = "truth.json"
+#: Hidden folder the files are written into before they are moved into place.
+PARTIAL = ".frames-partial"
 #: Name of the one-row-per-frame table.
 TABLE_FILE = "frames.csv"
 #: Columns of the table.
@@ -61,7 +64,7 @@ def claim_folder(folder: str | Path, force: bool) -> Path:
     path = Path(folder)
     if path.exists() and not path.is_dir():
         raise InputError(f"{path} exists and is not a folder", field="--output")
-    if path.is_dir() and any(path.iterdir()):
+    if path.is_dir() and any(p.name != PARTIAL for p in path.iterdir()):
         if not force:
             raise InputError(
                 f"the folder {path} is not empty: give an empty or new folder, or --force to "
@@ -172,19 +175,33 @@ def write_frames(
     site: tuple[float, float, float],
     name: str,
 ) -> list[dict[str, Any]]:
-    """Write every frame, then the truth and the table; returns the truth records."""
-    records = []
-    for frame in frames:
-        file = f"frame_{frame.index:04d}_{_safe(frame.band)}.fits"
-        _atomic_write(folder / file, fits_bytes(frame, imaging, site, name))
-        records.append(frame_record(frame, file))
-    truth = {
-        "pixel_convention": "0-based: the first pixel's centre is (0, 0) (FITS: (1, 1))",
-        "units": {"electrons": "e-", "x, y": "px", "ra, dec": "deg (ICRS, astrometric)"},
-        "frames": records,
-    }
-    _atomic_write(folder / TRUTH_FILE, json.dumps(truth, indent=1, default=_json).encode())
-    _atomic_write(folder / TABLE_FILE, _table(records).encode())
+    """Write every frame, then the truth and the table; returns the truth records.
+
+    The files are written into a hidden folder inside ``folder`` and moved out together at
+    the end, so that a run that fails or is interrupted leaves no partial set of frames.
+    """
+    partial = folder / PARTIAL
+    shutil.rmtree(partial, ignore_errors=True)
+    partial.mkdir()
+    try:
+        records = []
+        for frame in frames:
+            file = f"frame_{frame.index:04d}_{_safe(frame.band)}.fits"
+            _atomic_write(partial / file, fits_bytes(frame, imaging, site, name))
+            records.append(frame_record(frame, file))
+        truth = {
+            "pixel_convention": "0-based: the first pixel's centre is (0, 0) (FITS: (1, 1))",
+            "units": {"electrons": "e-", "x, y": "px", "ra, dec": "deg (ICRS, astrometric)"},
+            "frames": records,
+        }
+        _atomic_write(partial / TRUTH_FILE, json.dumps(truth, indent=1, default=_json).encode())
+        _atomic_write(partial / TABLE_FILE, _table(records).encode())
+        for r in records:
+            os.replace(partial / r["file"], folder / r["file"])
+        for file in (TABLE_FILE, TRUTH_FILE):  # the truth last: it marks a complete set
+            os.replace(partial / file, folder / file)
+    finally:
+        shutil.rmtree(partial, ignore_errors=True)
     return records
 
 

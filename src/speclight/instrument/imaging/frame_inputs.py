@@ -20,7 +20,6 @@ import xarray as xr
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
-from speclight.input_files import check_user_file
 from speclight.instrument.imaging.target_path import Track
 from speclight.instrument.photometry import photon_kernel
 from speclight.instrument.telescope import aperture_area_m2
@@ -120,17 +119,11 @@ class FrameInputs:
 
 
 def load_dataset(path: str | Path) -> xr.Dataset:
-    """Read a simulate dataset into memory (clear errors for what is not one)."""
-    check_user_file(Path(path), what="dataset", max_bytes=None)
-    try:
-        return xr.load_dataset(path, engine="h5netcdf")
-    except (OSError, ValueError, TypeError, KeyError) as exc:
-        said = " ".join(str(exc).split())
-        raise InputError(
-            f"cannot read it as a NetCDF dataset ({said}); give a file written by "
-            "`speclight simulate`",
-            source=str(path),
-        ) from exc
+    """Read a simulate dataset into memory (:func:`speclight.io.user_dataset.read_user_dataset`:
+    clear errors for what is not one)."""
+    from speclight.io.user_dataset import read_user_dataset
+
+    return read_user_dataset(path, "DATASET", what="dataset")
 
 
 def _kept_images(ds: xr.Dataset, photometry: Photometry) -> KeptImages | None:
@@ -186,6 +179,16 @@ def frame_inputs(ds: xr.Dataset, source: str) -> FrameInputs:
     obs = scenario.scenario.observer
     f = lambda name: np.asarray(ds[name].values, dtype=np.float64)  # noqa: E731
     rate = f("count_rate")
+    known = rate[~np.isnan(rate)]
+    if np.any(~np.isfinite(known)) or np.any(known < 0):
+        raise InputError(
+            "count_rate holds infinite or negative values: a photo-electron rate is >= 0 "
+            "(NaN where not observable); give a dataset written by `speclight simulate`",
+            source=source,
+        )
+    for name in ("ra_cos_dec_rate", "dec_rate"):
+        if np.any(np.isinf(f(name))):
+            raise InputError(f"{name} holds infinite values", source=source)
     track = Track(
         time_utc=ds["time"].values.astype("datetime64[ns]"),
         ra_deg=f("ra"),

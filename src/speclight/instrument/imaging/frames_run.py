@@ -130,6 +130,7 @@ def make_frame_files(
             field="instrument.imaging",
         )
     exposure_s = imaging.exposure_s or scenario.instrument.exposure_s
+    existed = Path(folder).exists()
     out = claim_folder(folder, force)
     kept: list[Any] = []
 
@@ -139,7 +140,12 @@ def make_frame_files(
                 kept.append(frame)
             yield frame
 
-    records = write_frames(frames(), out, imaging, inputs.site, scenario.name)
+    try:
+        records = write_frames(frames(), out, imaging, inputs.site, scenario.name)
+    except BaseException:
+        if not existed and not any(out.iterdir()):
+            out.rmdir()  # a folder this run made, left as it was: absent
+        raise
     _, skipped = plan_starts(inputs, imaging, exposure_s)
     notes = []
     if skipped:
