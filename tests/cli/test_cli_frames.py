@@ -125,5 +125,5 @@ def test_a_failed_run_leaves_no_folder(simulated, tmp_path) -> None:
     result = CliRunner().invoke(
         app, ["frames", str(simulated), "-o", str(out), "--imaging", str(imaging)]
     )
-    assert result.exit_code == 2 and "did you mean 'V'" in result.output
+    assert result.exit_code == 2 and "not among the dataset's bands (V)" in result.output
     assert not out.exists()
