@@ -127,3 +127,23 @@ def test_a_failed_run_leaves_no_folder(simulated, tmp_path) -> None:
     )
     assert result.exit_code == 2 and "not among the dataset's bands (V)" in result.output
     assert not out.exists()
+
+
+def test_the_figure_shows_frames_with_the_target_on_them_in_one_band() -> None:
+    from types import SimpleNamespace
+
+    from speclight.instrument.imaging.frames_run import FigureFrames
+
+    def frame(index: int, band: str, electrons: float) -> SimpleNamespace:
+        truth = {"target": {"electrons_on_frame": electrons}}
+        return SimpleNamespace(index=index, band=band, exposure=SimpleNamespace(truth=truth))
+
+    stream = [frame(k, b, 0.0 if k < 3 else 50.0) for k in range(8) for b in ("B", "V")]
+    kept = FigureFrames(keep=4)
+    for f in stream:
+        kept.offer(f)
+    assert [(f.index, f.band) for f in kept.chosen] == [(3, "B"), (4, "B"), (5, "B"), (6, "B")]
+    dark = FigureFrames(keep=4)  # the target lit none: the first frames
+    for f in stream[:6]:
+        dark.offer(f)
+    assert [(f.index, f.band) for f in dark.chosen] == [(0, "B"), (0, "V"), (1, "B"), (1, "V")]

@@ -1,4 +1,8 @@
-"""The figure of ``speclight frames``: the first frames with their truth drawn on them.
+"""The figure of ``speclight frames``: frames with their truth drawn on them.
+
+The panels are the frames ``speclight frames`` kept: the first ones in which the target put
+light on the detector (in one band, so that consecutive panels show it moving), or the first
+ones where it put none anywhere (below the horizon, in the Earth's shadow).
 
 Each panel is one frame in ADU on an asinh stretch between its median (the sky) and a high
 percentile, north and east arrows from its WCS, the target's streak from its start (circle)
@@ -54,15 +58,20 @@ def _compass(ax: Any, pointing: Any) -> None:
         ax.text(x0 + 1.25 * d[0], y0 + 1.25 * d[1], label, color="white", ha="center", va="center")
 
 
+def _file_of(frame: Any, records: list[dict[str, Any]]) -> str:
+    """The file name of ``frame``'s truth record (same exposure index and band)."""
+    return next(r["file"] for r in records if (r["index"], r["band"]) == (frame.index, frame.band))
+
+
 def frames_figure(frames: list[Any], records: list[dict[str, Any]]) -> Any:
     """A figure of up to :data:`MAX_PANELS` frames and their truth.
 
     Parameters
     ----------
     frames
-        :class:`~speclight.instrument.imaging.frame_set.Frame` objects.
+        :class:`~speclight.instrument.imaging.frame_set.Frame` objects to draw.
     records
-        Their truth records (``truth.json``), in the same order.
+        The truth records of the run (``truth.json``), each frame's among them.
 
     Returns
     -------
@@ -73,7 +82,8 @@ def frames_figure(frames: list[Any], records: list[dict[str, Any]]) -> Any:
     from speclight.engine_packages import require_engine
 
     require_engine("matplotlib", "--plot", "the frames figure")
-    shown = list(zip(frames, records, strict=False))[:MAX_PANELS]
+    by_file = {r["file"]: r for r in records}
+    shown = [(f, by_file[_file_of(f, records)]) for f in frames[:MAX_PANELS]]
     n = max(len(shown), 1)
     cols = min(n, 2)
     rows = int(np.ceil(n / cols))

@@ -36,7 +36,8 @@ class FramesResult:
     records
         The truth of every frame (as in ``truth.json``).
     frames
-        The frames themselves (for the figure), the first few only.
+        The frames themselves (for the figure), a few only: the first ones with the
+        target's light on the detector (in one band), else the first ones.
     notes
         Lines for the user.
     """
@@ -73,6 +74,31 @@ def imaging_from(data: Any, source: str) -> Imaging:
         ) from None
 
 
+class FigureFrames:
+    """The few frames kept in memory for the figure, chosen as they stream past: the first
+    ``keep`` with the target's light on the detector, in the band of the first such frame
+    (consecutive panels then show the target moving), else the first ``keep`` frames."""
+
+    def __init__(self, keep: int) -> None:
+        self.keep = keep
+        self._first: list[Any] = []
+        self._lit: list[Any] = []
+
+    def offer(self, frame: Any) -> None:
+        """Keep ``frame`` if the figure may show it."""
+        if len(self._first) < self.keep:
+            self._first.append(frame)
+        if len(self._lit) >= self.keep or frame.exposure.truth["target"]["electrons_on_frame"] <= 0:
+            return
+        if not self._lit or frame.band == self._lit[0].band:
+            self._lit.append(frame)
+
+    @property
+    def chosen(self) -> list[Any]:
+        """The frames to draw, in time order."""
+        return self._lit or self._first
+
+
 def _daylight_frames(inputs: Any, records: list[dict[str, Any]]) -> int:
     """How many frames have the Sun above the twilight model's top at mid-exposure."""
     from speclight.instrument.imaging.sky_brightness import TWILIGHT_TOP_DEG
@@ -106,7 +132,7 @@ def make_frame_files(
     force
         Replace an earlier run's frames.
     keep
-        How many frames to keep in memory for the figure.
+        How many frames to keep in memory for the figure (see ``frames``).
     """
     from speclight.instrument.imaging.fits_output import claim_folder, write_frames
     from speclight.instrument.imaging.frame_inputs import frame_inputs, load_dataset
@@ -132,12 +158,11 @@ def make_frame_files(
     exposure_s = imaging.exposure_s or scenario.instrument.exposure_s
     existed = Path(folder).exists()
     out = claim_folder(folder, force)
-    kept: list[Any] = []
+    shown = FigureFrames(keep)
 
     def frames() -> Any:
         for frame in make_frames(inputs, imaging, exposure_s):
-            if len(kept) < keep:
-                kept.append(frame)
+            shown.offer(frame)
             yield frame
 
     try:
@@ -158,4 +183,4 @@ def make_frame_files(
             f"{day} frames with the Sun above -0.9 deg: the sky model is held at its twilight "
             "value there (a daylight sky is not modelled; docs/frames.md, Sky)"
         )
-    return FramesResult(out, records, kept, notes)
+    return FramesResult(out, records, shown.chosen, notes)
