@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import signal
 import sys
 import threading
@@ -119,6 +120,24 @@ def _signals_end_the_run() -> Iterator[None]:
 def _fail(message: str, code: int) -> None:
     typer.echo(f"error: {message}", err=True)
     raise typer.Exit(code)
+
+
+@contextmanager
+def _flag_names(**flags: str) -> Iterator[None]:
+    """Say the command-line flags where a plain-array core's error names its Python
+    parameters (``n_phases = 0`` -> ``--phases = 0``): ``flags`` maps parameter names to
+    flags. A name with an underscore is replaced wherever it stands; a plain word
+    (``draws``) only as ``draws =``, so that the prose around it stays."""
+    try:
+        yield
+    except InputError as exc:
+        if exc.field not in flags:
+            raise
+        message = exc.message
+        for name, flag in flags.items():
+            tail = r"(?!\w)" if "_" in name else r"(?= = )"
+            message = re.sub(rf"(?<![\w-]){re.escape(name)}{tail}", flag, message)
+        raise InputError(message, source=exc.source, field=flags[str(exc.field)]) from None
 
 
 def _guarded(func: Callable[[], Any]) -> Any:
@@ -959,7 +978,11 @@ def period(
             "double" if if_symmetric == "double" else "keep" if if_symmetric == "keep" else "auto"
         )
         inputs = _measured_inputs(measured, scenario)
-        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+        flags = _flag_names(
+            min_period_s="--min-period-s", max_period_s="--max-period-s", draws="--draws",
+            harmonics="--harmonics", seed="--seed", synodic="--synodic", bin_s="--bin-s",
+        )  # fmt: skip
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure), flags:
             loaded = _optional_scenario(scenario)
             result = estimate_period(
                 measured,
@@ -982,10 +1005,13 @@ def period(
                 from speclight.plot.period_figure import period_figure
 
                 figure.write(period_figure(result))
+        def shown(key: str, spec: str) -> str:  # null: not determined (PERIOD.json says)
+            return "undetermined" if summary[key] is None else format(summary[key], spec)
+
         typer.echo(
-            f"rotation period {summary['period_s']:.6g} +- {summary['period_std_s']:.2g} s "
-            f"(photometric {summary['photometric_period_s']:.6g} s, false-alarm probability "
-            f"{summary['false_alarm_probability']:.2g})"
+            f"rotation period {shown('period_s', '.6g')} +- {shown('period_std_s', '.2g')} s "
+            f"(photometric {shown('photometric_period_s', '.6g')} s, false-alarm probability "
+            f"{shown('false_alarm_probability', '.2g')})"
         )
         typer.echo(f"wrote {output}" + (f" and {plot_file}" if plot_file else ""))
 
