@@ -831,8 +831,14 @@ def spin_axis(
         from speclight.plot.figure_output import claim_outputs
         from speclight.scenario import load_scenario
 
-        check_search_options(grid_deg, phases)
-        check_refine_options(refine_method, period_bound if free_period else None)
+        flags = dict(
+            grid_deg="--grid-deg", n_phases="--phases", period_s="--period-s", bands="--bands",
+            refine_method="--refine", period_bound="--period-bound", y="MEASURED", bmap="--map",
+            ranging_weight="--ranging-weight",
+        )  # fmt: skip
+        with _flag_names(**flags):
+            check_search_options(grid_deg, phases)
+            check_refine_options(refine_method, period_bound if free_period else None)
         check_light(source)
         if period_s is not None and not (period_s > 0 and period_s < float("inf")):
             raise InputError(
@@ -840,7 +846,9 @@ def spin_axis(
             )
         names = [b.strip() for b in bands.split(",") if b.strip()] if bands else None
         inputs = {"scenario file": scenario, "measured file": measured, "map": map_file}
-        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure), _flag_names(
+            **flags
+        ):
             loaded = load_scenario(scenario)
             result = spin_axis_measured(
                 loaded,
@@ -875,6 +883,9 @@ def spin_axis(
                 + (f"period {a['refined_period_s']:.6g} s " if free_period else "")
                 + f"by {a['refine_method']} with {a['refine_misfit_evaluations']} misfit and "
                 f"{a['refine_gradient_evaluations']} gradient evaluations "
+                if math.isfinite(float(a["refined_ra_deg"])) and not result.result.refine_note
+                else f"refined RA {a['refined_ra_deg']:.2f} Dec {a['refined_dec_deg']:.2f}: "
+                f"{result.result.refine_note} "
                 if math.isfinite(float(a["refined_ra_deg"]))
                 else "not refined (--no-refine) "
             )
