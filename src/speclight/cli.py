@@ -360,7 +360,9 @@ def fit(
         if bin_s is not None and not 0 < bin_s < float("inf"):
             raise InputError(f"--bin-s = {bin_s!r} must be a duration > 0 s", field="--bin-s")
         inputs = {"scenario file": scenario, "measurements": measured}
-        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure), _flag_names(
+            bin_s="--bin-s"
+        ):
             result = fit_scenario(
                 load_scenario(scenario), read_measured(measured), free=names, bin_s=bin_s,
                 progress=sys.stderr.isatty(), method=chosen,
