@@ -37,7 +37,17 @@ def _dataset_bisector(path: Path, source: str) -> tuple[np.ndarray, F64, F64] | 
             phase = ds["phase_angle"].values.astype(float)
         else:
             return None
-    return t, quat_rotate(q, pv), phase
+    gcrs = quat_rotate(q, pv)
+    if not np.all(np.isfinite(gcrs), axis=1).any():
+        import warnings
+
+        warnings.warn(
+            f"{path}: {vector} or attitude_quaternion is NaN at every epoch; the geometry "
+            "of the synodic correction is the scenario's (where there is one)",
+            stacklevel=3,
+        )
+        return None
+    return t, gcrs, phase
 
 
 def _at(t_out: np.ndarray, t_in: np.ndarray, v: F64) -> F64:

@@ -277,9 +277,9 @@ def _check_some_usable(lc: MeasuredLightCurve, m: F64, ds: Any, loaded: LoadedSc
     )
     t = loaded.scenario.time
     raise InputError(
-        f"no measured rate can be fitted: of the {lc.time_utc.size} epochs "
-        f"({time_span_text(lc.time_utc)}), none has a finite rate where the scenario sees its "
-        f"target lit ({counts or 'no rate is finite'}); the scenario's time window is "
+        f"no measured rate can be fitted: none of the epochs {time_span_text(lc.time_utc)} "
+        "has a finite rate where the scenario sees its target lit (flagged: "
+        f"{counts or 'none; no rate is finite'}); the scenario's time window is "
         f"{t.start:%Y-%m-%dT%H:%M:%S} .. {t.stop:%Y-%m-%dT%H:%M:%S} UTC: give the "
         "scenario of this target, site and night",
         source=lc.source,

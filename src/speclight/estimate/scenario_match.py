@@ -57,6 +57,14 @@ def _window_text(loaded: LoadedScenario) -> str:
     return f"{t.start:%Y-%m-%dT%H:%M:%S} .. {t.stop:%Y-%m-%dT%H:%M:%S} UTC"
 
 
+def _overlap_text(loaded: LoadedScenario, time_utc: NDArray[np.datetime64]) -> str:
+    t = loaded.scenario.time
+    start = np.datetime64(t.start.replace(tzinfo=None), "ns")
+    stop = np.datetime64(t.stop.replace(tzinfo=None), "ns")
+    inside = (time_utc >= start) & (time_utc <= stop)
+    return " (no measured epoch lies in it)" if not inside.any() else ""
+
+
 def check_scenario_sees(
     loaded: LoadedScenario,
     measured: str | Path,
@@ -97,7 +105,8 @@ def check_scenario_sees(
             f"(elevation {span})"
             + (f" and at {int(dark.sum())} in the Earth's shadow" if light == "sun" else "")
             + f"; measured: {time_span_text(time_utc)}, the scenario's time window "
-            f"{_window_text(loaded)}, site lat {loaded.scenario.observer.latitude_deg:g} "
+            f"{_window_text(loaded)}{_overlap_text(loaded, time_utc)}, site lat "
+            f"{loaded.scenario.observer.latitude_deg:g} "
             f"lon {loaded.scenario.observer.longitude_deg:g} deg: give the scenario of this "
             "target, site and night",
             source=loaded.source,
