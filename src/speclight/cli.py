@@ -357,8 +357,6 @@ def fit(
 
         names = parse_free(free)
         chosen = parse_method(method)
-        if bin_s is not None and not 0 < bin_s < float("inf"):
-            raise InputError(f"--bin-s = {bin_s!r} must be a duration > 0 s", field="--bin-s")
         inputs = {"scenario file": scenario, "measurements": measured}
         with claim_outputs(output, plot_file, force, inputs) as (claim, figure), _flag_names(
             bin_s="--bin-s"
@@ -518,7 +516,8 @@ def unmix(
         members = _endmember_files(measured, endmembers)
         check_unmix_options(members, extract, n, method, source)
         inputs = _measured_inputs(measured[0], scenario, members)
-        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+        flags = _flag_names(bin_s="--bin-s")
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure), flags:
             loaded = _optional_scenario(scenario)
             ds = unmix_measured(
                 measured[0],
@@ -623,7 +622,8 @@ def reflection_map_cmd(
         check_nside(nside)
         check_light(source)
         inputs = _measured_inputs(measured[0], scenario, members)
-        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+        flags = _flag_names(bin_s="--bin-s")
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure), flags:
             loaded = _optional_scenario(scenario)
             ds = reflection_map_measured(
                 measured[0],
@@ -842,10 +842,6 @@ def spin_axis(
             check_search_options(grid_deg, phases)
             check_refine_options(refine_method, period_bound if free_period else None)
         check_light(source)
-        if period_s is not None and not (period_s > 0 and period_s < float("inf")):
-            raise InputError(
-                f"--period-s = {period_s} must be a number > 0 [s]", field="--period-s"
-            )
         names = [b.strip() for b in bands.split(",") if b.strip()] if bands else None
         inputs = {"scenario file": scenario, "measured file": measured, "map": map_file}
         with claim_outputs(output, plot_file, force, inputs) as (claim, figure), _flag_names(

@@ -48,6 +48,8 @@ from speclight.estimate.spin_axis_ranging import (
 from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
+#: Shortest rotation period accepted [s] (:func:`_spin_model`).
+MIN_PERIOD_S = 1e-3
 
 
 @dataclasses.dataclass
@@ -123,12 +125,17 @@ def _spin_model(loaded: LoadedScenario, period_s: float | None) -> tuple[float, 
         if spin is None:
             raise InputError(
                 f"no rotation period: the scenario's attitude is '{att.model}', not 'spin'; "
-                "give --period-s (e.g. from speclight period)",
+                "give period_s (e.g. from speclight period)",
                 field="period_s",
             )
         period_s = spin.period_s
-    if not (np.isfinite(period_s) and period_s > 0):
-        raise InputError(f"period_s = {period_s} must be a number > 0 [s]", field="period_s")
+    if not (np.isfinite(period_s) and period_s >= MIN_PERIOD_S):
+        raise InputError(
+            f"period_s = {period_s} must be a number >= {MIN_PERIOD_S:g} [s] (a thousand "
+            "turns per second: no satellite spins faster, and the rotation phase of shorter "
+            "periods is lost to rounding over a pass)",
+            field="period_s",
+        )
     axis = list(spin.spin_body_axis) if spin is not None else [0.0, 0.0, 1.0]
     return float(period_s), [float(v) for v in axis], spin
 
