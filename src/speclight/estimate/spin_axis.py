@@ -52,6 +52,10 @@ F64 = NDArray[np.float64]
 DEFAULT_AXIS_CHUNK = 256
 #: A second minimum must lie this far from the best cell to count as the mirror [deg].
 MIRROR_SEP_DEG = 20.0
+#: Finest grid and phase step accepted [deg]: 36", far finer than the pixels of any map
+#: (0.23 deg at HEALPix nside 256); how large a search may be is estimated apart
+#: (:mod:`.spin_axis_limits`).
+MIN_STEP_DEG = 0.01
 
 
 @dataclass
@@ -78,12 +82,20 @@ class SpinAxisResult:
 
 
 def check_search_options(grid_deg: float, n_phases: int) -> None:
-    """Refuse a grid step outside (0, 90] deg or fewer than one phase (how large a search
+    """Refuse a grid or phase step outside [MIN_STEP_DEG, 90] deg (how large a search
     may be: :func:`.spin_axis_limits.check_search_cost`)."""
-    if not (np.isfinite(grid_deg) and 0 < grid_deg <= 90):
-        raise InputError(f"grid_deg = {grid_deg} must be in (0, 90] [deg]", field="grid_deg")
-    if int(n_phases) < 1:
-        raise InputError(f"n_phases = {n_phases} must be >= 1", field="n_phases")
+    if not (np.isfinite(grid_deg) and MIN_STEP_DEG <= grid_deg <= 90):
+        raise InputError(
+            f"grid_deg = {grid_deg} must be in [{MIN_STEP_DEG:g}, 90] [deg] (no map resolves "
+            "a finer step)",
+            field="grid_deg",
+        )
+    if not 1 <= int(n_phases) <= round(360 / MIN_STEP_DEG):
+        raise InputError(
+            f"n_phases = {n_phases} must be 1..{round(360 / MIN_STEP_DEG)} (a phase step of at "
+            f"least {MIN_STEP_DEG:g} deg)",
+            field="n_phases",
+        )
 
 
 def check_measured_curves(y: F64, band_names: list[str]) -> None:

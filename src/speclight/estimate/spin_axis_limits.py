@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from speclight.estimate.limits import ANNOUNCE_SECONDS, check_cost, duration
-from speclight.estimate.spin_axis import DEFAULT_AXIS_CHUNK, radec_grid
+from speclight.estimate.spin_axis import DEFAULT_AXIS_CHUNK
 from speclight.estimate.spin_axis_lookup import cell_deg_for
 
 #: float64 temporaries of the map lookup per spin-frame cell, beside ``16 B`` per band [bytes].
@@ -38,6 +38,11 @@ SECONDS_PER_CELL_GEOMETRY = 10e-6
 SECONDS_PER_LOOKUP = 10e-9
 #: The default ``n_phases`` (``--phases``), to tell which option made a search large.
 DEFAULT_PHASES = 72
+
+
+def grid_size(grid_deg: float) -> tuple[float, float]:
+    """RA and Dec cells of :func:`.spin_axis.radec_grid` (without making them)."""
+    return float(max(1, round(360.0 / grid_deg))), float(max(1, round(180.0 / grid_deg)))
 
 
 def _frame_map_cost(nside: int, n_geometries: int, n_phases: int, n_channels: int) -> tuple:
@@ -66,8 +71,8 @@ def search_cost(
     if ranging:
         r_bytes, r_s, _ = _frame_map_cost(nside, 1, n_phases, 2 * n_b)
         map_bytes, map_s = map_bytes + r_bytes, map_s + r_s
-    ra, dec = radec_grid(grid_deg)
-    n_axes = float(ra.size) * dec.size
+    n_ra, n_dec = grid_size(grid_deg)
+    n_axes = float(n_ra) * n_dec
     grid_bytes = 4 * 8 * n_axes * n_phases
     grid_bytes += BYTES_PER_AXIS_EPOCH * min(n_axes, DEFAULT_AXIS_CHUNK) * n_epochs
     grid_bytes += 3 * 4 * float(n_epochs) * n_phases * n_b
@@ -94,9 +99,9 @@ def check_search_cost(
 
     args = (nside, n_phase_angles, n_rolls, grid_deg)
     map_b, map_s, grid_b, grid_s = search_cost(*args, n_phases, n_epochs, n_bands, ranging)
-    ra, dec = radec_grid(grid_deg)
+    n_ra, n_dec = grid_size(grid_deg)
     what = (
-        f"the search of {ra.size} x {dec.size} axes x {n_phases} phases x {n_epochs} epochs "
+        f"the search of {n_ra:.6g} x {n_dec:.6g} axes x {n_phases} phases x {n_epochs} epochs "
         f"x {n_bands} bands (a spin-frame map of {n_phase_angles} phase angles x {n_rolls} "
         f"rolls at HEALPix nside {nside}{', with the ranging term' if ranging else ''})"
     )
@@ -112,4 +117,4 @@ def check_search_cost(
         warnings.warn(f"spin-axis: {what} takes about {duration(seconds)}", stacklevel=2)
 
 
-__all__ = ["check_search_cost", "search_cost"]
+__all__ = ["check_search_cost", "grid_size", "search_cost"]
