@@ -358,8 +358,9 @@ def fit(
         names = parse_free(free)
         chosen = parse_method(method)
         inputs = {"scenario file": scenario, "measurements": measured}
-        with claim_outputs(output, plot_file, force, inputs) as (claim, figure), _flag_names(
-            bin_s="--bin-s"
+        with (
+            claim_outputs(output, plot_file, force, inputs) as (claim, figure),
+            _flag_names(bin_s="--bin-s"),
         ):
             result = fit_scenario(
                 load_scenario(scenario), read_measured(measured), free=names, bin_s=bin_s,
@@ -844,8 +845,9 @@ def spin_axis(
         check_light(source)
         names = [b.strip() for b in bands.split(",") if b.strip()] if bands else None
         inputs = {"scenario file": scenario, "measured file": measured, "map": map_file}
-        with claim_outputs(output, plot_file, force, inputs) as (claim, figure), _flag_names(
-            **flags
+        with (
+            claim_outputs(output, plot_file, force, inputs) as (claim, figure),
+            _flag_names(**flags),
         ):
             loaded = load_scenario(scenario)
             result = spin_axis_measured(
@@ -1014,6 +1016,7 @@ def period(
                 from speclight.plot.period_figure import period_figure
 
                 figure.write(period_figure(result))
+
         def shown(key: str, spec: str) -> str:  # null: not determined (PERIOD.json says)
             return "undetermined" if summary[key] is None else format(summary[key], spec)
 

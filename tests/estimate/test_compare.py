@@ -300,6 +300,7 @@ def test_too_many_sites_to_finish_in_a_day_are_refused(tmp_path, monkeypatch) ->
     module = importlib.import_module("speclight.estimate.compare")
     monkeypatch.setattr(module, "SECONDS_PER_SITE", 50_000.0)
     loaded = parse_scenario(_scenario(tmp_path).read_text())
-    rows = [f"{EPOCHS[0]}Z,10.0,0.05,G-600/40,{s[0]},{s[1]},{s[2]}" for s in (STUTTGART, ZIMMERWALD)]
+    rows = [f"{EPOCHS[0]}Z,10.0,0.05,G-600/40,{lat},{lon},{alt}"
+            for lat, lon, alt in (STUTTGART, ZIMMERWALD)]  # fmt: skip
     with pytest.raises(InputError, match=r"each of its 2 sites .* about 27.8 h"):
         compare(loaded, read_observations(_write(tmp_path / "obs.csv", rows)))

@@ -33,7 +33,8 @@ def test_bins_average_the_used_entries_by_hand() -> None:
     v = np.array([[1.0, 10], [2, 99], [99, 99], [6, 30], [99, 7], [99, 99]])
     np.testing.assert_allclose(bins.mean(v), [[3.0, 20.0], [np.nan, 7.0]])
     # derivatives (K, N, B) along axis 1: the same averages per parameter
-    np.testing.assert_allclose(bins.mean(np.stack([v, 2 * v]), axis=1)[1], [[6.0, 40.0], [np.nan, 14.0]])
+    twice = bins.mean(np.stack([v, 2 * v]), axis=1)[1]
+    np.testing.assert_allclose(twice, [[6.0, 40.0], [np.nan, 14.0]])
     # sigma of a mean of n independent values: sqrt(sum sigma^2) / n
     s = np.array([[3.0, 1], [4, 1], [1, 1], [0, 2], [1, 5], [1, 1]])
     np.testing.assert_allclose(bins.sigma(s), [[5 / 3, np.sqrt(5) / 2], [np.nan, 5.0]])

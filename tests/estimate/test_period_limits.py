@@ -100,6 +100,7 @@ def test_a_band_with_too_few_points_adds_nothing() -> None:
 
 def test_nan_in_the_summary_becomes_null_and_is_listed() -> None:
     missing: list[str] = []
-    out = _nulls_for_nan({"a": 1.0, "b": float("nan"), "c": [{"d": np.float64("inf")}]}, "", missing)
+    summary = {"a": 1.0, "b": float("nan"), "c": [{"d": np.float64("inf")}]}
+    out = _nulls_for_nan(summary, "", missing)
     assert out == {"a": 1.0, "b": None, "c": [{"d": None}]}
     assert missing == ["b", "c[0].d"]

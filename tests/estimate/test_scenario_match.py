@@ -56,7 +56,7 @@ def test_where_skyfield_sees_it_passes_and_elsewhere_not(tmp_path: Path) -> None
     with pytest.raises(InputError, match=r"deg from where .* saw the target"):
         check_scenario_sees(loaded, turned, PASS, "laser")
     other = _recorded(tmp_path / "other.nc", PASS, az, el, example_text("box-wing"))
-    with pytest.raises(InputError, match="catalogue number 1520, but .* was made for"):
+    with pytest.raises(InputError, match=r"catalogue number 1520, but .* was made for"):
         check_scenario_sees(loaded, other, PASS, "laser")
 
 

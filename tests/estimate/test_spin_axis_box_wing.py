@@ -212,6 +212,7 @@ def test_cli_refuses_what_cannot_be_searched(folder) -> None:
     zero = [base[0], str(scenario), str(folder / "zero.csv"), *base[3:]]
     _one_line_error(runner.invoke(app, [*zero, *new, "--grid-deg", "30", "--phases", "12"]),
                     "MEASURED", f"'{bands[2]}' (0)")  # fmt: skip
+
     # the scenario of another satellite (the calsphere's orbit) for the box-wing's pass
     def orbit(text: str) -> str:
         return text[text.index("orbit:") : text.index("attitude:")]

@@ -81,6 +81,7 @@ def test_fallback_rule_by_hand() -> None:
     assert sa._refined_or_best([nan, good], best, 0.4, geo) == (good.answer, 37.0, "")
     answer, period, note = sa._refined_or_best([worse], best, 0.4, geo)
     assert answer == (10.0, 20.0, 30.0, 0.4) and "above the grid's best" in note
+    assert period == geo.period_s
     answer, _, note = sa._refined_or_best([nan], best, np.inf, geo)
     assert answer == best and "no finite misfit" in note  # the grid's own misfit then
 

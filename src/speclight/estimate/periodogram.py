@@ -241,9 +241,7 @@ def refine_peak(
     lo, hi = frequency_hz - half, frequency_hz + half
     if within is not None:
         lo, hi = max(lo, float(within[0])), min(hi, float(within[1]))
-    found = minimize_scalar(
-        chi, bounds=(lo, hi), method="bounded", options={"xatol": 1e-6 * half}
-    )
+    found = minimize_scalar(chi, bounds=(lo, hi), method="bounded", options={"xatol": 1e-6 * half})
     best = float(found.x)
     chi2, npar, coefs = harmonic_chi2(series, best, orders, phase_rad, trend_degree)
     dof = max(series.t_s.size - npar - 1, 1)

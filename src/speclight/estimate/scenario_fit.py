@@ -229,9 +229,7 @@ def fit_scenario(
                 "Jacobian (variable projection), weighted least squares for scales"
             )
         else:
-            fit = fit_rough_slsqp(
-                base, first, m, sigma, rough, "albedo" in free, show, scan, bins
-            )
+            fit = fit_rough_slsqp(base, first, m, sigma, rough, "albedo" in free, show, scan, bins)
             method_text = (
                 "SLSQP over roughness (variable projection), weighted least squares for scales"
             )

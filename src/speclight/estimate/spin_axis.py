@@ -314,20 +314,26 @@ def _refined_or_best(
     (:class:`.spin_axis_refine.Refined`); the grid's best cell with its misfit under the
     map's own interpolation, the period given and the reason, where no refinement ended
     finite or none below that misfit."""
-    finite = [
-        t for t in tries if np.all(np.isfinite(t.answer)) and np.isfinite(t.period_s)
-    ]
+    finite = [t for t in tries if np.all(np.isfinite(t.answer)) and np.isfinite(t.period_s)]
     exact = float(best_exact) if np.isfinite(best_exact) else best[3]
     fallback = (best[0], best[1], best[2], exact)
     if not finite:
-        return fallback, geo.period_s, (
-            "the refinement ended at no finite misfit from any start; refined_* is the "
-            "grid's best cell"
+        return (
+            fallback,
+            geo.period_s,
+            (
+                "the refinement ended at no finite misfit from any start; refined_* is the "
+                "grid's best cell"
+            ),
         )
     chosen = min(finite, key=lambda t: t.error)
     if np.isfinite(best_exact) and chosen.error > best_exact:
-        return fallback, geo.period_s, (
-            f"the refinement ended at a misfit {chosen.error:.4g} above the grid's best "
-            f"cell's {best_exact:.4g}; refined_* is that cell"
+        return (
+            fallback,
+            geo.period_s,
+            (
+                f"the refinement ended at a misfit {chosen.error:.4g} above the grid's best "
+                f"cell's {best_exact:.4g}; refined_* is that cell"
+            ),
         )
     return chosen.answer, chosen.period_s, ""
