@@ -766,8 +766,12 @@ def spin_axis(
         float | None,
         typer.Option("--period-s", help="Rotation period [s] (default: the scenario's)."),
     ] = None,
-    grid_deg: Annotated[float, typer.Option("--grid-deg", help="RA/Dec grid step [deg].")] = 2.0,
-    phases: Annotated[int, typer.Option("--phases", help="Rotation phases tried per axis.")] = 72,
+    grid_deg: Annotated[
+        float, typer.Option("--grid-deg", help="RA/Dec grid step in deg, 0.01..90.")
+    ] = 2.0,
+    phases: Annotated[
+        int, typer.Option("--phases", help="Rotation phases tried per axis (1..36000).")
+    ] = 72,
     bands: Annotated[
         str | None, typer.Option("--bands", metavar="LIST", help="Comma-separated band names.")
     ] = None,
@@ -932,7 +936,8 @@ def period(
         float | None, typer.Option("--bin-s", help="Average epochs into bins of S seconds.")
     ] = None,
     draws: Annotated[
-        int, typer.Option("--draws", help="Bootstrap draws for the false-alarm probability.")
+        int,
+        typer.Option("--draws", help="Bootstrap draws for the false-alarm probability (1..10000)."),
     ] = 40,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the bootstrap.")] = 0,
     if_symmetric: Annotated[

@@ -13,7 +13,8 @@ the estimate, the limit and what to reduce.
   on a path-mode render: the output is written only at the end, so a longer run risks
   losing everything to one interruption. The rates behind the estimates were measured on
   the development machine (2 cores shared with other jobs; BENCHMARKS.md, "Estimator
-  limits") and are upper bounds there; a faster machine finishes sooner.
+  limits", ``bench/bench_estimator_limits.py``), within about 20 % there; against a limit of
+  a day only their order of magnitude matters.
 """
 
 from __future__ import annotations

@@ -84,8 +84,8 @@ MAX_RATE_OVER_MEDIAN = 1e6
 #: tens of draws (:mod:`.period_fap`); 10 000 draws pin it far beyond what a decision needs.
 MAX_DRAWS = 10_000
 #: Seconds per frequency and band of astropy's chi2 periodogram, and per frequency, band and
-#: point times (2 harmonics + 1)^2 (measured: 300-20 000 points, 1-10 harmonics; upper
-#: bounds on the development machine, BENCHMARKS.md "Estimator limits").
+#: point times (2 harmonics + 1)^2 (measured: 300-20 000 points, 1-10 harmonics, within 20 %
+#: or above; BENCHMARKS.md "Estimator limits", bench/bench_estimator_limits.py).
 SECONDS_PER_BAND_FREQUENCY = 60e-6
 SECONDS_PER_TERM = 10e-9
 #: Bytes per frequency of the grid: the grid, the power, the sum over bands and astropy's

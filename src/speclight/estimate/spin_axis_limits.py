@@ -15,8 +15,9 @@ What grows with the options (``grid_deg``, ``n_phases``) and the inputs (epochs 
 
 The ranging term (``ranging=True``) adds its own spin-frame map (one geometry, ``2 B``
 channels) and doubles the grid pass. Rates measured on the box-wing example (768-direction
-map, 4 phase angles x 8 rolls, 300 epochs, 10 bands; BENCHMARKS.md "Estimator limits"):
-6-10 us per cell and geometry, 5-9 ns per lookup; the constants are the upper ends.
+map, 4 phase angles x 8 rolls, 300 epochs, 10 bands; BENCHMARKS.md "Estimator limits",
+``bench/bench_estimator_limits.py``): 6-10.5 us per cell and geometry, 4.6-9 ns per lookup;
+the constants are about the upper ends.
 """
 
 from __future__ import annotations
