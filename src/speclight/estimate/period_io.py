@@ -373,7 +373,7 @@ def check_periodogram_cost(
     else:
         check_cost("min_period_s", f"{min_p:g}", what, n_bytes, seconds, reduce)
     if seconds > ANNOUNCE_SECONDS:
-        warnings.warn(f"period: {what} take about {duration(seconds)}", stacklevel=2)
+        warnings.warn(f"period: {what.rstrip(',')}: about {duration(seconds)}", stacklevel=2)
 
 
 def estimate_period(

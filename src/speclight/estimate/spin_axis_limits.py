@@ -115,7 +115,7 @@ def check_search_cost(
     else:
         check_cost("grid_deg", grid_deg, what, n_bytes, seconds, reduce)
     if seconds > ANNOUNCE_SECONDS:
-        warnings.warn(f"spin-axis: {what} takes about {duration(seconds)}", stacklevel=2)
+        warnings.warn(f"spin-axis: {what}: about {duration(seconds)}", stacklevel=2)
 
 
 __all__ = ["check_search_cost", "grid_size", "search_cost"]
