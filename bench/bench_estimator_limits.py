@@ -43,10 +43,11 @@ def spin_axis() -> None:
     nside, angles, rolls, bands, n_t = 8, 4, 8, 10, 300
     d = healpix_directions(nside)
     rates = np.random.default_rng(1).uniform(1, 2, (d.shape[0], angles, rolls, bands))
-    header = MapHeader(Path("synthetic"), nside, np.array([500.0]), [str(b) for b in range(bands)],
-                       np.linspace(40, 130, angles), np.arange(rolls) * 360.0 / rolls, {})  # fmt: skip
+    names = [str(b) for b in range(bands)]
+    angle_deg, roll_deg = np.linspace(40, 130, angles), np.arange(rolls) * 360.0 / rolls
+    header = MapHeader(Path("synthetic"), nside, np.array([500.0]), names, angle_deg, roll_deg, {})
     bmap = ReflectivityMap(header, d, rates.astype(np.float32))
-    print("spin axis: phases, grid -> spin-frame map s (per cell x geometry), grid s (per lookup)")
+    print("spin axis: phases, grid -> spin-frame map s (per cell x geometry), grid s")
     ang = np.radians(np.linspace(0, 60, n_t))
     sun = np.stack([np.cos(ang), np.sin(ang), np.zeros(n_t)], -1)
     obs = np.stack([np.cos(ang + 1), np.sin(ang + 1), np.zeros(n_t)], -1)
