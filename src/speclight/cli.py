@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import signal
 import sys
 import threading
@@ -119,6 +120,24 @@ def _signals_end_the_run() -> Iterator[None]:
 def _fail(message: str, code: int) -> None:
     typer.echo(f"error: {message}", err=True)
     raise typer.Exit(code)
+
+
+@contextmanager
+def _flag_names(**flags: str) -> Iterator[None]:
+    """Say the command-line flags where a plain-array core's error names its Python
+    parameters (``n_phases = 0`` -> ``--phases = 0``): ``flags`` maps parameter names to
+    flags. A name with an underscore is replaced wherever it stands; a plain word
+    (``draws``) only as ``draws =``, so that the prose around it stays."""
+    try:
+        yield
+    except InputError as exc:
+        if exc.field not in flags:
+            raise
+        message = exc.message
+        for name, flag in flags.items():
+            tail = r"(?!\w)" if "_" in name else r"(?= = )"
+            message = re.sub(rf"(?<![\w-]){re.escape(name)}{tail}", flag, message)
+        raise InputError(message, source=exc.source, field=flags[str(exc.field)]) from None
 
 
 def _guarded(func: Callable[[], Any]) -> Any:
@@ -339,10 +358,11 @@ def fit(
 
         names = parse_free(free)
         chosen = parse_method(method)
-        if bin_s is not None and not 0 < bin_s < float("inf"):
-            raise InputError(f"--bin-s = {bin_s!r} must be a duration > 0 s", field="--bin-s")
         inputs = {"scenario file": scenario, "measurements": measured}
-        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+        with (
+            claim_outputs(output, plot_file, force, inputs) as (claim, figure),
+            _flag_names(bin_s="--bin-s"),
+        ):
             result = fit_scenario(
                 load_scenario(scenario), read_measured(measured), free=names, bin_s=bin_s,
                 progress=sys.stderr.isatty(), method=chosen,
@@ -503,7 +523,8 @@ def unmix(
         members = _endmember_files(measured, endmembers)
         check_unmix_options(members, extract, n, method, source)
         inputs = _measured_inputs(measured[0], scenario, members)
-        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+        flags = _flag_names(bin_s="--bin-s")
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure), flags:
             loaded = _optional_scenario(scenario)
             ds = unmix_measured(
                 measured[0],
@@ -610,7 +631,8 @@ def reflection_map_cmd(
         check_nside(nside)
         check_light(source)
         inputs = _measured_inputs(measured[0], scenario, members)
-        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+        flags = _flag_names(bin_s="--bin-s")
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure), flags:
             loaded = _optional_scenario(scenario)
             ds = reflection_map_measured(
                 measured[0],
@@ -757,8 +779,12 @@ def spin_axis(
         float | None,
         typer.Option("--period-s", help="Rotation period [s] (default: the scenario's)."),
     ] = None,
-    grid_deg: Annotated[float, typer.Option("--grid-deg", help="RA/Dec grid step [deg].")] = 2.0,
-    phases: Annotated[int, typer.Option("--phases", help="Rotation phases tried per axis.")] = 72,
+    grid_deg: Annotated[
+        float, typer.Option("--grid-deg", help="RA/Dec grid step in deg, 0.01..90.")
+    ] = 2.0,
+    phases: Annotated[
+        int, typer.Option("--phases", help="Rotation phases tried per axis (1..36000).")
+    ] = 72,
     bands: Annotated[
         str | None, typer.Option("--bands", metavar="LIST", help="Comma-separated band names.")
     ] = None,
@@ -825,16 +851,21 @@ def spin_axis(
         from speclight.plot.figure_output import claim_outputs, write_outputs
         from speclight.scenario import load_scenario
 
-        check_search_options(grid_deg, phases)
-        check_refine_options(refine_method, period_bound if free_period else None)
+        flags = dict(
+            grid_deg="--grid-deg", n_phases="--phases", period_s="--period-s", bands="--bands",
+            refine_method="--refine", period_bound="--period-bound", y="MEASURED", bmap="--map",
+            ranging_weight="--ranging-weight",
+        )  # fmt: skip
+        with _flag_names(**flags):
+            check_search_options(grid_deg, phases)
+            check_refine_options(refine_method, period_bound if free_period else None)
         check_light(source)
-        if period_s is not None and not (period_s > 0 and period_s < float("inf")):
-            raise InputError(
-                f"--period-s = {period_s} must be a number > 0 [s]", field="--period-s"
-            )
         names = [b.strip() for b in bands.split(",") if b.strip()] if bands else None
         inputs = {"scenario file": scenario, "measured file": measured, "map": map_file}
-        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+        with (
+            claim_outputs(output, plot_file, force, inputs) as (claim, figure),
+            _flag_names(**flags),
+        ):
             loaded = load_scenario(scenario)
             result = spin_axis_measured(
                 loaded,
@@ -871,6 +902,9 @@ def spin_axis(
                 + (f"period {a['refined_period_s']:.6g} s " if free_period else "")
                 + f"by {a['refine_method']} with {a['refine_misfit_evaluations']} misfit and "
                 f"{a['refine_gradient_evaluations']} gradient evaluations "
+                if math.isfinite(float(a["refined_ra_deg"])) and not result.result.refine_note
+                else f"refined RA {a['refined_ra_deg']:.2f} Dec {a['refined_dec_deg']:.2f}: "
+                f"{result.result.refine_note} "
                 if math.isfinite(float(a["refined_ra_deg"]))
                 else "not refined (--no-refine) "
             )
@@ -917,7 +951,8 @@ def period(
         float | None, typer.Option("--bin-s", help="Average epochs into bins of S seconds.")
     ] = None,
     draws: Annotated[
-        int, typer.Option("--draws", help="Bootstrap draws for the false-alarm probability.")
+        int,
+        typer.Option("--draws", help="Bootstrap draws for the false-alarm probability (1..10000)."),
     ] = 40,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the bootstrap.")] = 0,
     if_symmetric: Annotated[
@@ -974,7 +1009,11 @@ def period(
             "double" if if_symmetric == "double" else "keep" if if_symmetric == "keep" else "auto"
         )
         inputs = _measured_inputs(measured, scenario)
-        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+        flags = _flag_names(
+            min_period_s="--min-period-s", max_period_s="--max-period-s", draws="--draws",
+            harmonics="--harmonics", seed="--seed", synodic="--synodic", bin_s="--bin-s",
+        )  # fmt: skip
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure), flags:
             loaded = _optional_scenario(scenario)
             result = estimate_period(
                 measured,
@@ -999,10 +1038,14 @@ def period(
                 return period_figure(result)
 
             write_outputs(claim, (json.dumps(summary, indent=2) + "\n").encode(), figure, draw)
+
+        def shown(key: str, spec: str) -> str:  # null: not determined (PERIOD.json says)
+            return "undetermined" if summary[key] is None else format(summary[key], spec)
+
         typer.echo(
-            f"rotation period {summary['period_s']:.6g} +- {summary['period_std_s']:.2g} s "
-            f"(photometric {summary['photometric_period_s']:.6g} s, false-alarm probability "
-            f"{summary['false_alarm_probability']:.2g})"
+            f"rotation period {shown('period_s', '.6g')} +- {shown('period_std_s', '.2g')} s "
+            f"(photometric {shown('photometric_period_s', '.6g')} s, false-alarm probability "
+            f"{shown('false_alarm_probability', '.2g')})"
         )
         typer.echo(f"wrote {output}" + (f" and {plot_file}" if plot_file else ""))
 

@@ -78,7 +78,9 @@ def test_rmap_per_spec_with_per_pixel_contributions_and_figure(tmp_path: Path) -
     np.testing.assert_allclose(ds["reflectance_factor_std"].values[:, PIXELS], 0.0, atol=1e-15)
 
 
-@pytest.mark.parametrize("case", ["nside", "csv", "no-direction", "source", "exists", "band"])
+@pytest.mark.parametrize(
+    "case", ["nside", "csv", "no-direction", "source", "exists", "band", "nan-direction", "bin"]
+)
 def test_bad_input_is_one_line_and_exit_2(tmp_path: Path, case: str) -> None:
     measured = _measured(tmp_path)
     out = tmp_path / "rmap.nc"
@@ -90,6 +92,8 @@ def test_bad_input_is_one_line_and_exit_2(tmp_path: Path, case: str) -> None:
         "source": "unknown source 'moon'",
         "exists": "exists",
         "band": "unknown band 'X'",
+        "nan-direction": "the map would be empty: measured 2020-",
+        "bin": "--bin-s = 1e+09 s is not shorter than the",
     }[case]
     if case == "nside":
         args += ["--nside", "12"]
@@ -105,6 +109,13 @@ def test_bad_input_is_one_line_and_exit_2(tmp_path: Path, case: str) -> None:
         out.write_text("keep me")
     elif case == "band":
         args += ["--plot", str(tmp_path / "f.png"), "--band", "X"]
+    elif case == "nan-direction":  # every phase vector NaN: no epoch has a direction
+        ds = xr.load_dataset(measured, engine="h5netcdf")
+        ds["phase_vector_body"][:] = np.nan
+        ds.to_netcdf(tmp_path / "nan.nc", engine="h5netcdf")
+        args[0] = str(tmp_path / "nan.nc")
+    elif case == "bin":
+        args += ["--bin-s", "1e9"]
     result = _run(*args)
     assert result.exit_code == 2, result.output
     assert needle in result.stderr

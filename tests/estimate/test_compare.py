@@ -290,3 +290,17 @@ def test_observed_positions_give_a_nadir_attitude_its_velocity(tmp_path) -> None
     )
     assert np.isfinite(tle_run["magnitude_simulated"].values[4])
     assert np.isnan(placed["magnitude_simulated"].values[4]) and placed["flags"].values[4] & 64
+
+
+def test_too_many_sites_to_finish_in_a_day_are_refused(tmp_path, monkeypatch) -> None:
+    # one simulation per site: with 50 000 s per site (in place of the 1 s lower bound),
+    # two sites are 27.8 h, over the one-day limit of estimate/limits.py
+    import importlib
+
+    module = importlib.import_module("speclight.estimate.compare")
+    monkeypatch.setattr(module, "SECONDS_PER_SITE", 50_000.0)
+    loaded = parse_scenario(_scenario(tmp_path).read_text())
+    rows = [f"{EPOCHS[0]}Z,10.0,0.05,G-600/40,{lat},{lon},{alt}"
+            for lat, lon, alt in (STUTTGART, ZIMMERWALD)]  # fmt: skip
+    with pytest.raises(InputError, match=r"each of its 2 sites .* about 27.8 h"):
+        compare(loaded, read_observations(_write(tmp_path / "obs.csv", rows)))

@@ -52,5 +52,5 @@ def test_laser_source_needs_laser_returns(tmp_path):
         estimate_period(csv, source="laser")
     with pytest.raises(InputError, match="--source = 'moon'"):
         estimate_period(csv, source="moon")
-    with pytest.raises(InputError, match="--synodic = 'always'"):
+    with pytest.raises(InputError, match="synodic = 'always'"):
         estimate_period(csv, synodic="always")  # type: ignore[arg-type]

@@ -26,7 +26,7 @@ from speclight.estimate.reflectivity_map import reflectivity_map
 from speclight.estimate.spin_axis import angular_distance_deg
 from speclight.estimate.spin_axis_io import spin_axis_measured
 from speclight.io.netcdf import dataset_bytes
-from speclight.scenario import load_scenario
+from speclight.scenario import example_text, load_scenario
 from speclight.simulate import simulate
 
 GRID_DEG, PHASES = 10.0, 36
@@ -182,3 +182,52 @@ def test_cli_run_and_bad_input(folder) -> None:
     base_fewer = [base[0], str(folder / "fewer.yaml"), *base[2:]]
     _one_line_error(runner.invoke(app, [*base_fewer, *new]), "instrument.bands")
     assert not (folder / "new.nc").exists()
+
+
+def test_cli_refuses_what_cannot_be_searched(folder) -> None:
+    """Sizes that cannot finish, curves without a mean, another satellite (issue 22)."""
+    scenario = _simulated(folder, "antenna", _pass_text())
+    measured = scenario.with_suffix(".nc")
+    base = ["spin-axis", str(scenario), str(measured), "--map", str(folder / "m.zarr")]
+    new = ["-o", str(folder / "refused.nc")]
+    _one_line_error(runner.invoke(app, [*base, *new, "--phases", "1000000000"]),
+                    "--phases = 1000000000 must be 1..36000")  # fmt: skip
+    # within the bounds but over the memory or time limit (which, depends on the machine)
+    _one_line_error(runner.invoke(app, [*base, *new, "--phases", "36000"]),
+                    "--phases = 36000: the search of 180 x 90 axes x 36000 phases")  # fmt: skip
+    _one_line_error(runner.invoke(app, [*base, *new, "--grid-deg", "0.01"]),
+                    "--grid-deg = 0.01: the search of 36000 x 18000 axes")  # fmt: skip
+    _one_line_error(runner.invoke(app, [*base, *new, "--period-s", "1e-9"]), "--period-s")
+    # a band of zero rates (a CSV of the pass): its curve cannot be divided by its mean
+    with xr.open_dataset(measured, engine="h5netcdf") as sim:
+        rate = sim["count_rate_measured"].transpose("time", "band").values
+        bands = [str(b) for b in sim["band"].values]
+        times = sim["time"].values
+    rate[:, 2] = 0.0
+    rows = [f"time,{','.join(bands)}"] + [
+        f"{np.datetime_as_string(t, unit='ms')}Z," + ",".join(f"{x:.7g}" for x in r)
+        for t, r in zip(times, rate, strict=True)
+    ]
+    (folder / "zero.csv").write_text("\n".join(rows) + "\n")
+    zero = [base[0], str(scenario), str(folder / "zero.csv"), *base[3:]]
+    _one_line_error(runner.invoke(app, [*zero, *new, "--grid-deg", "30", "--phases", "12"]),
+                    "MEASURED", f"'{bands[2]}' (0)")  # fmt: skip
+
+    # the scenario of another satellite (the calsphere's orbit) for the box-wing's pass
+    def orbit(text: str) -> str:
+        return text[text.index("orbit:") : text.index("attitude:")]
+
+    other = _pass_text().replace(orbit(_pass_text()), orbit(example_text("calsphere")))
+    (folder / "other.yaml").write_text(other)
+    _one_line_error(
+        runner.invoke(app, [base[0], str(folder / "other.yaml"), *base[2:], *new]),
+        "catalogue number 1520",
+    )
+    assert not (folder / "refused.nc").exists()
+    # a run that passes: finite refined axis, and AXIS.nc says how it was refined
+    ok = runner.invoke(app, [*base, "-o", str(folder / "ok.nc"), "--grid-deg", "30",
+                             "--phases", "12"])  # fmt: skip
+    assert ok.exit_code == 0, ok.output
+    with xr.open_dataset(folder / "ok.nc", engine="h5netcdf") as ds:
+        assert all(np.isfinite(ds.attrs[f"refined_{k}"]) for k in ("ra_deg", "dec_deg", "error"))
+        assert ds.attrs["refine_note"] and ds.attrs["mirror_note"]

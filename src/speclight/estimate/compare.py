@@ -37,6 +37,9 @@ from speclight.scenario import LoadedScenario
 from speclight.scenario.overrides import with_overrides
 
 F64 = NDArray[np.float64]
+#: Least time of one site's simulation [s]: the target's build and one render launch, a lower
+#: bound of the 5.7 s per site of 100 observations each measured in BENCHMARKS.md ("Compare").
+SECONDS_PER_SITE = 1.0
 #: Per-observation geometry copied from the simulation: output name -> simulate variable.
 GEOMETRY = {
     "phase_angle": "phase_angle",
@@ -162,6 +165,7 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
     for name in ("sun_direction_body", "observer_direction_body"):
         geo[name] = np.full((n, 3), np.nan)
     groups = obs.site_groups()
+    _check_sites(len(groups), obs)
     for (lat, lon, alt), idx in groups:
         site_scenario = with_overrides(
             base,
@@ -187,6 +191,20 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
     if not np.any(np.isfinite(sim) & np.isfinite(obs.magnitude)):
         raise no_usable_epochs(n, loaded.source, obs.source, FIELD, "observed")
     return CompareResult(dataset=_dataset(loaded, obs, sim, flags, geo), notes=notes)
+
+
+def _check_sites(n_sites: int, obs: Observations) -> None:
+    """Refuse observations from so many sites that one simulation each cannot finish in a
+    day (:mod:`.limits`), at :data:`SECONDS_PER_SITE` each at least."""
+    from speclight.estimate.limits import check_cost
+
+    check_cost(
+        FIELD, f"{obs.source} ({obs.time_utc.size} rows)",
+        f"one simulation for each of its {n_sites} sites (at least {SECONDS_PER_SITE:g} s "
+        "each: the target's build and a render launch)",
+        0.0, n_sites * SECONDS_PER_SITE,
+        "group the observations by site into fewer files, or round the sites' coordinates",
+    )  # fmt: skip
 
 
 def _dataset(

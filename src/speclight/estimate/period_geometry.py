@@ -40,8 +40,15 @@ def _dataset_bisector(path: Path, source: str) -> tuple[np.ndarray, F64, F64] | 
         phase = values(ds, "phase_angle", ("time",), src, "MEASURED")
     with np.errstate(invalid="ignore"):
         gcrs = quat_rotate(q, pv)
-    if np.sum(np.all(np.isfinite(gcrs), axis=1)) < 2:
-        return None  # NaN at (nearly) every epoch: the geometry is not known
+    if np.sum(np.all(np.isfinite(gcrs), axis=1)) < 2:  # NaN at (nearly) every epoch
+        import warnings
+
+        warnings.warn(
+            f"{path}: {vector} or attitude_quaternion is NaN at (nearly) every epoch; the "
+            "geometry of the synodic correction is the scenario's (where there is one)",
+            stacklevel=3,
+        )
+        return None
     return t, gcrs, phase
 
 

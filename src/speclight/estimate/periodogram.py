@@ -99,10 +99,19 @@ def _chi2_0(series: BandSeries) -> F64:
 
 
 def multiband_power(series: BandSeries, frequency_hz: F64, harmonics: int) -> F64:
-    """Power ``1 - sum chi2_b(f) / sum chi2_0b`` at each frequency (module docstring)."""
+    """Power ``1 - sum chi2_b(f) / sum chi2_0b`` at each frequency (module docstring).
+
+    Bands with no more points than the ``2 harmonics + 1`` parameters of their model are
+    left out; NaN everywhere when no band is left (or none varies).
+    """
     from astropy.timeseries import LombScargle
 
     chi0 = _chi2_0(series)
+    for b in range(series.n_bands):  # a band with no more points than parameters tells nothing
+        if np.count_nonzero(series.band == b) <= 2 * harmonics + 1:
+            chi0[b] = 0.0
+    if not chi0.sum() > 0:
+        return np.full(frequency_hz.size, np.nan)
     total = np.zeros(frequency_hz.size)
     for b in range(series.n_bands):
         m = series.band == b
@@ -206,12 +215,14 @@ def refine_peak(
     orders: list[int],
     phase_rad: F64 | None = None,
     trend_degree: int = TREND_DEGREE,
+    within: tuple[float, float] | None = None,
 ) -> Peak:
     """Best frequency near ``frequency_hz`` and its standard deviation.
 
     The chi-square of the model with the harmonics ``orders`` and a polynomial trend of
     ``trend_degree`` per band is minimised over ``+-0.1 / span`` around ``frequency_hz`` (a
-    tenth of the peak width; scipy's bounded Brent search, to 1e-6 of that window). Its
+    tenth of the peak width; scipy's bounded Brent search, to 1e-6 of that window), cut to
+    ``within`` (the searched frequency range [Hz], if given). Its
     curvature at the minimum, ``c2`` of ``chi2(f) ~ chi2_min + c2 (f - f0)^2``, comes from a
     central difference whose step is set to twice the resulting standard deviation (two
     passes). The standard deviation follows from ``delta chi2 = 1`` after scaling the
@@ -227,12 +238,10 @@ def refine_peak(
         return harmonic_chi2(series, f, orders, phase_rad, trend_degree)[0]
 
     half = 0.1 / series.span_s
-    found = minimize_scalar(
-        chi,
-        bounds=(frequency_hz - half, frequency_hz + half),
-        method="bounded",
-        options={"xatol": 1e-6 * half},
-    )
+    lo, hi = frequency_hz - half, frequency_hz + half
+    if within is not None:
+        lo, hi = max(lo, float(within[0])), min(hi, float(within[1]))
+    found = minimize_scalar(chi, bounds=(lo, hi), method="bounded", options={"xatol": 1e-6 * half})
     best = float(found.x)
     chi2, npar, coefs = harmonic_chi2(series, best, orders, phase_rad, trend_degree)
     dof = max(series.t_s.size - npar - 1, 1)

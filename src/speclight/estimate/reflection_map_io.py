@@ -38,6 +38,7 @@ from numpy.typing import NDArray
 
 from speclight.errors import InputError
 from speclight.estimate.endmember_spectra import endmembers_from_files, endmembers_from_scenario
+from speclight.estimate.limits import time_span_text
 from speclight.estimate.reflection_map import (
     ReflectionMap,
     check_nside,
@@ -112,17 +113,20 @@ def reflection_map_measured(
     if endmembers == [SCENARIO_ENDMEMBERS] and loaded is None and is_nc:
         head = read_user_dataset(p, "MEASURED", what="measurements", variables=())
         loaded = dataset_scenario(head, str(p))
+    if not is_nc and loaded is not None:  # the scenario's geometry: can it be the target?
+        _check_csv_scenario(p, loaded, light)
     data = read_reflectance_factors(p, loaded, bin_s, progress, light)
     direction, offset, origin = _directions(p, is_nc, data, loaded, bin_s)
-    mappable = np.all(np.isfinite(direction), axis=1) & np.any(np.isfinite(data.factor), axis=1)
-    if not np.any(mappable):
+    rmap = reflection_map(direction, data.factor, nside)
+    if not np.any(rmap.n_samples > 0):
         raise InputError(
-            f"no epoch has both a reflectance factor and a direction ({origin}): the map "
-            "would be empty; the directions are NaN where the factors are known",
+            f"no epoch has both a finite reflectance factor and a body-frame direction, so the "
+            f"map would be empty: measured {time_span_text(data.time_utc)}"
+            + (f"; the scenario's time window {_window(loaded)}" if loaded is not None else "")
+            + f"; directions from {origin}",
             source=str(p),
             field="MEASURED",
         )
-    rmap = reflection_map(direction, data.factor, nside)
     ds = _dataset(data, rmap, direction, origin)
     if offset is not None:
         rng = reflection_map(direction, offset, nside)
@@ -140,6 +144,21 @@ def reflection_map_measured(
             raise InputError("--endmembers scenario needs --scenario SCENARIO.yaml", field="-e")
         ds = _with_abundance(ds, data, rmap.pixel, endmembers, method, loaded)
     return ds
+
+
+def _window(loaded: LoadedScenario) -> str:
+    t = loaded.scenario.time
+    return f"{t.start:%Y-%m-%dT%H:%M:%S} .. {t.stop:%Y-%m-%dT%H:%M:%S} UTC"
+
+
+def _check_csv_scenario(p: Path, loaded: LoadedScenario, light: str | None) -> None:
+    """Refuse a scenario that cannot be the target of the CSV (its epochs with a rate)."""
+    from speclight.estimate.measured import read_measured
+    from speclight.estimate.scenario_match import check_scenario_sees
+
+    lc = read_measured(p)
+    chosen = light or ("sun" if loaded.scenario.illumination.sun else "laser")
+    check_scenario_sees(loaded, p, lc.time_utc[np.isfinite(lc.rate_per_s).any(axis=1)], chosen)
 
 
 def _directions(

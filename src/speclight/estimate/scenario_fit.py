@@ -31,8 +31,8 @@ from numpy.typing import NDArray
 from speclight import schema
 from speclight.errors import InputError
 from speclight.estimate.fit import F64, fit_scales, shot_noise_sigma
-from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve
-from speclight.estimate.measured_checks import no_usable_epochs
+from speclight.estimate.fit_bins import EpochBins
+from speclight.estimate.measured import MeasuredLightCurve
 from speclight.estimate.scenario_roughness import (
     fit_rough_gradient,
     fit_rough_slsqp,
@@ -162,9 +162,9 @@ def fit_scenario(
     free
         Parameters to fit: ``albedo``, ``roughness`` or both.
     bin_s
-        Average the measurements into bins of this many seconds first
-        (:func:`~speclight.estimate.bin_light_curve`); the model is evaluated at each bin's
-        mean epoch, and bins holding a flagged or penumbra epoch are left out.
+        Average the measurements into bins of this many seconds, shorter than their time
+        span, and the model over the same epochs and bands (:mod:`.fit_bins`: the model is
+        simulated at every measured epoch; the flagged ones are left out of both).
     progress
         Show render progress and the roughness iterations on a terminal.
     method
@@ -188,7 +188,9 @@ def fit_scenario(
         raise InputError("the scenario has no instrument bands to fit", field="instrument.bands")
     lc = measured.select_bands(names)
     if bin_s is not None:
-        lc = _binned(loaded, lc, bin_s)
+        from speclight.estimate.limits import check_bin_s
+
+        check_bin_s(bin_s, lc.time_utc)
     rough = rough_materials(loaded) if "roughness" in free else []
     if "roughness" in free and not rough:
         raise InputError(
@@ -214,19 +216,21 @@ def fit_scenario(
     sigma = shot if sigma is None else np.where(np.isfinite(sigma), sigma, shot)
     usable = (ds["flags"].values.astype(np.int64) & _SKIP) == 0
     m = np.where(usable[:, None], lc.rate_per_s, np.nan)
-    if not np.any(np.isfinite(m)):
-        raise no_usable_epochs(lc.time_utc.size, loaded.source, lc.source)
+    _check_some_usable(lc, m, ds, loaded)
+    bins = None
+    if bin_s is not None:
+        bins = EpochBins.of(lc.time_utc, bin_s, np.isfinite(m) & np.isfinite(sigma) & (sigma > 0))
     rho = _band_reflectance(loaded, ds)
     notes: list[str] = []
     if rough:
         if method == "gradient":
-            fit = fit_rough_gradient(base, first, m, sigma, rough, "albedo" in free, show)
+            fit = fit_rough_gradient(base, first, m, sigma, rough, "albedo" in free, show, bins)
             method_text = (
                 "gradient: least squares (trust region) over log roughness with the analytic "
                 "Jacobian (variable projection), weighted least squares for scales"
             )
         else:
-            fit = fit_rough_slsqp(base, first, m, sigma, rough, "albedo" in free, show, scan)
+            fit = fit_rough_slsqp(base, first, m, sigma, rough, "albedo" in free, show, scan, bins)
             method_text = (
                 "SLSQP over roughness (variable projection), weighted least squares for scales"
             )
@@ -242,12 +246,44 @@ def fit_scenario(
         model = np.where(usable[:, None], model, np.nan)
         if "albedo" not in free:
             raise InputError("--free must include albedo or roughness", field="--free")
-        scales = fit_scales(model, m, sigma)
+        if bins is not None:
+            model = bins.mean(model)
+        m_fit, s_fit = (m, sigma) if bins is None else (bins.mean(m), bins.sigma(sigma))
+        scales = fit_scales(model, m_fit, s_fit)
         roughness, extra = {}, {}
         method_text = "weighted least squares (closed form; linear in albedo)"
+    if bins is not None:
+        m = bins.mean(m)
+        lc = replace(lc, time_utc=bins.time_utc)
+        method_text += f"; measurements and model averaged over the same {bin_s:g} s bins"
     notes += _scale_problems(names, scales.scale, scales.scale_std, scales.n_used)
     fitted = model * scales.scale[None, :]
     return _result(lc, names, rho, scales, roughness, m, fitted, method_text, notes, extra)
+
+
+def _check_some_usable(lc: MeasuredLightCurve, m: F64, ds: Any, loaded: LoadedScenario) -> None:
+    """Refuse measurements of which no entry can be fitted: none finite at an epoch where the
+    scenario sees the target lit (the flags of ``ds`` say why not)."""
+    if np.isfinite(m).any():
+        return
+    from speclight.estimate.limits import time_span_text
+
+    flags = ds["flags"].values.astype(np.int64)
+    counts = ", ".join(
+        f"{name} at {int(np.count_nonzero(flags & bit))}"
+        for bit, name in schema.FLAG_MEANINGS.items()
+        if bit & _SKIP and np.any(flags & bit)
+    )
+    t = loaded.scenario.time
+    raise InputError(
+        f"no measured rate can be fitted: none of the epochs {time_span_text(lc.time_utc)} "
+        "has a finite rate where the scenario sees its target lit (flagged: "
+        f"{counts or 'none; no rate is finite'}); the scenario's time window is "
+        f"{t.start:%Y-%m-%dT%H:%M:%S} .. {t.stop:%Y-%m-%dT%H:%M:%S} UTC: give the "
+        "scenario of this target, site and night",
+        source=lc.source,
+        field="MEASURED",
+    )
 
 
 def _scale_problems(names: list[str], scale: F64, std: F64, n_used: NDArray) -> list[str]:
@@ -260,21 +296,6 @@ def _scale_problems(names: list[str], scale: F64, std: F64, n_used: NDArray) -> 
         elif scale[j] < 0:
             out.append(f"albedo of band '{name}' came out negative ({scale[j]:.3g} x start)")
     return out
-
-
-def _binned(loaded: LoadedScenario, lc: MeasuredLightCurve, bin_s: float) -> MeasuredLightCurve:
-    """``lc`` averaged into ``bin_s`` bins, without the bins that hold an epoch the model
-    cannot represent by one epoch: flagged (shadow, below the horizon...) or in penumbra, where
-    the light changes too fast for the bin's mean epoch to stand for it."""
-    from speclight.simulate.geometry_stage import scenario_geometry
-
-    binned = bin_light_curve(lc, bin_s)
-    flags = scenario_geometry(loaded, lc.time_utc).flags.astype(np.int64)
-    bad = ((flags & (_SKIP | schema.FLAG_PENUMBRA)) != 0).astype(float)[:, None]
-    marker = replace(lc, band_names=["flagged"], rate_per_s=bad, sigma_per_s=None)
-    keep = bin_light_curve(marker, bin_s).rate_per_s[:, 0] == 0
-    rate = np.where(keep[:, None], binned.rate_per_s, np.nan)
-    return replace(binned, rate_per_s=rate)
 
 
 def _band_reflectance(loaded: LoadedScenario, ds: Any) -> F64:

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.estimate.fit import F64
+from speclight.estimate.fit_bins import EpochBins
 from speclight.estimate.roughness_fit import PROFILE_SIGMAS, fit_roughness
 from speclight.scenario import LoadedScenario
 from speclight.scenario.overrides import replace_fields
@@ -37,12 +38,15 @@ def fit_rough_slsqp(
     fit_scale: bool,
     show: bool,
     scan: bool = True,
+    bins: EpochBins | None = None,
 ) -> Any:
+    """SLSQP over the roughness (:mod:`.roughness_fit`) of the measurements ``m`` (N, B) and
+    ``sigma``, simulated at their epochs; ``bins``: both averaged over them (:mod:`.fit_bins`)."""
     from speclight.simulate import simulate
 
     usable, start = _usable_and_start(base, m, rough)
 
-    def model(alpha: F64) -> F64:
+    def per_epoch(alpha: F64) -> F64:
         run = simulate(
             _with_roughness(base, dict(zip(rough, alpha, strict=True))),
             progress=show,
@@ -51,17 +55,22 @@ def fit_rough_slsqp(
         c = run.dataset["count_rate"].transpose("time", "band").values.astype(float)
         return np.where(usable[:, None], c, np.nan)
 
+    def model(alpha: F64) -> F64:
+        return per_epoch(alpha) if bins is None else bins.mean(per_epoch(alpha))
+
     on_iteration = _printer(rough, "iteration") if show else None
     c0 = first.dataset["count_rate"].transpose("time", "band").values.astype(float)
+    c0 = np.where(usable[:, None], c0, np.nan)
+    m_fit, s_fit = (m, sigma) if bins is None else (bins.mean(m), bins.sigma(sigma))
     return fit_roughness(
         model,
-        m,
-        sigma,
+        m_fit,
+        s_fit,
         start,
         ROUGHNESS_BOUNDS,
         fit_scale=fit_scale,
         on_iteration=on_iteration,
-        start_model=np.where(usable[:, None], c0, np.nan),
+        start_model=c0 if bins is None else bins.mean(c0),
         scan=scan,
     )
 
@@ -74,15 +83,25 @@ def fit_rough_gradient(
     rough: list[str],
     fit_scale: bool,
     show: bool,
+    bins: EpochBins | None = None,
 ) -> Any:
+    """The trust-region fit with analytic derivatives (:mod:`.gradient_fit`) of ``m`` (N, B)
+    and ``sigma``; ``bins``: rates, derivatives and measurements averaged over them."""
     from speclight.estimate.gradient_fit import fit_roughness_gradient
     from speclight.estimate.roughness_gradient import RoughnessRates
 
     usable, start = _usable_and_start(base, m, rough)
     rates = RoughnessRates(base, first.geometry, rough, usable)
+
+    def binned(alpha: F64) -> tuple[F64, F64]:
+        c, dc = rates(alpha)
+        assert bins is not None
+        return bins.mean(c), bins.mean(dc, axis=1)
+
+    m_fit, s_fit = (m, sigma) if bins is None else (bins.mean(m), bins.sigma(sigma))
     return fit_roughness_gradient(
-        rates, m, sigma, start, ROUGHNESS_BOUNDS, fit_scale=fit_scale,
-        on_iteration=_printer(rough, "evaluation") if show else None,
+        rates if bins is None else binned, m_fit, s_fit, start, ROUGHNESS_BOUNDS,
+        fit_scale=fit_scale, on_iteration=_printer(rough, "evaluation") if show else None,
     )  # fmt: skip
 
 

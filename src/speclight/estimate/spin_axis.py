@@ -52,6 +52,10 @@ F64 = NDArray[np.float64]
 DEFAULT_AXIS_CHUNK = 256
 #: A second minimum must lie this far from the best cell to count as the mirror [deg].
 MIRROR_SEP_DEG = 20.0
+#: Finest grid and phase step accepted [deg]: 36", far finer than the pixels of any map
+#: (0.23 deg at HEALPix nside 256); how large a search may be is estimated apart
+#: (:mod:`.spin_axis_limits`).
+MIN_STEP_DEG = 0.01
 
 
 @dataclass
@@ -73,14 +77,41 @@ class SpinAxisResult:
     refined_period_s: float = float("nan")  # the period of ``refined`` [s]
     refine_n_misfit: int = 0  # misfit evaluations of the refinement (all starts)
     refine_n_gradient: int = 0  # analytic gradient (Jacobian) evaluations
+    #: what became of the refinement, in words ("" where it ended below the grid's best)
+    refine_note: str = ""
 
 
 def check_search_options(grid_deg: float, n_phases: int) -> None:
-    """Refuse a grid step outside (0, 90] deg or fewer than one phase."""
-    if not (np.isfinite(grid_deg) and 0 < grid_deg <= 90):
-        raise InputError(f"--grid-deg = {grid_deg} must be in (0, 90] [deg]", field="--grid-deg")
-    if int(n_phases) < 1:
-        raise InputError(f"--phases = {n_phases} must be >= 1", field="--phases")
+    """Refuse a grid or phase step outside [MIN_STEP_DEG, 90] deg (how large a search
+    may be: :func:`.spin_axis_limits.check_search_cost`)."""
+    if not (np.isfinite(grid_deg) and MIN_STEP_DEG <= grid_deg <= 90):
+        raise InputError(
+            f"grid_deg = {grid_deg} must be in [{MIN_STEP_DEG:g}, 90] [deg] (no map resolves "
+            "a finer step)",
+            field="grid_deg",
+        )
+    if not 1 <= int(n_phases) <= round(360 / MIN_STEP_DEG):
+        raise InputError(
+            f"n_phases = {n_phases} must be 1..{round(360 / MIN_STEP_DEG)} (a phase step of at "
+            f"least {MIN_STEP_DEG:g} deg)",
+            field="n_phases",
+        )
+
+
+def check_measured_curves(y: F64, band_names: list[str]) -> None:
+    """Refuse a band whose measured curve (T, B) cannot be divided by its mean: a mean that
+    is not > 0 (all zero, negative or no light), or no finite value at all."""
+    with np.errstate(invalid="ignore"):
+        mean = np.mean(y, axis=0)
+    bad = [j for j in range(y.shape[1]) if not mean[j] > 0 or not np.isfinite(mean[j])]
+    if bad:
+        shown = ", ".join(f"'{band_names[j]}' ({mean[j]:.3g})" for j in bad)
+        raise InputError(
+            f"the measured curve of band(s) {shown} has a mean over the {y.shape[0]} usable "
+            "epochs that is not > 0: it cannot be divided by its mean (all zero, negative "
+            "or no light in that band); leave it out: bands = the others",
+            field="y",
+        )
 
 
 def radec_grid(grid_deg: float) -> tuple[F64, F64]:
@@ -208,6 +239,7 @@ def spin_axis_search(
         )
     geo = EpochGeometry(geo.sun_gcrs[ok], geo.observer_gcrs[ok], geo.t_s[ok], geo.period_s)
     y = np.asarray(y, dtype=float)[ok]
+    check_measured_curves(y, band_names)
     ranging = ranging.select(ok) if ranging is not None else None
     ra, dec = radec_grid(grid_deg)
     flat, e_r = grid_terms(sfm, geo, y, ra, dec, chunk, progress, ranging)
@@ -216,6 +248,14 @@ def spin_axis_search(
 
         ranging = resolve_weight(ranging, flat, e_r)
         flat = flat + float(ranging.weight or 0.0) * e_r
+    if not np.any(np.isfinite(flat)):
+        raise InputError(
+            f"no candidate of the grid has a finite misfit: at the {int(ok.sum())} measured "
+            "epochs the map predicts no light (a band's mean rate is 0) in some band for "
+            "every spin axis and phase; check that the map is of this target, with these "
+            "bands, and covers the pass's phase angles",
+            field="bmap",
+        )
     best_k = np.argmin(flat, axis=1)
     phase = np.arange(sfm.n_phases) * 360.0 / sfm.n_phases
     error = flat.min(axis=1).reshape(dec.size, ra.size)
@@ -233,6 +273,8 @@ def spin_axis_search(
         mirror = (float(r_f[i]), float(d_f[i]), float(p_f[i]), float(e_f[i]))
     refined = nan4
     tries = []
+    note = "not refined (the refinement was turned off): refined_* is NaN"
+    period_s = float("nan")
     if do_refine:
         step = max(grid_deg, 360.0 / sfm.n_phases) / 2
         starts = [best] + ([mirror] if far.size else [])
@@ -242,7 +284,9 @@ def spin_axis_search(
             )
             for s in starts
         ]
-        refined = min(tries, key=lambda t: t.error).answer
+        refined, period_s, note = _refined_or_best(
+            tries, best, exact_misfit(bmap, geo, y, spin_body_axis, *best[:3], ranging), geo
+        )
     return SpinAxisResult(
         ra,
         dec,
@@ -256,7 +300,40 @@ def spin_axis_search(
         list(band_names),
         0.0 if ranging is None else float(ranging.weight or 0.0),
         refine_method,
-        min(tries, key=lambda t: t.error).period_s if tries else float("nan"),
+        period_s,
         sum(t.n_misfit for t in tries),
         sum(t.n_gradient for t in tries),
+        note,
     )
+
+
+def _refined_or_best(
+    tries: list, best: tuple[float, float, float, float], best_exact: float, geo: EpochGeometry
+) -> tuple[tuple[float, float, float, float], float, str]:
+    """The best finite refinement (answer, period [s], "") of ``tries``
+    (:class:`.spin_axis_refine.Refined`); the grid's best cell with its misfit under the
+    map's own interpolation, the period given and the reason, where no refinement ended
+    finite or none below that misfit."""
+    finite = [t for t in tries if np.all(np.isfinite(t.answer)) and np.isfinite(t.period_s)]
+    exact = float(best_exact) if np.isfinite(best_exact) else best[3]
+    fallback = (best[0], best[1], best[2], exact)
+    if not finite:
+        return (
+            fallback,
+            geo.period_s,
+            (
+                "the refinement ended at no finite misfit from any start; refined_* is the "
+                "grid's best cell"
+            ),
+        )
+    chosen = min(finite, key=lambda t: t.error)
+    if np.isfinite(best_exact) and chosen.error > best_exact:
+        return (
+            fallback,
+            geo.period_s,
+            (
+                f"the refinement ended at a misfit {chosen.error:.4g} above the grid's best "
+                f"cell's {best_exact:.4g}; refined_* is that cell"
+            ),
+        )
+    return chosen.answer, chosen.period_s, ""

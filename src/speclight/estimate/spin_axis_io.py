@@ -48,6 +48,8 @@ from speclight.estimate.spin_axis_ranging import (
 from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
+#: Shortest rotation period accepted [s] (:func:`_spin_model`).
+MIN_PERIOD_S = 1e-3
 
 
 @dataclasses.dataclass
@@ -124,12 +126,17 @@ def _spin_model(loaded: LoadedScenario, period_s: float | None) -> tuple[float, 
             raise InputError(
                 f"no rotation period: the scenario's attitude is "
                 f"'{att.model if att is not None else 'not given'}', not 'spin'; "
-                "give --period-s (e.g. from speclight period)",
-                field="--period-s",
+                "give period_s (e.g. from speclight period)",
+                field="period_s",
             )
         period_s = spin.period_s
-    if not (np.isfinite(period_s) and period_s > 0):
-        raise InputError(f"--period-s = {period_s} must be a number > 0 [s]", field="--period-s")
+    if not (np.isfinite(period_s) and period_s >= MIN_PERIOD_S):
+        raise InputError(
+            f"period_s = {period_s} must be a number >= {MIN_PERIOD_S:g} [s] (a thousand "
+            "turns per second: no satellite spins faster, and the rotation phase of shorter "
+            "periods is lost to rounding over a pass)",
+            field="period_s",
+        )
     axis = list(spin.spin_body_axis) if spin is not None else [0.0, 0.0, 1.0]
     return float(period_s), [float(v) for v in axis], spin
 
@@ -152,6 +159,9 @@ def spin_axis_measured(
 ) -> SpinAxisRun:
     """Search the spin axis of a measured pass against a reflectivity map (module doc);
     ``refine_method`` and ``period_bound`` (a free period): :func:`.spin_axis_search`."""
+    from speclight.estimate.measured import read_measured
+    from speclight.estimate.scenario_match import check_scenario_sees
+    from speclight.estimate.spin_axis_limits import check_search_cost
     from speclight.estimate.spin_axis_refine import check_refine_options
     from speclight.estimate.unmix_inputs import read_reflectance_factors
     from speclight.render.map_lookup import check_map_matches
@@ -170,9 +180,16 @@ def spin_axis_measured(
         if b not in names:
             raise InputError(
                 f"band '{b}' is not a band of the scenario and map ({', '.join(names)})",
-                field="--bands",
+                field="bands",
             )
     is_csv = Path(measured).suffix.lower() not in (".nc", ".nc4", ".netcdf", ".h5")
+    if is_csv:  # before the CSV's rates are turned into factors with the scenario's geometry
+        lc = read_measured(measured)
+        sun = loaded.scenario.illumination.sun
+        check_scenario_sees(
+            loaded, measured, lc.time_utc[np.isfinite(lc.rate_per_s).any(axis=1)],
+            light or ("sun" if sun else "laser"),
+        )  # fmt: skip
     rf = read_reflectance_factors(
         measured, _with_map_render(loaded, map_path) if is_csv else loaded, light=light
     )
@@ -183,6 +200,8 @@ def spin_axis_measured(
         )
     cols = [names.index(b) for b in chosen]
     y = rf.factor[:, cols]
+    if not is_csv:
+        check_scenario_sees(loaded, measured, rf.time_utc[np.any(np.isfinite(y), 1)], rf.light)
     geo = scenario_geometry(loaded, rf.time_utc)
     epochs = inertial_epochs(geo, period)
     lit = geo.sunlit_fraction > 0 if rf.light == "sun" else np.ones(y.shape[0], dtype=bool)
@@ -209,6 +228,11 @@ def spin_axis_measured(
     else:
         rates = bmap.intensity_W_sr_nm[..., cols]
         sub = dataclasses.replace(bmap, intensity_W_sr_nm=np.ascontiguousarray(rates))
+    header = sub.header
+    check_search_cost(
+        header.nside, header.phase_angle_deg.size, header.roll_deg.size, grid_deg, n_phases,
+        y.shape[0], len(cols), ranging=ranged and laser is not None and offsets is not None,
+    )  # fmt: skip
     ranging = None
     if ranged and laser is not None and offsets is not None:
         from speclight.estimate.spin_axis_ranging import RangingTerm
@@ -307,6 +331,12 @@ def axis_dataset(run: SpinAxisRun, map_path: str, scenario_source: str) -> xr.Da
     refined = bool(np.isfinite(r.refined[0]))
     attrs.update(
         refine_method=r.refine_method if refined else "none",
+        refine_note=r.refine_note or "refined from the grid's best cell (and the mirror's)",
+        mirror_note="the lowest local minimum farther than mirror_min_separation_deg from the "
+        "best cell"
+        if np.isfinite(r.mirror[0])
+        else "no local minimum of the misfit farther than mirror_min_separation_deg from the "
+        "best cell: mirror_* is NaN",
         refine_misfit_evaluations=r.refine_n_misfit,
         refine_gradient_evaluations=r.refine_n_gradient,
         period_free=int(run.period_bound is not None),

@@ -44,6 +44,9 @@ from speclight.render.map_lookup import ReflectivityMap, read_header
 
 F64 = NDArray[np.float64]
 FIELD = "--map"
+#: Largest ranging weight accepted: the intensity term, about 1e-3..1, would then count for
+#: less than 1e-6 of the misfit.
+MAX_WEIGHT = 1e6
 
 
 def laser_kernel(response: F64, wavelength_nm: F64, source_W_m2_nm: F64 | None) -> F64:
@@ -181,14 +184,17 @@ def check_ranging_weight(weight: float | None, offsets: F64 | None) -> float | N
     none was given, 0 where there are none."""
     if weight is None:
         return None if offsets is not None else 0.0
-    if not (np.isfinite(weight) and weight >= 0):
+    if not (np.isfinite(weight) and 0 <= weight <= MAX_WEIGHT):
         raise InputError(
-            f"--ranging-weight = {weight} must be a number >= 0", field="--ranging-weight"
+            f"ranging_weight = {weight} must be a number from 0 to {MAX_WEIGHT:g} (a weight "
+            "of the ranging term against the intensity term; beyond it the intensity no "
+            "longer counts, and the sum overflows)",
+            field="ranging_weight",
         )
     if weight > 0 and offsets is None:
         raise InputError(
-            f"--ranging-weight = {weight} but MEASURED has no range_offset(time, band) (a "
+            f"ranging_weight = {weight} but MEASURED has no range_offset(time, band) (a "
             "simulate NetCDF of a pass with lasers has it; a CSV never)",
-            field="--ranging-weight",
+            field="ranging_weight",
         )
     return float(weight)

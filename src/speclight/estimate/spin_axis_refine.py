@@ -70,12 +70,13 @@ def check_refine_options(method: str, period_bound: float | None) -> None:
     """Refuse an unknown method or a period bound outside (0, 0.5)."""
     if method not in REFINE_METHODS:
         raise InputError(
-            f"--refine = {method!r}; accepted: {', '.join(REFINE_METHODS)}", field="--refine"
+            f"refine_method = {method!r}; accepted: {', '.join(REFINE_METHODS)}",
+            field="refine_method",
         )
     if period_bound is not None and not (np.isfinite(period_bound) and 0 < period_bound < 0.5):
         raise InputError(
-            f"--period-bound = {period_bound} must be in (0, 0.5) (a fraction of the period)",
-            field="--period-bound",
+            f"period_bound = {period_bound} must be in (0, 0.5) (a fraction of the period)",
+            field="period_bound",
         )
 
 

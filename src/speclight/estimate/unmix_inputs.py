@@ -34,6 +34,7 @@ import xarray as xr
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
+from speclight.estimate.limits import check_bin_s
 from speclight.estimate.measured import (
     NETCDF_VARIABLES,
     MeasuredLightCurve,
@@ -142,7 +143,8 @@ def read_reflectance_factors(
         scenario the dataset was simulated from, its ``scenario_yaml``).
     bin_s
         Average the epochs into bins of this many seconds (rates for a CSV, factors for a
-        NetCDF), or None.
+        NetCDF), from 1 ns to less than the epochs' span
+        (:func:`speclight.estimate.limits.check_bin_s`), or None.
     progress
         Show the simulation's progress bar (CSV input).
     light
@@ -210,6 +212,7 @@ def read_reflectance_factors(
             labels = [str(m) for m in ds["material_reflectance"].values]
     time = checked.time_utc
     if bin_s is not None:
+        check_bin_s(bin_s, time)
         t0 = time
         time, factor = bin_factors(t0, factor, bin_s, src)
         _, source = bin_factors(t0, source, bin_s, src)
@@ -247,6 +250,7 @@ def _factors_from_rates(
     names = [b.name for b in loaded.scenario.instrument.bands]
     lc = lc.select_bands(names)
     if bin_s is not None:
+        check_bin_s(bin_s, lc.time_utc)
         lc = bin_light_curve(lc, bin_s)
     ds = simulate(loaded, progress=progress, time_utc=lc.time_utc).dataset
     bands = dataset_band_responses(ds, loaded.source)
