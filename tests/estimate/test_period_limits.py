@@ -36,7 +36,8 @@ def _csv(path: Path, n: int = 240, period_s: float = 37.0, huge_at: int | None =
         for scale in (1e5, 5e4):
             rate = scale * 10 ** (-0.4 * mag[i])
             sigma = np.sqrt(rate)
-            value = 1e300 if i == huge_at and scale == 1e5 else rate + rng.normal(0, sigma)
+            value = 1e20 if i == huge_at and scale == 1e5 else rate + rng.normal(0, sigma)
+            sigma = np.sqrt(value) if i == huge_at and scale == 1e5 else sigma  # its shot noise
             cells += [f"{value:.6g}", f"{sigma * sigma_scale:.6g}"]
         rows.append(",".join(cells))
     path.write_text("\n".join(rows) + "\n")
@@ -73,6 +74,7 @@ def test_options_that_cannot_work_name_the_parameter(tmp_path: Path, kwargs, fie
 
 
 def test_broken_points_are_refused_with_their_epoch(tmp_path: Path) -> None:
+    # 1e20: below the reader's 1e30 s-1 ceiling, 1e15 times the band's median
     with pytest.raises(InputError, match=r"band 'B1' at 2020-02-29T21:16:07.*times the band's"):
         estimate_period(_csv(tmp_path / "huge.csv", huge_at=7))
     # sigmas of ~1e-12 of the rate (the shot noise sqrt(1e5) times 1e-12 sqrt(1e5)): ~1e-12

@@ -198,7 +198,7 @@ def test_cli_refuses_what_cannot_be_searched(folder) -> None:
     _one_line_error(runner.invoke(app, [*base, *new, "--grid-deg", "0.01"]),
                     "--grid-deg = 0.01: the search of 36000 x 18000 axes")  # fmt: skip
     _one_line_error(runner.invoke(app, [*base, *new, "--period-s", "1e-9"]), "--period-s")
-    # a band of zero rates (a CSV of the pass): its curve cannot be divided by its mean
+    # a band of zero rates (a CSV of the pass): the reader refuses it (it measured nothing)
     with xr.open_dataset(measured, engine="h5netcdf") as sim:
         rate = sim["count_rate_measured"].transpose("time", "band").values
         bands = [str(b) for b in sim["band"].values]
@@ -211,7 +211,7 @@ def test_cli_refuses_what_cannot_be_searched(folder) -> None:
     (folder / "zero.csv").write_text("\n".join(rows) + "\n")
     zero = [base[0], str(scenario), str(folder / "zero.csv"), *base[3:]]
     _one_line_error(runner.invoke(app, [*zero, *new, "--grid-deg", "30", "--phases", "12"]),
-                    "MEASURED", f"'{bands[2]}' (0)")  # fmt: skip
+                    "MEASURED", f"band '{bands[2]}' has no rate above 0")  # fmt: skip
 
     # the scenario of another satellite (the calsphere's orbit) for the box-wing's pass
     def orbit(text: str) -> str:
