@@ -12,7 +12,7 @@ The sample budget is split in ``K`` passes with independent samples; their sprea
 standard error of the mean per bin. All passes of an epoch are sampled in one launch of
 Mitsuba's path integrator over rays and wavelengths drawn here (:mod:`.path_sampling`: the
 radiance of each sample goes to its bins, without a film), whatever the materials: plastic
-coats are the spectral BSDF of :mod:`.path_coat`. Measured lab BRDF tables are not
+coats are the spectral BSDF of :mod:`.bsdfs.path_coat`. Measured lab BRDF tables are not
 available in this mode; RGL ``.bsdf`` measured materials use Mitsuba's ``measured`` plugin
 (:mod:`.rgl`). A smooth mirror (``specular``, smooth plastic coat) lit by the directional
 (point) Sun reflects no light toward a given observer (a delta BSDF meets a delta light);
@@ -37,8 +37,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
+from speclight.render.bsdfs.path_plastic import group_bases, index_groups
 from speclight.render.camera import image_axes, primary_rays
-from speclight.render.path_plastic import group_bases, index_groups
 from speclight.render.path_sampling import FREEZE_MIN_LAUNCHES, PassSampler, launch_count
 from speclight.render.path_scene import build_scene, set_epoch
 from speclight.render.polarization import sky_axes
@@ -78,7 +78,7 @@ def render_path(
 
     ``solar_disk``: light the target with the finite solar disk instead of a point
     (directional) Sun, so that smooth mirrors and smooth plastic coats show their glint.
-    ``coat``: ``'spectral'`` (plastic coats as :mod:`.path_coat`, one launch per epoch) or
+    ``coat``: ``'spectral'`` (plastic coats as :mod:`.bsdfs.path_coat`, one launch per epoch) or
     ``'grouped'`` (the previous model: Mitsuba's plastic with one coat index per group of
     bins, one ``mi.render`` per group, epoch and pass; kept as a reference for the tests).
     Scalar variants (no Dr.Jit kernels to trace a Python BSDF or a sample loop into) always

@@ -29,7 +29,6 @@ from speclight.engine_packages import (
 )
 from speclight.errors import InputError
 from speclight.scenario.scenario_model import Scenario
-from speclight.target.rgl_file import is_rgl_path
 
 
 def needed_engines(scenario: Scenario) -> list[Need]:
@@ -56,9 +55,10 @@ def needed_engines(scenario: Scenario) -> list[Need]:
         if render.variant not in (None, "auto", "numpy"):
             needs.append(Need(MITSUBA, "render.variant", f"the Mitsuba variant {render.variant!r}"))
         for part, material in scenario.target.materials.items():
-            if material.bsdf == "measured" and is_rgl_path(material.brdf_table):
-                field = f"target.materials.{part}.brdf_table"
-                needs.append(Need(MITSUBA, field, f"the RGL file {material.brdf_table!r}"))
+            bsdf = material.model
+            for engine, key in bsdf.engines:
+                reason = f"bsdf '{bsdf.label}' with {key} {getattr(material, key)!r}"
+                needs.append(Need(ENGINES[engine], f"target.materials.{part}.{key}", reason))
     return needs
 
 

@@ -21,8 +21,15 @@ from pydantic import (
 
 from speclight.instrument.bands import MAX_GAUSSIAN_NM
 from speclight.scenario.sections_geometry import Strict, Vector3
+from speclight.target.bsdf_models import (
+    MAX_ROUGHNESS,
+    PARAMETERS,
+    BsdfModel,
+    BsdfName,
+    bsdf_model,
+    parameter_problems,
+)
 
-BsdfName = Literal["lambertian", "beckmann", "ggx", "plastic", "specular", "measured"]
 ConductorName = Literal["Al", "Ag", "Au"]
 DielectricName = Literal["SiO2", "Si", "GaAs", "Kapton"]
 #: Shipped reflectance tables (``data/materials``, :mod:`speclight.target.material_tables`).
@@ -129,7 +136,10 @@ class Material(Strict):
         "specular); for plastic the coat's dielectric",
     )
     roughness: float | None = Field(
-        default=None, gt=0, le=1, description="Microfacet alpha (beckmann, ggx; plastic coat)"
+        default=None,
+        gt=0,
+        le=MAX_ROUGHNESS,
+        description="Microfacet alpha (beckmann, ggx; plastic coat)",
     )
     diffuse_reflectance: Reflectance | None = Field(
         default=None, description="Diffuse base of a plastic/coated layer"
@@ -144,17 +154,29 @@ class Material(Strict):
     def _params(self) -> Material:
         if isinstance(self.reflectance, float) and not 0.0 <= self.reflectance <= 1.0:
             raise ValueError(f"reflectance = {self.reflectance} must lie in [0, 1]")
-        if self.bsdf in ("beckmann", "ggx") and self.roughness is None:
-            raise ValueError(f"bsdf '{self.bsdf}' needs roughness (microfacet alpha, 0 < a <= 1)")
-        if self.bsdf in ("lambertian", "specular", "measured") and self.roughness is not None:
-            raise ValueError(f"bsdf '{self.bsdf}' takes no roughness")
-        if self.bsdf == "plastic" and self.diffuse_reflectance is None:
-            raise ValueError("bsdf 'plastic' needs diffuse_reflectance (the base under the coat)")
-        if self.bsdf == "measured" and not self.brdf_table:
-            raise ValueError("bsdf 'measured' needs brdf_table: a shipped table name or a CSV file")
-        if self.bsdf != "measured" and self.brdf_table:
-            raise ValueError(f"brdf_table is only used by bsdf 'measured', not '{self.bsdf}'")
+        kind = _reflectance_kind(self.reflectance)
+        problems = parameter_problems(self.bsdf, self.parameters(), kind)
+        if problems:
+            raise ValueError(problems[0][1])
         return self
+
+    def parameters(self) -> dict[str, Any]:
+        """The model parameters given (:data:`speclight.target.bsdf_models.PARAMETERS`)."""
+        given = {name: getattr(self, name) for name in PARAMETERS}
+        given["brdf_table"] = self.brdf_table or None  # an empty name is none
+        return given
+
+    @property
+    def model(self) -> BsdfModel:
+        """The material's entry (its form) in the table of BSDF models."""
+        return bsdf_model(self.bsdf, self.parameters())
+
+
+def _reflectance_kind(value: Any) -> str:
+    """The :class:`~speclight.target.Reflectance` kind a validated reflectance becomes."""
+    if isinstance(value, Conductor | Dielectric):
+        return "conductor" if isinstance(value, Conductor) else "dielectric"
+    return "constant" if isinstance(value, float) else "table"
 
 
 _SHAPE_SIZES: dict[str, tuple[str, ...]] = {

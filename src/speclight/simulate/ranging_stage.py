@@ -44,6 +44,7 @@ from speclight.instrument.photometry import photon_kernel
 from speclight.orbit.timescale import time_from_utc
 from speclight.ranging import link, transmitter_geometry
 from speclight.ranging.bins import RANGE_BINS, range_bin_edges_m
+from speclight.render.bsdfs import material_bsdf
 from speclight.render.laser_returns import LaserLight, LaserReturnAccumulator, LaserReturns
 from speclight.render.path_scene import MAX_DEPTH as PATH_MAX_DEPTH
 from speclight.render.session import RenderSession
@@ -318,10 +319,7 @@ def laser_ranging(
     if (
         acc is not None
         and sc.render.mode == "path"
-        and any(
-            m.bsdf == "specular" or (m.bsdf == "plastic" and m.roughness is None)
-            for m in acc.target.materials
-        )
+        and any(material_bsdf(m).mirror_lobe() for m in acc.target.materials)
     ):
         notes.append(
             "laser ranging in render.mode 'path' does not follow the mirror reflection of "

@@ -14,7 +14,6 @@ from numpy.typing import NDArray
 
 from speclight import schema
 from speclight.constants import AU_M
-from speclight.errors import InputError
 from speclight.illumination import solar_irradiance_W_m2_nm
 from speclight.render.result import RenderImage
 from speclight.render.session import RenderSession
@@ -36,11 +35,10 @@ from speclight.target.articulation import (
     joint_angles_rad,
     read_angle_table,
 )
-from speclight.target.brdf_table import load_brdf_table
+from speclight.target.bsdf_models import bsdf_file_parameters
 from speclight.target.from_values import BUILTIN_SHAPES
 from speclight.target.material_tables import material_table_path
 from speclight.target.mesh_io import load_mesh
-from speclight.target.rgl_file import is_rgl_path
 
 F64 = NDArray[np.float64]
 
@@ -107,15 +105,13 @@ def _reflectance(loaded: LoadedScenario, spec: Any, field: str) -> Reflectance:
 
 
 def _material(loaded: LoadedScenario, name: str, m: MaterialModel) -> Material:
+    """A scenario material as a :class:`Material` (files named relative to the scenario)."""
     field = f"target.materials.{name}"
-    table = m.brdf_table
-    if table is not None and Path(table).suffix:  # a file, not a shipped table name
-        table = str(loaded.resolve(table))
-    if m.bsdf == "measured" and table is not None and not is_rgl_path(table):
-        try:  # read the lab table now (it is cached), not halfway through the run
-            load_brdf_table(table)
-        except InputError as exc:
-            raise InputError(exc.message, source=exc.source, field=f"{field}.brdf_table") from None
+    files = {
+        key: str(loaded.resolve(value)) if Path(value).suffix else value  # not a shipped name
+        for key in bsdf_file_parameters()
+        if (value := getattr(m, key))
+    }
     diffuse = m.diffuse_reflectance
     return Material(
         name=name,
@@ -125,7 +121,7 @@ def _material(loaded: LoadedScenario, name: str, m: MaterialModel) -> Material:
         diffuse_reflectance=None
         if diffuse is None
         else _reflectance(loaded, diffuse, f"{field}.diffuse_reflectance"),
-        brdf_table=table,
+        **files,
     )
 
 
