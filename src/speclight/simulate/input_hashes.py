@@ -27,8 +27,11 @@ from pydantic import BaseModel
 
 from speclight.orbit.iers_files import finals_path
 from speclight.scenario import LoadedScenario
+from speclight.target.bsdf_models import bsdf_file_parameters
 
-#: Scenario fields (by their last name) whose string values may name a file or folder.
+#: Scenario fields (by their last name) whose string values may name a file or folder: the
+#: material parameters that name a file come from the table of BSDF models
+#: (:func:`speclight.target.bsdf_models.bsdf_file_parameters`).
 FILE_FIELDS = frozenset(
     {
         "file",
@@ -39,10 +42,10 @@ FILE_FIELDS = frozenset(
         "spectrum_file",
         "table_file",
         "map_file",
-        "brdf_table",
         "detector_qe",
         "optics_transmission",
     }
+    | bsdf_file_parameters()
 )
 _CHUNK = 1 << 20
 

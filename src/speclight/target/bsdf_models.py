@@ -175,10 +175,10 @@ _FRESNEL = (
 )
 
 
-def _microfacet(distribution: str) -> BsdfModel:
+def _microfacet(distribution: str, label: str) -> BsdfModel:
     return BsdfModel(
         distribution,
-        f"rough surface: Cook-Torrance microfacets with {distribution} normals "
+        f"rough surface: Cook-Torrance microfacets with {label} normals "
         "(Walter et al. 2007, doi:10.2312/EGWR/EGSR07/195-206)",
         _FRESNEL,
         required=(ROUGHNESS,),
@@ -225,8 +225,8 @@ _MODELS = (
         channels="one: cos theta_i / pi x albedo(lambda)",
         examples=({"bsdf": "lambertian", "reflectance": 1.0},),
     ),
-    _microfacet("beckmann"),
-    _microfacet("ggx"),
+    _microfacet("beckmann", "Beckmann"),
+    _microfacet("ggx", "GGX"),
     BsdfModel(
         "plastic",
         "a diffuse base under a dielectric coat, smooth or Beckmann-rough (Weidlich & Wilkie "
