@@ -22,7 +22,8 @@ Interpolation: 10-point (degree 9) Lagrange in ITRF, as the format's authors rec
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -148,143 +149,87 @@ def read_cpf(path: str | Path) -> Cpf:
     """
     p = str(path)
     lines = read_user_text(path, "orbit.cpf_file", what="CPF file").split("\n")
-    head: dict[str, list[str]] = {}
-    times: list[np.datetime64] = []
-    pos: list[list[float]] = []
-    pos_lines: list[int] = []
-    vel: list[list[float]] = []
-    vel_times: list[np.datetime64] = []
-    version = 0
-    com: float | None = None
-    for lineno, raw in enumerate(lines, start=1):
-        line = raw.rstrip()
-        if not line.strip():
-            continue
-        rec = line[:2].upper()
-        tok = line.split()
-        try:
-            if rec == "H1":
-                if len(tok) < 3 or tok[1].upper() != "CPF":
-                    raise _err(
-                        p,
-                        lineno,
-                        line,
-                        "H1 record does not start 'H1 CPF'",
-                        "This is not an ILRS CPF file.",
-                    )
-                version = int(tok[2])
-                if version not in (1, 2):
-                    raise _err(
-                        p,
-                        lineno,
-                        line,
-                        f"format version {version} is not supported",
-                        "Accepted: CPF format versions 1 and 2.",
-                    )
-                need = 10 if version == 1 else 11
-                if len(tok) < need:
-                    raise _err(
-                        p,
-                        lineno,
-                        line,
-                        f"H1 has {len(tok)} fields, version {version} needs {need}",
-                        "Expected: H1 CPF version source yyyy mm dd hh sequence "
-                        + ("" if version == 1 else "sub-daily-sequence ")
-                        + "target",
-                    )
-                head["H1"] = tok
-            elif rec == "H2":
-                if len(tok) < 20:
-                    raise _err(
-                        p,
-                        lineno,
-                        line,
-                        f"H2 has {len(tok)} fields, need at least 20",
-                        "Expected: H2 cospar sic norad start(y m d h m s) end(y m d h m"
-                        " s) step tiv target-class reference-frame ...",
-                    )
-                head["H2"] = tok
-            elif rec == "H5":
-                head["H5"] = tok
-                com = float(tok[1]) if len(tok) > 1 else None
-            elif rec == "H9":
-                head["H9"] = tok
-            elif rec == "10":
-                if len(tok) != 8:
-                    raise _err(
-                        p,
-                        lineno,
-                        line,
-                        f"position record has {len(tok)} fields, need 8",
-                        "Expected: 10 direction MJD seconds-of-day leap-second x y z.",
-                    )
-                if int(tok[1]) != 0:
-                    continue
-                times.append(_record_time(lineno, line, p, tok[2], tok[3]))
-                pos.append([float(v) for v in tok[5:8]])
-                pos_lines.append(lineno)
-            elif rec == "20":
-                if len(tok) != 5:
-                    raise _err(
-                        p,
-                        lineno,
-                        line,
-                        f"velocity record has {len(tok)} fields, need 5",
-                        "Expected: 20 direction vx vy vz.",
-                    )
-                if int(tok[1]) != 0:
-                    continue
-                vel.append([float(v) for v in tok[2:5]])
-                vel_times.append(times[-1] if times else MJD0)
-            elif rec == "99":
-                break
-            elif rec not in _SKIPPED:
-                raise _err(
-                    p,
-                    lineno,
-                    line,
-                    f"unknown record type {rec!r}",
-                    "CPF records are H1-H9, 00, 10, 20, 30, 40, 50, 60, 70, 99.",
-                )
-        except ValueError as exc:
-            if isinstance(exc, InputError):
-                raise
-            raise _err(
-                p,
-                lineno,
-                line,
-                f"record {rec} has an unreadable field ({exc})",
-                "Check the record against the CPF format description.",
-            ) from exc
-    for rec in ("H1", "H2"):
-        if rec not in head:
-            raise InputError(f"missing {rec} header record; is this an ILRS CPF file?", source=p)
-    r_arr = np.array(pos, dtype=np.float64).reshape(-1, 3)
+    rec = _read_records(p, lines)
+    r_arr = np.array(rec.pos, dtype=np.float64).reshape(-1, 3)
     usable = plausible_position(r_arr)
     if np.count_nonzero(usable) < 2:
-        raise InputError(_too_few_records(r_arr, usable, pos_lines), source=p)
-    h1, h2 = head["H1"], head["H2"]
-    lineno_h2 = next(i for i, ln in enumerate(lines, 1) if ln[:2].upper() == "H2")
-    try:
-        start, end = _datetime(h2[4:10]), _datetime(h2[10:16])
-        step_s, frame = int(h2[16]), int(h2[19])
-    except ValueError as exc:
-        raise _err(
-            p,
-            lineno_h2,
-            lines[lineno_h2 - 1],
-            f"H2 has an unreadable field ({exc})",
-            "Expected integers for the dates, step and reference frame.",
-        ) from exc
-    if frame != 0:
-        raise _err(
-            p,
-            lineno_h2,
-            lines[lineno_h2 - 1],
-            f"reference frame {frame} ({FRAME_NAMES.get(frame, 'unknown')}) is not supported",
-            "Only frame 0 (geocentric true body-fixed, ITRF), the ILRS default for "
-            "Earth satellites, is read; obtain the frame-0 prediction.",
-        )
+        raise InputError(_too_few_records(r_arr, usable, rec.pos_lines), source=p)
+    h1, h2 = rec.head["H1"], rec.head["H2"]
+    start, end, step_s, frame = _h2_span(p, lines, h2)
+    t_arr = _increasing_times(p, rec.times)
+    return Cpf(
+        path=p,
+        version=rec.version,
+        source=h1[3],
+        target_name=h1[9] if rec.version == 1 else h1[10],
+        cospar_id=h2[1],
+        sic=h2[2],
+        norad_id=h2[3],
+        start_utc=start,
+        end_utc=end,
+        step_s=step_s,
+        reference_frame=frame,
+        com_offset_m=rec.com,
+        times_utc=t_arr[usable],
+        r_itrf_m=r_arr[usable],
+        v_itrf_m_s=_velocities(rec, usable),
+        unusable_lines=tuple(ln for ln, ok in zip(rec.pos_lines, usable, strict=True) if not ok),
+    )
+
+
+@dataclass
+class _Records:
+    """What the records of a CPF file hold, as read (:func:`_read_records`)."""
+
+    head: dict[str, list[str]] = field(default_factory=dict)
+    times: list[np.datetime64] = field(default_factory=list)
+    pos: list[list[float]] = field(default_factory=list)
+    pos_lines: list[int] = field(default_factory=list)
+    vel: list[list[float]] = field(default_factory=list)
+    vel_times: list[np.datetime64] = field(default_factory=list)
+    version: int = 0
+    com: float | None = None
+
+
+#: ``(path, line number, line, its fields, records so far)`` -> None, per record type.
+_Reader = Callable[[str, int, str, list[str], _Records], None]
+
+
+def _read_records(p: str, lines: list[str]) -> _Records:
+    """Every record up to 99 (end of file), each read by its type's reader."""
+    rec = _Records()
+    for lineno, raw in enumerate(lines, start=1):
+        line = raw.rstrip()
+        kind = line[:2].upper()
+        if kind == "99":
+            break
+        if not line.strip():
+            continue
+        if kind in _SKIPPED:
+            continue
+        reader = _READERS.get(kind)
+        if reader is None:
+            raise _err(
+                p, lineno, line, f"unknown record type {kind!r}",
+                "CPF records are H1-H9, 00, 10, 20, 30, 40, 50, 60, 70, 99.",
+            )  # fmt: skip
+        try:
+            reader(p, lineno, line, line.split(), rec)
+        except InputError:
+            raise
+        except ValueError as exc:
+            raise _err(
+                p, lineno, line, f"record {kind} has an unreadable field ({exc})",
+                "Check the record against the CPF format description.",
+            ) from exc  # fmt: skip
+    for name in ("H1", "H2"):
+        if name not in rec.head:
+            raise InputError(f"missing {name} header record; is this an ILRS CPF file?", source=p)
+    return rec
+
+
+def _increasing_times(p: str, times: list[np.datetime64]) -> NDArray[np.datetime64]:
+    """The position records' epochs, checked to increase strictly."""
     t_arr = np.array(times, dtype="datetime64[ns]")
     if np.any(np.diff(t_arr) <= np.timedelta64(0, "ns")):
         bad = int(np.argmax(np.diff(t_arr) <= np.timedelta64(0, "ns"))) + 1
@@ -293,27 +238,119 @@ def read_cpf(path: str | Path) -> Cpf:
             "records must be in strictly increasing time order",
             source=p,
         )
-    v_arr = None
-    if vel and len(vel) == len(times) and vel_times == times:
-        v_arr = np.array(vel, dtype=np.float64)[usable]
-    return Cpf(
-        path=p,
-        version=version,
-        source=h1[3],
-        target_name=h1[9] if version == 1 else h1[10],
-        cospar_id=h2[1],
-        sic=h2[2],
-        norad_id=h2[3],
-        start_utc=start,
-        end_utc=end,
-        step_s=step_s,
-        reference_frame=frame,
-        com_offset_m=com,
-        times_utc=t_arr[usable],
-        r_itrf_m=r_arr[usable],
-        v_itrf_m_s=v_arr,
-        unusable_lines=tuple(ln for ln, ok in zip(pos_lines, usable, strict=True) if not ok),
-    )
+    return t_arr
+
+
+def _velocities(rec: _Records, usable: NDArray[np.bool_]) -> NDArray[np.float64] | None:
+    """The usable positions' velocities (records 20), when every position has one."""
+    if rec.vel and len(rec.vel) == len(rec.times) and rec.vel_times == rec.times:
+        return np.array(rec.vel, dtype=np.float64)[usable]
+    return None
+
+
+def _h1(p: str, lineno: int, line: str, tok: list[str], rec: _Records) -> None:
+    """H1: format version, source, target name."""
+    if len(tok) < 3 or tok[1].upper() != "CPF":
+        raise _err(
+            p, lineno, line, "H1 record does not start 'H1 CPF'", "This is not an ILRS CPF file."
+        )
+    rec.version = int(tok[2])
+    if rec.version not in (1, 2):
+        raise _err(
+            p, lineno, line, f"format version {rec.version} is not supported",
+            "Accepted: CPF format versions 1 and 2.",
+        )  # fmt: skip
+    need = 10 if rec.version == 1 else 11
+    if len(tok) < need:
+        raise _err(
+            p, lineno, line, f"H1 has {len(tok)} fields, version {rec.version} needs {need}",
+            "Expected: H1 CPF version source yyyy mm dd hh sequence "
+            + ("" if rec.version == 1 else "sub-daily-sequence ")
+            + "target",
+        )  # fmt: skip
+    rec.head["H1"] = tok
+
+
+def _h2(p: str, lineno: int, line: str, tok: list[str], rec: _Records) -> None:
+    """H2: ids, span, step, reference frame (read by :func:`_h2_span`)."""
+    if len(tok) < 20:
+        raise _err(
+            p, lineno, line, f"H2 has {len(tok)} fields, need at least 20",
+            "Expected: H2 cospar sic norad start(y m d h m s) end(y m d h m"
+            " s) step tiv target-class reference-frame ...",
+        )  # fmt: skip
+    rec.head["H2"] = tok
+
+
+def _h5(p: str, lineno: int, line: str, tok: list[str], rec: _Records) -> None:
+    """H5: centre-of-mass offset."""
+    rec.head["H5"] = tok
+    rec.com = float(tok[1]) if len(tok) > 1 else None
+
+
+def _h9(p: str, lineno: int, line: str, tok: list[str], rec: _Records) -> None:
+    """H9: end of header."""
+    rec.head["H9"] = tok
+
+
+def _position(p: str, lineno: int, line: str, tok: list[str], rec: _Records) -> None:
+    """10: a position (common-epoch records only; direction flags 1, 2 are skipped)."""
+    if len(tok) != 8:
+        raise _err(
+            p, lineno, line, f"position record has {len(tok)} fields, need 8",
+            "Expected: 10 direction MJD seconds-of-day leap-second x y z.",
+        )  # fmt: skip
+    if int(tok[1]) != 0:
+        return
+    rec.times.append(_record_time(lineno, line, p, tok[2], tok[3]))
+    rec.pos.append([float(v) for v in tok[5:8]])
+    rec.pos_lines.append(lineno)
+
+
+def _velocity(p: str, lineno: int, line: str, tok: list[str], rec: _Records) -> None:
+    """20: the velocity at the last position's epoch."""
+    if len(tok) != 5:
+        raise _err(
+            p, lineno, line, f"velocity record has {len(tok)} fields, need 5",
+            "Expected: 20 direction vx vy vz.",
+        )  # fmt: skip
+    if int(tok[1]) != 0:
+        return
+    rec.vel.append([float(v) for v in tok[2:5]])
+    rec.vel_times.append(rec.times[-1] if rec.times else MJD0)
+
+
+_READERS: dict[str, _Reader] = {
+    "H1": _h1,
+    "H2": _h2,
+    "H5": _h5,
+    "H9": _h9,
+    "10": _position,
+    "20": _velocity,
+}
+
+
+def _h2_span(
+    p: str, lines: list[str], h2: list[str]
+) -> tuple[np.datetime64, np.datetime64, int, int]:
+    """Start, end, step [s] and reference frame of the H2 record (frame 0 only)."""
+    lineno = next(i for i, ln in enumerate(lines, 1) if ln[:2].upper() == "H2")
+    try:
+        start, end = _datetime(h2[4:10]), _datetime(h2[10:16])
+        step_s, frame = int(h2[16]), int(h2[19])
+    except ValueError as exc:
+        raise _err(
+            p, lineno, lines[lineno - 1], f"H2 has an unreadable field ({exc})",
+            "Expected integers for the dates, step and reference frame.",
+        ) from exc  # fmt: skip
+    if frame != 0:
+        raise _err(
+            p, lineno, lines[lineno - 1],
+            f"reference frame {frame} ({FRAME_NAMES.get(frame, 'unknown')}) is not supported",
+            "Only frame 0 (geocentric true body-fixed, ITRF), the ILRS default for "
+            "Earth satellites, is read; obtain the frame-0 prediction.",
+        )  # fmt: skip
+    return start, end, step_s, frame
 
 
 def plausible_position(r_m: NDArray[np.float64]) -> NDArray[np.bool_]:
