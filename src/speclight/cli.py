@@ -223,7 +223,7 @@ def plot(
         typer.Option(
             "--kind",
             help="Figures to write: overview, chain, images, ranging (repeatable; default: all "
-            "that the data can fill; the overview is always written).",
+            "that the data can fill). OUTPUT is the first of them, the others go beside it.",
         ),
     ] = None,
     magnitude: Annotated[
@@ -237,7 +237,8 @@ def plot(
     force: Annotated[bool, typer.Option("--force", help="Overwrite existing figures.")] = False,
 ) -> None:
     """Plot a dataset: light curves, spectrogram and geometry in OUTPUT; the one-epoch chain,
-    images and ranging figures beside it (OUTPUT-chain.png, ...).
+    images and ranging figures beside it (OUTPUT-chain.png, ...). With --kind, OUTPUT holds
+    the first figure asked for: `--kind chain -o chain.png` writes chain.png alone.
 
     OUTPUT is claimed as `simulate` claims its output; none of the figures may be DATASET.
     """
@@ -250,7 +251,7 @@ def plot(
         chosen: int | str | None = epoch
         if epoch is not None and epoch.strip().lstrip("-").isdigit():
             chosen = int(epoch)
-        kinds = None if not kind else ["overview", *[k for k in kind if k != "overview"]]
+        kinds = kind or None
         with OutputClaim(output, force=force, inputs={"dataset": dataset}) as claim:
             for figure in figure_paths(claim.path, KINDS).values():
                 if figure.exists() and figure.samefile(dataset):
@@ -710,6 +711,12 @@ def reflectivity_map(
             announce=True,
         )
         _raise_if_signalled()
+        if result.damaged:
+            typer.echo(
+                f"notice: {len(result.damaged)} chunk(s) marked done did not read back "
+                f"(chunk {result.damaged[0]}: a file cut short or deleted): rendered again",
+                err=True,
+            )
         typer.echo(
             f"{result.n_directions} directions in {result.n_chunks} chunks: rendered "
             f"{result.rendered}, skipped {result.skipped} done before, in {result.seconds:.1f} s"
@@ -1025,7 +1032,8 @@ def sweep(
     on a Dask cluster and store every case's light curves in one Zarr store with a `case`
     dimension (docs/sweep.md). Every case is validated before any runs. Rerunning the same
     command resumes an interrupted sweep (done cases are skipped, failed ones retried); a
-    failed case is recorded in error(case) and the others go on.
+    failed case is recorded in error(case) and the others go on (a warning says how many;
+    exit code 0); exit code 1 when every case failed.
 
     Example: speclight sweep docs/examples/sweep-calsphere.yaml -o runs.zarr --workers 2
     """
@@ -1054,20 +1062,31 @@ def sweep(
             announce=not quiet,
         )
         _raise_if_signalled()
-        if quiet:
-            return
         last = result.first_case + result.n_cases - 1
-        typer.echo(
-            f"cases {result.first_case}..{last}: ran {result.ran}, skipped {result.skipped} "
-            f"done before, in {result.seconds:.1f} s"
-        )
-        if result.failed:
-            index, message = next(iter(result.failed.items()))
+        if result.damaged:
             typer.echo(
-                f"{len(result.failed)} case(s) failed (case {index}: {message}); their rows "
-                "are NaN and error(case) holds the message: rerun the same command to retry them"
+                f"notice: {len(result.damaged)} case(s) marked done did not read back (case "
+                f"{result.damaged[0]}: a file cut short): run again",
+                err=True,
             )
-        typer.echo(f"wrote {output}")
+        if not quiet:
+            typer.echo(
+                f"cases {result.first_case}..{last}: ran {result.ran}, skipped {result.skipped} "
+                f"done before, in {result.seconds:.1f} s"
+            )
+        if result.failed:  # docs/sweep.md, "Failures": exit 1 if all failed, else 0
+            index, message = next(iter(result.failed.items()))
+            level = "error" if result.exit_code else "warning"
+            typer.echo(
+                f"{level}: {len(result.failed)} of {result.n_cases} case(s) failed (case {index}: "
+                f"{message}); their rows are NaN and error(case) holds the message: rerun the "
+                "same command to retry them",
+                err=True,
+            )
+        if not quiet:
+            typer.echo(f"wrote {output}")
+        if result.exit_code:
+            raise typer.Exit(result.exit_code)
 
     _guarded(run)
 
@@ -1194,9 +1213,38 @@ def _one_line_notice(
     return f"notice: {message}\n"
 
 
+#: Notices printed by this process: their text, or the category of those said once whatever
+#: their text (the Earth-orientation table's).
+_shown_notices: set[object] = set()
+
+
+def _show_notice_once(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: Any = None,
+    line: str | None = None,
+) -> None:
+    """Print a warning as a one-line notice, once per process (Python's own "once per
+    place" starts over whenever a library changes the warning filters)."""
+    from speclight.orbit.staleness import EarthOrientationWarning
+
+    key = category if issubclass(category, EarthOrientationWarning) else (category, str(message))
+    if key in _shown_notices:
+        return
+    _shown_notices.add(key)
+    stream = sys.stderr if file is None else file
+    try:
+        stream.write(_one_line_notice(message, category, filename, lineno, line))
+    except OSError:  # stderr closed: a notice is not worth failing for
+        pass
+
+
 def main() -> None:
     """Console-script entry point."""
     warnings.formatwarning = _one_line_notice  # fallbacks are notices, not tracebacks
+    warnings.showwarning = _show_notice_once
     app(prog_name="speclight")
 
 

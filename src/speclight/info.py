@@ -46,7 +46,7 @@ def info_report() -> dict[str, dict[str, str]]:
         "data coverage": data_coverage(),
     }
     try:
-        from speclight.render.variant import available_variants, find_libllvm
+        from speclight.render.variant import available_variants, libllvm_status
 
         variants = available_variants()
         single, path, polarized = run_variants()
@@ -56,7 +56,7 @@ def info_report() -> dict[str, dict[str, str]]:
             "variant in path mode": path,
             "variant in polarised path mode": polarized,
             "gpu (CUDA)": "yes" if any(v.startswith("cuda_") for v in variants) else "none",
-            "libLLVM": find_libllvm() or "not found (LLVM variants unavailable)",
+            "libLLVM": libllvm_status(),
         }
     except ImportError as exc:  # rendering stage not installed
         report["render"] = {"status": f"unavailable ({exc})"}

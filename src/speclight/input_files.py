@@ -60,10 +60,36 @@ def read_user_bytes(
         ``max_bytes``, or not readable.
     """
     path = Path(path).expanduser()
-    source = str(path)
 
     def refuse(problem: str) -> InputError:
-        return InputError(f"cannot read {what}: {problem}", source=source, field=field)
+        return _refusal(path, field, what, problem)
+
+    check_user_file(path, field, what=what, max_bytes=max_bytes)
+    try:
+        with open(path, "rb") as f:
+            data = f.read(max_bytes + 1)
+    except OSError as exc:
+        raise refuse(exc.strerror or str(exc)) from None
+    if len(data) > max_bytes:  # grew since os.stat
+        raise refuse(f"it is larger than the limit of {_size(max_bytes)}")
+    return data
+
+
+def check_user_file(
+    path: str | Path,
+    field: str | None = None,
+    *,
+    what: str = "file",
+    max_bytes: int | None = MAX_TEXT_BYTES,
+) -> None:
+    """Refuse a path that is not a regular file of at most ``max_bytes`` (None: any size),
+    with the errors of :func:`read_user_bytes`, from ``os.stat`` alone (nothing is opened:
+    for files another library reads, such as a NetCDF dataset).
+    """
+    path = Path(path).expanduser()
+
+    def refuse(problem: str) -> InputError:
+        return _refusal(path, field, what, problem)
 
     try:
         st = os.stat(path)
@@ -82,16 +108,12 @@ def read_user_bytes(
     if not stat.S_ISREG(st.st_mode):
         kind = next((name for test, name in _KINDS if test(st.st_mode)), "not a regular file")
         raise refuse(f"it is {kind}, not a regular file; give the path of a file")
-    if st.st_size > max_bytes:
+    if max_bytes is not None and st.st_size > max_bytes:
         raise refuse(f"it is {_size(st.st_size)}, above the limit of {_size(max_bytes)}")
-    try:
-        with open(path, "rb") as f:
-            data = f.read(max_bytes + 1)
-    except OSError as exc:
-        raise refuse(exc.strerror or str(exc)) from None
-    if len(data) > max_bytes:  # grew since os.stat
-        raise refuse(f"it is larger than the limit of {_size(max_bytes)}")
-    return data
+
+
+def _refusal(path: Path, field: str | None, what: str, problem: str) -> InputError:
+    return InputError(f"cannot read {what}: {problem}", source=str(path), field=field)
 
 
 def read_user_text(

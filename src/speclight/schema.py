@@ -3,10 +3,12 @@
 ``speclight.simulate`` writes its dataset through this module (:func:`variable`,
 :func:`coordinate`), and the readers (``speclight.plot``, the coming ``speclight.estimate``)
 read names, units and flag bits from it, so that a variable is described once.
-Units follow CF / UDUNITS spelling (``W sr-1 nm-1``). Magnitudes are logarithmic and have no
-UDUNITS unit: they are written with units ``1`` (CF-1.10 section 3.1: dimensionless) and a
-``comment`` that names the magnitude system (``units_metadata`` is not for them: CF-1.11
-allows it only on temperatures).
+Units follow CF / UDUNITS spelling (``W sr-1 nm-1``), except magnitudes: they are
+logarithmic and UDUNITS has no unit for them, so they are written with units ``mag`` (the
+spelling of the IAU, FITS, VOUnits and astropy, which xarray and plots print on their axes)
+and a ``comment`` that names the magnitude system. A CF checker reports ``mag`` as not
+recognised by UDUNITS; that is the one CF finding speclight accepts (``units = "1"`` would
+pass but label magnitude axes ``[1]``).
 """
 
 from __future__ import annotations
@@ -32,12 +34,12 @@ class VariableInfo:
 
 #: The magnitude system of the AB magnitudes (for their ``comment``).
 AB_COMMENT = (
-    "magnitude (logarithmic, units 1): -2.5 log10 of the photon-weighted in-band irradiance "
+    "magnitude (logarithmic): -2.5 log10 of the photon-weighted in-band irradiance "
     "over that of a 3631 Jy flat f_nu source (Oke & Gunn 1983)"
 )
 #: The magnitude system of the Vega V magnitudes (for their ``comment``).
 VEGA_V_COMMENT = (
-    "magnitude (logarithmic, units 1): the AB magnitude in speclite's bessell-V band minus "
+    "magnitude (logarithmic): the AB magnitude in speclite's bessell-V band minus "
     "0.02, the AB - Vega offset of V (Blanton & Roweis 2007, AJ 133, 734, table 1; V zero "
     "points of different realisations differ by about 0.01-0.02 mag); absent when the "
     "wavelength grid does not cover the V band"
@@ -54,6 +56,9 @@ V_SIGN = (
     "V > 0: right-handed in the IAU (IEEE) sense, the electric vector turning "
     "counter-clockwise (north toward east) as seen by the observer facing the target"
 )
+
+#: Units of magnitudes (see the module docstring).
+MAG = "mag"
 
 V = VariableInfo
 VARIABLES: dict[str, VariableInfo] = {
@@ -119,20 +124,20 @@ VARIABLES: dict[str, VariableInfo] = {
     "count_rate": V(TB, "s-1", "detected photo-electrons per second in each band"),
     "ab_magnitude": V(
         TB,
-        "1",
+        MAG,
         "AB magnitude of the in-band irradiance at the aperture",
         comment=f"{AB_COMMENT}; through the atmosphere",
     ),
     "ab_magnitude_exo": V(
         TB,
-        "1",
+        MAG,
         "exo-atmospheric AB magnitude: the in-band irradiance at the aperture without the "
         "atmosphere's transmission",
         comment=f"{AB_COMMENT}; above the atmosphere (transmission 1)",
     ),
     "ab_magnitude_standard": V(
         TB,
-        "1",
+        MAG,
         "standard AB magnitude: ab_magnitude_exo moved to a range of 1000 km, "
         "m - 5 log10(range / 1000 km)",
         comment=f"{AB_COMMENT}; above the atmosphere, range-normalised to 1000 km as SSA "
@@ -140,13 +145,13 @@ VARIABLES: dict[str, VariableInfo] = {
     ),
     "vega_v_magnitude": V(
         T,
-        "1",
+        MAG,
         "Vega magnitude in the Bessell V band of the irradiance at the aperture",
         comment=VEGA_V_COMMENT + "; through the atmosphere",
     ),
     "vega_v_magnitude_standard": V(
         T,
-        "1",
+        MAG,
         "standard Vega V magnitude: above the atmosphere, range-normalised to 1000 km",
         comment=VEGA_V_COMMENT + "; above the atmosphere, m - 5 log10(range / 1000 km)",
     ),

@@ -1,5 +1,6 @@
-"""docs/output.md is the schema's page (scripts/make_output_doc.py), and no docstring cites a
-document that is not in the repository (SPEC.md lives outside it)."""
+"""docs/output.md is the schema's page (scripts/make_output_doc.py), README names every flag
+bit, and no docstring cites a document that is not in the repository (SPEC.md lives outside
+it)."""
 
 import importlib.util
 import re
@@ -27,3 +28,12 @@ def test_no_docstring_cites_the_spec_outside_the_repository():
         if re.search(r"\bSPEC(\.md)?\b", line)
     ]
     assert cited == []
+
+
+def test_readme_names_every_flag_bit():
+    # issue 22 item 9: README's flag list lacked attitude_undefined
+    from speclight.schema import FLAG_MEANINGS
+
+    listed = (ROOT / "README.md").read_text().split("a `flags` bit mask per epoch", 1)[1]
+    listed = listed.split(")", 1)[0]
+    assert [m for m in FLAG_MEANINGS.values() if f"`{m}`" not in listed] == []

@@ -76,3 +76,13 @@ def test_readme_runs_python_from_the_virtual_environment() -> None:
             for line in code.splitlines():
                 command = line.split("#")[0].strip()
                 assert not re.match(r"^(python3?|pip3?)\b", command), line
+
+
+def test_getting_started_names_every_built_in_scenario() -> None:
+    # issue 22 item 9: the page's comment listed 3 of the 9 examples
+    from speclight.scenario import example_names
+
+    text = DOC.read_text()
+    names = example_names()
+    assert f"lists the {len(names)} built-in scenarios" in text
+    assert [n for n in names if f"`{n}`" not in text] == []

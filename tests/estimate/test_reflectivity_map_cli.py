@@ -51,7 +51,8 @@ def test_map_written_then_refused_without_force_then_replaced(scenario, tmp_path
         (["--phase-angles-deg", "0,a"], ["--phase-angles-deg", "comma-separated"]),
         (["--phase-angles-deg", "0,180"], ["--phase-angles-deg", "0..179"]),
         (["--phase-angles-deg", "30,30"], ["--phase-angles-deg", "repeats"]),
-        (["--rolls", "0", "--phase-angles-deg", "30"], ["--rolls", ">= 1"]),
+        (["--rolls", "0", "--phase-angles-deg", "30"], ["--rolls", "1..360"]),
+        (["--rolls", "1000000000", "--phase-angles-deg", "30"], ["--rolls", "1..360"]),
         (["--chunk", "0"], ["--chunk", ">= 1"]),
     ],
 )

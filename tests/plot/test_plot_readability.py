@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -151,3 +153,101 @@ def test_images_figure_draws_the_compass() -> None:
     # without attitude or image axes: no compass, the figure still draws
     plain = images_figure(image_dataset(), None)
     assert not [t for t in plain.axes[0].texts if t.get_text()]
+
+
+def _overlapping_tick_labels(fig, ax) -> list[tuple[str, str]]:  # type: ignore[no-untyped-def]
+    """Pairs of neighbouring x tick labels of ``ax`` whose drawn boxes intersect."""
+    fig.canvas.draw()  # layout and ticks as they are saved
+    renderer = fig.canvas.get_renderer()
+    labels = [t for t in ax.get_xticklabels() if t.get_visible() and t.get_text()]
+    boxes = sorted(((t.get_window_extent(renderer), t.get_text()) for t in labels),
+                   key=lambda box: box[0].x0)  # fmt: skip
+    return [(a, b) for (p, a), (q, b) in itertools.pairwise(boxes) if p.x1 > q.x0]
+
+
+@pytest.mark.parametrize("span_s", [20.0, 600.0, 6 * 3600.0])
+def test_time_tick_labels_do_not_run_together(span_s: float) -> None:
+    # issue 22 item 9: the box-wing pass (600 s) read "02:20:0002:21:00..."
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    ds = _with_bands(full_dataset(), TEN_BANDS_NM)  # ten bands: a colour bar, narrow axes
+    step = np.timedelta64(int(span_s / (N_TIME - 1) * 1e9), "ns")
+    ds = ds.assign_coords(time=ds["time"].values[0] + np.arange(N_TIME) * step)
+    fig = overview_figure(ds)
+    FigureCanvasAgg(fig)
+    bottom = next(ax for ax in fig.axes if ax.get_xlabel().startswith("time [UTC]"))
+    assert _overlapping_tick_labels(fig, bottom) == []
+    assert len([t for t in bottom.get_xticklabels() if t.get_text()]) >= 3
+
+
+def _polarised(ds: xr.Dataset) -> xr.Dataset:
+    """``ds`` with Stokes Q, U images (a quarter and a tenth of the radiance)."""
+    ds["image_radiance_q"] = ds["image_radiance"] * 0.25
+    ds["image_radiance_u"] = ds["image_radiance"] * 0.1
+    return ds
+
+
+def _inside(box, outer) -> bool:  # type: ignore[no-untyped-def]
+    return box.x0 >= outer.x0 and box.x1 <= outer.x1 and box.y0 >= outer.y0 and box.y1 <= outer.y1
+
+
+def test_images_figure_titles_stay_inside_the_figure_and_apart() -> None:
+    # issue 22 item 9: four panels a row (polarised) clipped their titles at the edges
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    ds = _polarised(_compass_dataset((1.0, 0.0, 0.0, 0.0)))
+    fig = images_figure(ds, None)
+    FigureCanvasAgg(fig).draw()
+    renderer = fig.canvas.get_renderer()
+    assert len(fig.axes) >= 4 * ds.sizes["image_time"]  # radiance, DoLP, depth, parts
+    texts = [ax.title for ax in fig.axes] + [ax.xaxis.label for ax in fig.axes]
+    texts += [sub._suptitle for sub in fig.subfigs]
+    texts = [t for t in texts if t is not None and t.get_text()]
+    outside = [t.get_text() for t in texts if not _inside(t.get_window_extent(renderer), fig.bbox)]
+    assert outside == []
+    titles = [ax.title.get_window_extent(renderer) for ax in fig.axes if ax.get_title()]
+    pairs = [(a, b) for i, a in enumerate(titles) for b in titles[i + 1 :]]
+    assert not [p for p in pairs if p[0].overlaps(p[1])]
+    # each row names its epoch once
+    assert [sub._suptitle.get_text()[:30] for sub in fig.subfigs] == [
+        "synthetic-pass: saved image 1 ",
+        "synthetic-pass: saved image 2 ",
+    ]
+
+
+def _compass_over_target(fig, ax, ds: xr.Dataset, k: int) -> int:  # type: ignore[no-untyped-def]
+    """On-target pixel centres under the compass disc of image ``k``, in display space."""
+    from matplotlib.patches import Circle
+
+    fig.canvas.draw()
+    (disc,) = [p for p in ax.patches if isinstance(p, Circle)]
+    outline = disc.get_transform().transform_path(disc.get_path())
+    ny, nx = ds.sizes["y"], ds.sizes["x"]
+    x0, x1, y0, y1 = ax.get_images()[0].get_extent()  # metres at the target, row 0 on top
+    xs = x0 + (np.arange(nx) + 0.5) * (x1 - x0) / nx
+    ys = y1 - (np.arange(ny) + 0.5) * (y1 - y0) / ny
+    gx, gy = np.meshgrid(xs, ys)
+    on = np.isfinite(ds["image_depth"].isel(image_time=k).values)
+    centres = ax.transData.transform(np.column_stack([gx[on], gy[on]]))
+    return int(outline.contains_points(centres).sum())
+
+
+def test_the_compass_is_drawn_off_the_target() -> None:
+    # issue 22 item 9: the compass (upper left) covered a wing reaching into that corner
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    ds = _compass_dataset((1.0, 0.0, 0.0, 0.0))
+    ny, nx = ds.sizes["y"], ds.sizes["x"]
+    row, col = np.meshgrid(np.arange(ny), np.arange(nx), indexing="ij")
+    # a wing from the upper-left corner to the lower-right one, and a body in the middle
+    wing = np.abs(row - col) <= 2
+    body = (row - ny / 2) ** 2 + (col - nx / 2) ** 2 < (ny / 5) ** 2
+    for corner in ("upper left", "upper right"):
+        mask = wing | body if corner == "upper left" else wing[:, ::-1] | body
+        depth = np.where(mask, 0.0, np.nan)
+        ds["image_depth"] = (("image_time", "y", "x"), np.stack([depth, depth]))
+        fig = images_figure(ds, None)
+        FigureCanvasAgg(fig)
+        ax = fig.axes[0]
+        assert _compass_over_target(fig, ax, ds, 0) == 0, corner
+        assert {t.get_text() for t in ax.texts} - {""} == {"N", "Z", "☉"}

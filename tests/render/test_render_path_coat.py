@@ -21,6 +21,8 @@ pytestmark = pytest.mark.skipif(
 #: A z-test at 4 standard errors fails by chance in 6e-5 of runs (normal), ~5e-3 with the
 #: 8-pass Student-t error estimate; seeds are fixed, so a pass is reproducible.
 Z_MAX = 4.0
+#: Relative rounding of float32 Dr.Jit kernels (the same samples, other launches).
+FLOAT32_ROUNDING = 1e-6
 
 
 def _mi():
@@ -300,7 +302,7 @@ def test_one_launch_per_epoch_reproducible_with_progress_per_epoch():
     four, again, calls_four = launches(4)
     assert (one, four) == (1, 4)
     assert (calls_one, calls_four) == (1, 4)
-    np.testing.assert_array_equal(again[:1], first)
+    np.testing.assert_allclose(again[:1], first, rtol=FLOAT32_ROUNDING)
 
 
 def test_epochs_split_over_launches_agree_with_one_launch(monkeypatch):
@@ -357,9 +359,14 @@ def test_frozen_launches_equal_traced_launches(monkeypatch, solar_disk):
     frozen = render_intensity(target, sun, obs, e, wl, **kw)
     monkeypatch.delattr(dr, "freeze")
     traced = render_intensity(target, sun, obs, e, wl, **kw)
-    np.testing.assert_array_equal(frozen.intensity_W_sr_nm, traced.intensity_W_sr_nm)
-    np.testing.assert_array_equal(
-        frozen.images[2].radiance_W_m2_sr_nm, traced.images[2].radiance_W_m2_sr_nm
+    np.testing.assert_allclose(
+        frozen.intensity_W_sr_nm, traced.intensity_W_sr_nm, rtol=FLOAT32_ROUNDING
+    )
+    np.testing.assert_allclose(
+        frozen.images[2].radiance_W_m2_sr_nm,
+        traced.images[2].radiance_W_m2_sr_nm,
+        rtol=FLOAT32_ROUNDING,
+        atol=FLOAT32_ROUNDING * float(np.max(traced.images[2].radiance_W_m2_sr_nm)),
     )
 
 
@@ -393,4 +400,4 @@ def test_freeze_env_zero_traces_every_launch(monkeypatch):
     monkeypatch.delenv(sampling.FREEZE_ENV)
     on = render_intensity(target, sun, obs, e, wl, **kw)
     assert len(calls) == 1
-    np.testing.assert_array_equal(off.intensity_W_sr_nm, on.intensity_W_sr_nm)
+    np.testing.assert_allclose(off.intensity_W_sr_nm, on.intensity_W_sr_nm, rtol=FLOAT32_ROUNDING)

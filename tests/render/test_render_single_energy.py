@@ -102,5 +102,6 @@ def test_worker_processes_give_the_same_answer():
         workers=2,
         keep_images_for=[3],
     )
-    np.testing.assert_array_equal(one.intensity_W_sr_nm, two.intensity_W_sr_nm)
-    np.testing.assert_array_equal(one.images[3].depth_m, two.images[3].depth_m)
+    # rays are split over processes: per-ray results are the same, sums may round differently
+    np.testing.assert_allclose(one.intensity_W_sr_nm, two.intensity_W_sr_nm, rtol=1e-12)
+    np.testing.assert_allclose(one.images[3].depth_m, two.images[3].depth_m, rtol=1e-12)

@@ -18,6 +18,14 @@ from speclight.simulate import simulate
 from speclight.target import Material, Reflectance, target_from_spec
 
 GEOMETRY_VARS = ("range", "elevation", "phase_angle", "sunlit", "observer_direction_body")
+#: Relative rounding of float64 through a few hundred operations; epochs computed in arrays of
+#: other lengths may take other SIMD/BLAS paths, so equal values may differ in the last bits.
+ROUNDING = 1e-12
+
+
+def assert_rounding_equal(got: np.ndarray, expected: np.ndarray, name: str) -> None:
+    scale = float(np.nanmax(np.abs(expected))) if np.size(expected) else 0.0
+    np.testing.assert_allclose(got, expected, rtol=ROUNDING, atol=ROUNDING * scale, err_msg=name)
 
 
 def _calsphere(albedo=0.9, **render):
@@ -36,8 +44,9 @@ def test_simulate_at_given_epochs_equals_the_grid_run_there():
     picked = full["time"].values[[1, 4, 7]]
     part = simulate(loaded, time_utc=picked).dataset
     np.testing.assert_array_equal(part["time"].values, picked)
-    for name in (*GEOMETRY_VARS, "attitude_quaternion", "flags"):
-        np.testing.assert_array_equal(part[name].values, full[name].values[[1, 4, 7]], err_msg=name)
+    np.testing.assert_array_equal(part["flags"].values, full["flags"].values[[1, 4, 7]])
+    for name in (*GEOMETRY_VARS, "attitude_quaternion"):
+        assert_rounding_equal(part[name].values, full[name].values[[1, 4, 7]], name)
     np.testing.assert_allclose(
         part["count_rate"].values, full["count_rate"].values[[1, 4, 7]], rtol=1e-12
     )
@@ -53,7 +62,7 @@ def test_given_epochs_keep_the_attitude_clock_of_time_start():
     grid = simulate(loaded).dataset
     given = simulate(loaded, time_utc=grid["time"].values[2:]).dataset
     for name in ("attitude_quaternion", "sun_direction_body", "observer_direction_body"):
-        np.testing.assert_array_equal(given[name].values, grid[name].values[2:], err_msg=name)
+        assert_rounding_equal(given[name].values, grid[name].values[2:], name)
     assert not np.array_equal(
         grid["attitude_quaternion"].values[0], given["attitude_quaternion"].values[0]
     )

@@ -117,3 +117,51 @@ def test_default_limit_is_a_fraction_of_physical_memory() -> None:
 
     physical = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
     assert 0 < memory.memory_limit_bytes() <= memory.MEMORY_FRACTION * physical
+
+
+@pytest.mark.parametrize("name", ["box-wing", "calsphere", "cube-materials", "starlink-v1.5"])
+def test_channel_count_is_the_renderers_layout(name: str) -> None:
+    # issue 22 item 8: the (epochs x channels) weight array was not in the model; its channel
+    # count must be the one the single-mode renderer lays out (3,271 for the box-wing's three
+    # plastics: 4 materials + 3 x 33^2 diffuse nodes)
+    from speclight.render.material_channels import ChannelLayout
+    from speclight.simulate.reflection import build_target
+
+    loaded = _loaded(name)
+    layout = ChannelLayout(build_target(loaded))
+    assert memory.channel_count(loaded.scenario, loaded.resolve) == layout.n_channels
+
+
+def test_plastic_targets_count_the_channel_weights_the_render_allocates() -> None:
+    # What the single-mode render allocates, traced (numpy reports its arrays to tracemalloc):
+    # the box-wing (3 plastics, 3,271 channels) at 8 px over 2000 epochs. The model's render
+    # terms (rays of a batch, channel weights, spectra) must bound the traced peak; without
+    # the channel term they do not (699 MiB estimated, 879 MiB measured at 10k epochs).
+    import tracemalloc
+
+    import numpy as np
+
+    from speclight.render.raycast import NumpyCaster
+    from speclight.render.single import render_single_polarized
+    from speclight.simulate.radiometry import wavelength_grid_nm
+    from speclight.simulate.reflection import build_target
+
+    loaded = _loaded("box-wing", render__resolution_px=8)
+    target = build_target(loaded)
+    wl = wavelength_grid_nm(loaded.scenario.spectrum)
+    n = 2000
+    rng = np.random.default_rng(1)
+    sun, obs = (v / np.linalg.norm(v, axis=1)[:, None] for v in rng.normal(size=(2, n, 3)))
+    caster = NumpyCaster(target)
+    tracemalloc.start()
+    try:
+        irradiance = np.ones((n, wl.size))
+        render_single_polarized(target, sun, obs, irradiance, wl, caster, 8, polarization=False)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    est = memory.estimate_memory(loaded.scenario, n, loaded.resolve)
+    weights = n * 3271 * 8  # w (N, C) float64 alone
+    assert est.parts["channels"] >= weights
+    render = est.parts["render batch"] + est.parts["spectra"]
+    assert render < peak <= render + est.parts["channels"]

@@ -26,10 +26,12 @@ from numpy.typing import NDArray
 
 from speclight.errors import InputError
 from speclight.estimate import reflectivity_map_store as store
+from speclight.estimate.reflectivity_map_limits import check_chunk_memory, check_rolls, store_bytes
 from speclight.estimate.reflectivity_map_task import MapChunk, MapJob, map_engine, render_map_chunk
 from speclight.ranging.bins import range_bin_edges_m
 from speclight.render.map_geometry import healpix_directions, nside_for
 from speclight.scale import Outcome, open_executor
+from speclight.scale.store_io import check_free_space, store_lock, store_writes
 from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
@@ -52,6 +54,8 @@ class MapRun:
     failed: dict[str, str] = field(default_factory=dict)
     complete: bool = False
     seconds: float = 0.0
+    #: Chunks marked done that did not read back (a chunk file cut short): rendered again.
+    damaged: list[int] = field(default_factory=list)
 
 
 def check_map_options(
@@ -78,8 +82,7 @@ def check_map_options(
         raise InputError(
             f"--phase-angles-deg = {phase_angles_deg} repeats an angle", field="--phase-angles-deg"
         )
-    if int(rolls) < 1:
-        raise InputError(f"--rolls = {rolls} must be >= 1", field="--rolls")
+    check_rolls(rolls)
     if int(chunk) < 1:
         raise InputError(f"--chunk = {chunk} must be >= 1", field="--chunk")
     if workers is not None and int(workers) < 1:
@@ -164,18 +167,21 @@ def reflectivity_map(
     )
     path = store.check_store_path(output, {"scenario file": Path(loaded.source)})
     from speclight.illumination import solar_irradiance_W_m2_nm
-    from speclight.render import engine_versions
     from speclight.simulate.radiometry import wavelength_grid_nm
 
+    dirs = healpix_directions(nside)
+    size = min(int(chunk), len(dirs))  # a chunk larger than the map is the whole map
+    n_geoms = sum(1 if a == 0 else n_rolls for a in angles)  # as _geometries lists them
+    task_bytes = check_chunk_memory(loaded, size, n_geoms, asked=int(chunk))  # up front
+    geoms = _geometries(angles, n_rolls)
     engine = map_engine(loaded, sc.render.variant)  # also the serial run's (cached)
     band_names = engine.kernel.band_names
     wl = wavelength_grid_nm(sc.spectrum)
-    dirs = healpix_directions(nside)
     parameters = {
         "healpix_nside": nside,
         "phase_angle_deg": angles,
         "rolls": n_rolls,
-        "chunk": int(chunk),
+        "chunk": size,
         "scenario_sha256": hashlib.sha256(loaded.yaml_text.encode()).hexdigest(),
     }
     ranging = bool(sc.illumination.lasers) and 0.0 in angles
@@ -193,7 +199,7 @@ def reflectivity_map(
     job = MapJob(
         loaded,
         engine.session.variant,
-        _geometries(angles, n_rolls),
+        geoms,
         shapes,
         wl,
         solar_irradiance_W_m2_nm(wl, 1.0),
@@ -201,52 +207,90 @@ def reflectivity_map(
         ranging,
     )
     started = time.perf_counter()
-    with store.store_lock(path):
-        group, resumed = store.open_or_create(path, parameters, shapes, int(chunk), force)
-        if not resumed:
-            store.write_coordinates(
-                group,
-                {
-                    "direction_body": dirs,
-                    "phase_angle_deg": np.array(angles),
-                    "roll_deg": 360.0 * np.arange(n_rolls) / n_rolls,
-                    "wavelength": wl,
-                },
-            )
-            if ranging and band_names:
-                store.write_coordinates(
-                    group,
-                    {
-                        "range_bin": 0.5 * (edges[1:] + edges[:-1]),
-                        "range_bin_bounds": np.stack([edges[:-1], edges[1:]], axis=1),
-                    },
-                )
-            group.attrs.update(_metadata(loaded, band_names, nside, engine.session.variant))
-            group.attrs["engine_versions"] = engine_versions()
-        states = store.chunk_states(group)
+    with store_lock(path):
+        with store_writes(path):
+            group, resumed = store.open_or_create(path, parameters, shapes, size, force)
+            if not resumed:
+                _write_header(group, loaded, job, dirs, angles, band_names, nside)
+                store.mark_created(group, parameters)
+        states, damaged = _chunks_to_do(path, group, resumed, size)
         todo = [k for k in range(states.size) if states[k] != store.DONE]
+        check_free_space(
+            path, store_bytes(shapes) * len(todo) // states.size, "the map", "--directions"
+        )
         if max_chunks is not None:
             todo = todo[: max(int(max_chunks), 0)]
         run = MapRun(path, len(dirs), states.size, 0, int(np.sum(states == store.DONE)))
-        size = int(chunk)
+        run.damaged = damaged
         chunks = [
             MapChunk(k, k * size, min((k + 1) * size, len(dirs)), dirs[k * size : (k + 1) * size])
             for k in todo
         ]
         if chunks:
-            with open_executor(scheduler, n_workers=n_workers, announce=announce) as executor:
+            with open_executor(
+                scheduler, n_workers=n_workers, announce=announce, task_bytes=task_bytes
+            ) as executor:
                 task = functools.partial(render_map_chunk, job)
                 for outcome in executor.run(
                     task, chunks, label="reflectivity map", progress=progress
                 ):
-                    write_chunk(group, outcome)
-                    run.rendered += 1
+                    with store_writes(path):
+                        write_chunk(group, outcome)
+                    if outcome.error is None:  # a failed chunk is counted in run.failed
+                        run.rendered += 1
         states = store.chunk_states(group)
         run.failed = dict(group.attrs.get("failed_chunks", {}))
         run.complete = bool(np.all(states == store.DONE))
-        group.attrs["complete"] = run.complete
+        with store_writes(path):
+            group.attrs["complete"] = run.complete
     run.seconds = time.perf_counter() - started
     return run
+
+
+def _write_header(
+    group: Any,
+    loaded: LoadedScenario,
+    job: MapJob,
+    dirs: F64,
+    angles: list[float],
+    band_names: list[str],
+    nside: int,
+) -> None:
+    """A new store's coordinates and metadata."""
+    from speclight.render import engine_versions
+
+    n_rolls, edges = job.shapes["roll"], job.edges_m
+    coords = {
+        "direction_body": dirs,
+        "phase_angle_deg": np.array(angles),
+        "roll_deg": 360.0 * np.arange(n_rolls) / n_rolls,
+        "wavelength": job.wavelength_nm,
+    }
+    if job.ranging and band_names:
+        coords["range_bin"] = 0.5 * (edges[1:] + edges[:-1])
+        coords["range_bin_bounds"] = np.stack([edges[:-1], edges[1:]], axis=1)
+    store.write_coordinates(group, coords)
+    group.attrs.update(_metadata(loaded, band_names, nside, job.variant))
+    group.attrs["engine_versions"] = engine_versions()
+
+
+def _chunks_to_do(
+    path: Path, group: Any, resumed: bool, chunk: int
+) -> tuple[NDArray[np.uint8], list[int]]:
+    """The chunk states, with the done chunks of a resumed store that do not read back
+    (damaged) set to do again; and those chunks."""
+    lost = False
+    try:
+        states = store.chunk_states(group)
+    except Exception:  # the state array itself is damaged: trust only data that reads back
+        states = np.full(group["chunk_state"].shape[0], store.DONE, dtype=np.uint8)
+        lost = True
+    damaged = store.damaged_chunks(group, states, chunk) if resumed or lost else []
+    states[damaged] = store.TODO
+    if damaged or lost:
+        with store_writes(path):
+            group["chunk_state"][...] = states
+    return states, damaged
 
 
 def write_chunk(group: Any, outcome: Outcome[MapChunk, dict[str, Any]]) -> None:

@@ -33,11 +33,8 @@ accept only a store whose ``complete`` is true.
 
 from __future__ import annotations
 
-import fcntl
 import os
 import shutil
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -46,11 +43,13 @@ from numpy.typing import NDArray
 
 from speclight.errors import InputError
 from speclight.io import zarr_store_path
-from speclight.io.output import lock_path
+from speclight.scale.store_io import readable
 
 FIELD = "--output"
 FORMAT_NAME = "speclight reflectivity map"
 TODO, DONE, FAILED = 0, 1, 2
+#: The per-direction arrays a chunk writes.
+DATA_ARRAYS = ("intensity", "count_rate", "range_offset", "range_histogram")
 #: Dimension names of each array (Zarr ``dimension_names``: ``xarray.open_zarr`` reads them).
 DIMS = {
     "intensity": ("direction", "phase", "roll", "wavelength"),
@@ -72,24 +71,6 @@ def check_store_path(output: str | os.PathLike[str], inputs: dict[str, Path]) ->
     return zarr_store_path.check_store_path(output, inputs, example="map.zarr")
 
 
-@contextmanager
-def store_lock(path: Path) -> Iterator[None]:
-    """Hold ``.NAME.speclight.lock`` beside the store (one writer at a time)."""
-    lock = lock_path(path)
-    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o666)
-    try:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            raise InputError(
-                f"another speclight run is writing {path}; wait for it to end", field=FIELD
-            ) from None
-        yield
-    finally:
-        os.close(fd)
-        lock.unlink(missing_ok=True)
-
-
 def open_or_create(
     path: Path,
     parameters: dict[str, Any],
@@ -101,11 +82,14 @@ def open_or_create(
 
     An existing store is resumed when its ``parameters`` equal ``parameters`` and it is not
     complete; a complete one, or one made with other parameters, is refused unless ``force``
-    (which deletes it first).
+    (which deletes it first). A store whose creation did not finish (an empty folder, or no
+    ``parameters`` yet: :func:`mark_created` was not reached, e.g. on a full disk) holds no
+    rendered chunk and is created again. The caller writes the coordinates and metadata of
+    a new store, then calls :func:`mark_created`.
     """
     import zarr
 
-    if path.exists() and not force:
+    if path.exists() and not force and not _unfinished_creation(path):
         try:
             group = zarr.open_group(str(path), mode="r+")
             old: dict[str, Any] = dict(group.attrs.get("parameters", {}))  # type: ignore[arg-type]
@@ -130,7 +114,7 @@ def open_or_create(
                 field=FIELD,
             )
         return group, True
-    if path.exists():  # --force: replace a map, never another folder
+    if path.exists():  # --force, or unfinished: replace a map, never another folder
         if any(path.iterdir()) and _format_of(path) != FORMAT_NAME:
             raise InputError(
                 f"{path} is a folder but not a speclight reflectivity map; --force replaces "
@@ -138,7 +122,10 @@ def open_or_create(
                 field=FIELD,
             )
         shutil.rmtree(path)
-    group = zarr.open_group(str(path), mode="w", zarr_format=3)
+    # the format first: a store cut short by a full disk is still known as a map
+    group = zarr.open_group(
+        str(path), mode="w", zarr_format=3, attributes={"format": FORMAT_NAME, "complete": False}
+    )
     d, p, r = shapes["direction"], shapes["phase"], shapes["roll"]
     n_wl, n_band = shapes["wavelength"], shapes["band"]
     n_chunks = -(-d // chunk)
@@ -186,8 +173,27 @@ def open_or_create(
         fill_value=0,
         dimension_names=DIMS["chunk_state"],
     )
-    group.attrs.update({"format": FORMAT_NAME, "parameters": parameters, "complete": False})
     return group, False
+
+
+def mark_created(group: Any, parameters: dict[str, Any]) -> None:
+    """Record the ``parameters`` of a new store, last: from now on it is resumed."""
+    group.attrs["parameters"] = parameters
+
+
+def _unfinished_creation(path: Path) -> bool:
+    """An empty folder, or a map store without ``parameters`` (see :func:`open_or_create`)."""
+    import json
+
+    if not path.is_dir():
+        return False
+    if not any(path.iterdir()):
+        return True
+    try:
+        attrs = json.loads((path / "zarr.json").read_text()).get("attributes", {})
+    except (OSError, ValueError, AttributeError):
+        return False
+    return attrs.get("format") == FORMAT_NAME and "parameters" not in attrs
 
 
 def write_coordinates(group: Any, coords: dict[str, NDArray[Any]]) -> None:
@@ -219,6 +225,17 @@ def mark(group: Any, k: int, state: int, message: str | None = None) -> None:
         failed.pop(str(k), None)
     group.attrs["failed_chunks"] = failed
     group["chunk_state"][k] = state
+
+
+def damaged_chunks(group: Any, states: NDArray[np.uint8], chunk: int) -> list[int]:
+    """Chunks marked done whose data do not read back (:func:`speclight.scale.store_io.
+    readable`: a chunk file cut short or deleted); the caller renders them again."""
+    arrays = [group[name] for name in DATA_ARRAYS if name in group]
+    return [
+        k
+        for k in np.flatnonzero(states == DONE).tolist()
+        if not readable(arrays, slice(k * chunk, (k + 1) * chunk), complete="intensity")
+    ]
 
 
 def _format_of(path: Path) -> str | None:

@@ -15,7 +15,6 @@ a worker on another machine needs the same paths (a shared file system).
 from __future__ import annotations
 
 import hashlib
-import multiprocessing
 import os
 from dataclasses import dataclass
 from typing import Any
@@ -25,7 +24,6 @@ from numpy.typing import NDArray
 
 from speclight.estimate.reflectivity_map_render import coaxial_returns, render_chunk
 from speclight.scale import worker_cached
-from speclight.scale.executor import RENDER_THREADS_ENV
 from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
@@ -116,7 +114,7 @@ def render_map_chunk(job: MapJob, chunk: MapChunk) -> dict[str, F32]:
         job.solar_W_m2_nm,
         engine.kernel,
         chunk.k,
-        workers=render_processes(),
+        workers=os.cpu_count() or 1,  # numpy caster: this process's share (one in Dask)
     )
     out = {"intensity": inten.astype(np.float32)}
     if band_names:
@@ -135,15 +133,3 @@ def render_map_chunk(job: MapJob, chunk: MapChunk) -> dict[str, F32]:
         if band_names:
             out["range_histogram"] = hist.astype(np.float32)
     return out
-
-
-def render_processes() -> int:
-    """Processes of the numpy ray caster (no Mitsuba): this process's share of the cores.
-
-    One inside a Dask worker (a daemon process cannot start others) or where
-    ``SPECLIGHT_RENDER_THREADS`` gives a worker's share; the cores otherwise.
-    """
-    if multiprocessing.current_process().daemon:
-        return 1
-    threads = os.environ.get(RENDER_THREADS_ENV, "")
-    return int(threads) if threads.isdigit() and int(threads) > 0 else os.cpu_count() or 1

@@ -122,7 +122,8 @@ def _spin_model(loaded: LoadedScenario, period_s: float | None) -> tuple[float, 
     if period_s is None:
         if spin is None:
             raise InputError(
-                f"no rotation period: the scenario's attitude is '{att.model}', not 'spin'; "
+                f"no rotation period: the scenario's attitude is "
+                f"'{att.model if att is not None else 'not given'}', not 'spin'; "
                 "give --period-s (e.g. from speclight period)",
                 field="--period-s",
             )

@@ -124,7 +124,8 @@ def table_band(path: str | os.PathLike, name: str | None = None) -> Band:
 
 
 def parse_band(spec: str | Band) -> Band:
-    """Band from its text form: ``G-531/26``, a speclite name, or a table file path."""
+    """Band from its text form: ``G-531/26`` (a Gaussian of centre 531 nm and standard
+    deviation, not FWHM, 26 nm), a speclite name, or a table file path."""
     if isinstance(spec, Band):
         return spec
     text = str(spec).strip()
@@ -132,7 +133,8 @@ def parse_band(spec: str | Band) -> Band:
         m = _GAUSS.match("G-" + text[2:])
         if m is None:
             raise InputError(
-                f"Gaussian band {text!r} must read G-<centre_nm>/<sigma_nm>, e.g. G-531/26",
+                f"Gaussian band {text!r} must read G-<centre_nm>/<sigma_nm> (sigma: the "
+                "standard deviation, not the FWHM), e.g. G-531/26",
                 field="instrument.bands",
             )
         return gaussian_band(float(m["c"]), float(m["s"]), name=text)

@@ -1,9 +1,11 @@
 """Orbit stage: where the target, the observer and the Sun are, epoch by epoch.
 
 Positions are numpy arrays in metres with the frame in the name (``r_gcrs_m``); times are
-skyfield ``Time`` objects or arrays of UTC ``datetime64``. Target sources: TLE (SGP4),
-ILRS CPF predictions, tabulated ephemerides. :func:`observation_geometry` bundles what the
-later stages need (Sun, site, shadow, range/azimuth/elevation, phase angle, unit vectors).
+skyfield ``Time`` objects or arrays of UTC ``datetime64``. Target sources (TLE, CPF, OEM,
+SP3, tabulated ephemerides, observed positions) are listed once, in
+:data:`~speclight.orbit.orbit_sources.ORBIT_SOURCES`, with :func:`orbit_trajectory` the front
+door. :func:`observation_geometry` bundles what the later stages need (Sun, site, shadow,
+range/azimuth/elevation, phase angle, unit vectors).
 """
 
 from speclight.orbit.cpf import Cpf, cpf_position_gcrs_m, read_cpf
@@ -18,6 +20,7 @@ from speclight.orbit.observer import (
     site_position_gcrs_m,
     topocentric,
 )
+from speclight.orbit.orbit_sources import ORBIT_SOURCES, OrbitSource, orbit_trajectory
 from speclight.orbit.shadow import sunlit_fraction
 from speclight.orbit.sun import AU_M, sun_distance_au, sun_position_gcrs_m
 from speclight.orbit.timescale import load_ephemeris, load_timescale, time_from_utc
@@ -25,10 +28,12 @@ from speclight.orbit.tle import Tle, parse_tle, read_tle_file, read_tles, tle_po
 
 __all__ = [
     "AU_M",
+    "ORBIT_SOURCES",
     "Cpf",
     "EarthOrientation",
     "Ephemeris",
     "ObservationGeometry",
+    "OrbitSource",
     "Site",
     "Tle",
     "Topocentric",
@@ -40,6 +45,7 @@ __all__ = [
     "load_ephemeris",
     "load_timescale",
     "observation_geometry",
+    "orbit_trajectory",
     "parse_tle",
     "phase_angle_deg",
     "read_cpf",

@@ -16,7 +16,9 @@ Two things make a run's geometry quietly wrong while every number still looks fi
   along a low orbit).
 
 Each is one :class:`StaleInputWarning`, which the command line prints as a one-line
-``notice:`` on stderr, once per run (Python shows a warning once per message and place).
+``notice:`` on stderr, once per process: the same notice never twice, and the
+Earth-orientation one (:class:`EarthOrientationWarning`, whose counts differ from one run
+to the next, e.g. per site of ``speclight compare``) only the first time.
 """
 
 from __future__ import annotations
@@ -41,6 +43,11 @@ LEO_MIN_MEAN_MOTION_REV_PER_DAY = 11.25
 
 class StaleInputWarning(UserWarning):
     """An input (TLE, Earth-orientation table) is too old for the epochs of a run."""
+
+
+class EarthOrientationWarning(StaleInputWarning):
+    """Epochs lie past the end of the Earth-orientation and leap-second table: one table
+    serves the whole process, so the command line says so once."""
 
 
 def _day(t: np.datetime64 | NDArray[np.datetime64]) -> str:
@@ -122,7 +129,7 @@ def warn_tle_age(
 
 
 def warn_past_tables(time_utc: NDArray[np.datetime64]) -> None:
-    """Issue :func:`tables_notice` as a :class:`StaleInputWarning`, if there is one."""
+    """Issue :func:`tables_notice` as an :class:`EarthOrientationWarning`, if there is one."""
     notice = tables_notice(time_utc)
     if notice:
-        warnings.warn(notice, StaleInputWarning, stacklevel=2)
+        warnings.warn(notice, EarthOrientationWarning, stacklevel=2)

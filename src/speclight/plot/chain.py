@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import numpy as np
@@ -12,7 +13,9 @@ from speclight import schema as v
 from speclight.constants import HC_J_M
 from speclight.plot.style import band_styles, epoch_summary, flags, new_figure
 
-# Planck constant x speed of light [J m] (CODATA 2018, exact), for photons per joule.
+#: The name ``G-<centre_nm>/<sigma_nm>`` of a Gaussian band (``instrument.bands``): the second
+#: number is the standard deviation, not the FWHM, which the band panel's title says.
+GAUSSIAN_NAME = re.compile(r"^G-\d+(\.\d*)?/\d+(\.\d*)?$")
 
 
 def _row(ds: xr.Dataset, name: str, i: int) -> NDArray[np.float64]:
@@ -201,8 +204,10 @@ def _bands(ds: xr.Dataset, ax: Any, w: NDArray[np.float64], i: int) -> None:
         ax.fill_between(w, 0.0, dn, color=styles[b]["color"], alpha=0.25, lw=0)
         ax.plot(w, dn, lw=1.2, label=f"{name}: {rate:.3g} s$^{{-1}}$", **styles[b])
     ax.set_ylabel("photo-electron rate\ndensity [s$^{-1}$ nm$^{-1}$]")
+    gaussian = any(GAUSSIAN_NAME.match(str(name)) for name in ds["band"].values)
     ax.set_title(
-        "5. each band: flux × optics × QE × response × λ/hc (legend: count rate)",
+        "5. each band: flux × optics × QE × response × λ/hc (legend: count rate"
+        + ("; G-c/s: Gaussian, centre c, sigma s [nm], not FWHM)" if gaussian else ")"),
         loc="left",
         fontsize="medium",
     )

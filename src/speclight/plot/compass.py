@@ -86,8 +86,43 @@ def image_plane_directions(ds: xr.Dataset, k: int) -> dict[str, tuple[float, flo
 _COLOURS = {"N": "#4fc3f7", "Z": "#aed581", "☉": "#ffd54f"}
 
 
-def draw_compass(ax: Any, ds: xr.Dataset, k: int) -> list[str]:
-    """Arrows of north, zenith and the Sun in the upper-left corner of image ``k``'s axes.
+#: Arrow length of a direction across the line of sight, and the radius of the compass's
+#: backing disc [axes fraction].
+ARROW_LENGTH, DISC_RADIUS = 0.09, 0.125
+#: Gap between the disc and the image's edges [axes fraction].
+EDGE_GAP = 0.015
+
+
+def compass_centres() -> list[tuple[float, float]]:
+    """Centres the compass may take [axes fraction]: the four corners, upper left first."""
+    near, far = DISC_RADIUS + EDGE_GAP, 1.0 - DISC_RADIUS - EDGE_GAP
+    return [(near, far), (far, far), (near, near), (far, near)]
+
+
+def disc_pixels(centre: tuple[float, float], shape: tuple[int, int]) -> NDArray[np.bool_]:
+    """Pixels of an image of ``shape`` (row 0 at the top) whose centres lie under the
+    compass disc at ``centre`` [axes fraction]."""
+    ny, nx = shape
+    y = 1.0 - (np.arange(ny) + 0.5) / ny  # row 0 at the top (imshow's origin="upper")
+    x = (np.arange(nx) + 0.5) / nx
+    return (x[None, :] - centre[0]) ** 2 + (y[:, None] - centre[1]) ** 2 <= DISC_RADIUS**2
+
+
+def compass_centre(on_target: NDArray[np.bool_] | None) -> tuple[float, float]:
+    """The corner whose disc covers the fewest pixels of the target (the first on a tie)."""
+    corners = compass_centres()
+    if on_target is None or on_target.ndim != 2:
+        return corners[0]
+    covered = [int(np.count_nonzero(on_target & disc_pixels(c, on_target.shape))) for c in corners]
+    return corners[int(np.argmin(covered))]
+
+
+def draw_compass(
+    ax: Any, ds: xr.Dataset, k: int, on_target: NDArray[np.bool_] | None = None
+) -> list[str]:
+    """Arrows of north, zenith and the Sun in a corner of image ``k``'s axes: the corner
+    that covers the fewest of the ``on_target`` pixels (an image drawn to fill the axes,
+    row 0 at the top), else the upper left.
 
     Returns the names drawn (for the caption).
     """
@@ -96,13 +131,12 @@ def draw_compass(ax: Any, ds: xr.Dataset, k: int) -> list[str]:
         return []
     from matplotlib.patches import Circle
 
-    centre = np.array([0.15, 0.83])  # axes fraction
-    scale = 0.105
+    centre = np.array(compass_centre(on_target))
     ax.add_patch(
-        Circle(tuple(centre), scale + 0.04, transform=ax.transAxes, color="k", alpha=0.3, lw=0)
+        Circle(tuple(centre), DISC_RADIUS, transform=ax.transAxes, color="k", alpha=0.3, lw=0)
     )
     for name, (x, y) in dirs.items():
-        tip = centre + scale * np.array([x, y])
+        tip = centre + ARROW_LENGTH * np.array([x, y])
         ax.annotate(
             "",
             xy=tuple(tip),
@@ -110,7 +144,7 @@ def draw_compass(ax: Any, ds: xr.Dataset, k: int) -> list[str]:
             xycoords="axes fraction",
             arrowprops={"arrowstyle": "-|>", "color": _COLOURS[name], "lw": 1.6},
         )
-        label = centre + scale * np.array([x, y]) + 0.025 * np.array([x, y]) / np.hypot(x, y)
+        label = tip + 0.022 * np.array([x, y]) / np.hypot(x, y)
         ax.text(
             *label,
             name,

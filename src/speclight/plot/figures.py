@@ -4,9 +4,10 @@
 spectrogram, geometry: all on one UTC time axis) and, beside it, one file per other
 figure the dataset can fill: ``pass-chain.png`` (one epoch through the radiometric
 chain, on a wavelength axis), ``pass-images.png`` (saved images) and
-``pass-ranging.png`` (range histograms and offsets). Every file is rendered to a
-temporary name first and moved into place only when all have rendered; none is
-written if any target exists and ``force`` is not set.
+``pass-ranging.png`` (range histograms and offsets). The file named always holds the
+first figure written: with ``kinds=["chain"]`` the chain goes to ``pass.png`` itself.
+Every file is rendered to a temporary name first and moved into place only when all
+have rendered; none is written if any target exists and ``force`` is not set.
 
 To add a figure, append a :class:`FigureKind` to :data:`FIGURES`.
 """
@@ -23,6 +24,7 @@ from typing import Any
 import xarray as xr
 
 from speclight.errors import InputError, did_you_mean
+from speclight.input_files import check_user_file
 from speclight.io.output import create_new_file
 from speclight.plot.chain import chain_figure
 from speclight.plot.images import images_figure
@@ -119,12 +121,8 @@ def _kinds(kinds: Sequence[str] | None) -> list[FigureKind]:
                 f"unknown figure {k!r}{did_you_mean(k, KINDS)} (choices: {', '.join(KINDS)})",
                 field="--kind",
             )
-    if "overview" not in kinds:
-        raise InputError(
-            "the overview figure is always written (it is the main output file); "
-            f"add 'overview' to the figures asked for (choices: {', '.join(KINDS)})",
-            field="--kind",
-        )
+    if not kinds:
+        raise InputError(f"no figure asked for (choices: {', '.join(KINDS)})", field="--kind")
     return [f for f in FIGURES if f.name in kinds]
 
 
@@ -154,9 +152,15 @@ def plot_dataset(ds: xr.Dataset, *, epoch: int | str | None = None) -> Any:
 
 
 def figure_paths(output: Path, names: Sequence[str]) -> dict[str, Path]:
-    """File of each figure: the main ``output`` and ``<stem><suffix><ext>`` beside it."""
+    """File of each figure: ``output`` itself for the first of ``names``, and
+    ``<stem><suffix><ext>`` beside it for the others (``pass-chain.png``...)."""
     by_name = {f.name: f for f in FIGURES}
-    return {n: output.with_name(f"{output.stem}{by_name[n].suffix}{output.suffix}") for n in names}
+    return {
+        n: output
+        if i == 0
+        else output.with_name(f"{output.stem}{by_name[n].suffix}{output.suffix}")
+        for i, n in enumerate(names)
+    }
 
 
 def _check_output(output: Path) -> None:
@@ -174,12 +178,22 @@ def _check_output(output: Path) -> None:
         raise InputError(f"folder {output.parent} does not exist", field="--output")
 
 
+#: What h5py's messages about an unreadable file mean, for a one-line error.
+_HDF5_PROBLEMS = {
+    "file signature not found": "it is not a NetCDF4 (HDF5) file",
+    "truncated file": "it is cut short (truncated)",
+}
+
+
 def _load(dataset: Path) -> xr.Dataset:
+    check_user_file(dataset, what="dataset", max_bytes=None)  # missing, a folder, a FIFO...
     try:
         ds = xr.load_dataset(dataset, engine="h5netcdf")
     except (OSError, ValueError, TypeError, KeyError) as exc:
+        said = " ".join(str(exc).split())  # h5py's can span lines
+        why = next((w for key, w in _HDF5_PROBLEMS.items() if key in said), said)
         raise InputError(
-            f"cannot read it as a NetCDF dataset ({exc}); give a file written by "
+            f"cannot read it as a NetCDF dataset: {why}; give a file written by "
             "`speclight simulate`",
             source=str(dataset),
         ) from exc
@@ -230,8 +244,9 @@ def plot_files(
     dataset
         NetCDF file written by ``speclight simulate``.
     output
-        Main figure file (``.png``, ``.pdf``, ``.svg``...); the other figures go beside it
-        as ``<stem>-chain``, ``<stem>-images``, ``<stem>-ranging`` with the same extension.
+        Main figure file (``.png``, ``.pdf``, ``.svg``...): the first figure written (the
+        overview, unless ``kinds`` leaves it out); the others go beside it as
+        ``<stem>-chain``, ``<stem>-images``, ``<stem>-ranging`` with the same extension.
     force
         Overwrite existing files; otherwise an existing target is an error and nothing is
         written.
@@ -242,8 +257,9 @@ def plot_files(
         Band of the radiance images (default: the first band; the whole wavelength grid
         when the dataset has no bands).
     kinds
-        Figures to write (names in :data:`KINDS`); None for all that apply. A figure asked
-        for that the dataset cannot fill (images of a run that saved none...) is an error.
+        Figures to write (names in :data:`KINDS`, written in that order); None for all that
+        apply. A figure asked for that the dataset cannot fill (images of a run that saved
+        none...) is an error.
     dpi
         Resolution of raster formats [dots per inch].
     magnitude
@@ -306,6 +322,6 @@ def plot_file(
     Returns
     -------
     Path
-        The main (overview) figure file.
+        The main figure file, ``output`` (the overview unless ``kinds`` leaves it out).
     """
     return plot_files(dataset, output, force, epoch=epoch, band=band, kinds=kinds, dpi=dpi)[0]

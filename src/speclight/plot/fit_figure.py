@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.plot.style import new_figure
+from speclight.plot.style import new_figure, set_time_ticks
 
 F64 = NDArray[np.float64]
 #: Band ratios are drawn where the reference band's fitted rate is at least this fraction of
@@ -36,7 +36,6 @@ def fit_figure(
     band_names
         (B,) band names.
     """
-    import matplotlib.dates as mdates
     from matplotlib import colormaps
 
     fig = new_figure(7.0)
@@ -81,8 +80,7 @@ def fit_figure(
             lo, hi = np.percentile(finite, [0.5, 99.5])
             pad = 0.25 * (hi - lo) + 0.05 * abs(hi)
             bottom.set_ylim(lo - pad, hi + pad)
-    bottom.xaxis.set_major_locator(mdates.AutoDateLocator(minticks=5, maxticks=13))
-    bottom.xaxis.set_major_formatter(mdates.DateFormatter("%H:%M:%S"))
+    set_time_ticks(bottom)
     day = np.datetime_as_string(t[0], unit="D") if t.size else ""
     bottom.set_xlabel(f"time [UTC] on {day}")
     return fig

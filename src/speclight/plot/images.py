@@ -59,7 +59,7 @@ def _draw_parts(fig: Any, ax: Any, ds: xr.Dataset, k: int) -> str:
     )
     bar = fig.colorbar(im, ax=ax, ticks=np.arange(len(names)), shrink=0.85)
     bar.ax.set_yticklabels(names, fontsize="small")
-    return "part seen (grey: off target)"
+    return "part seen\n(grey: off target)"
 
 
 def _draw_dolp(fig: Any, ax: Any, ds: xr.Dataset, k: int, band: str | None) -> str:
@@ -82,7 +82,7 @@ def _draw_dolp(fig: Any, ax: Any, ds: xr.Dataset, k: int, band: str | None) -> s
     )
     fig.colorbar(im, ax=ax, label="DoLP [1]", shrink=0.85)
     where = f"in {band}" if band else "whole grid"
-    return f"degree of linear polarisation, {where} (grey: no signal)"
+    return f"degree of linear polarisation, {where}\n(grey: no signal)"
 
 
 def image_dolp(ds: xr.Dataset, k: int, band: str | None) -> NDArray[np.float64]:
@@ -102,15 +102,16 @@ def _caption(names: list[str]) -> str:
 
 
 def images_figure(ds: xr.Dataset, band: str | None) -> Any:
-    """One row per saved epoch: radiance in ``band`` (or the whole grid), its degree of
-    linear polarisation (when the images carry Stokes Q, U: ``render.polarization``),
-    depth map, and the part seen in each pixel (when the dataset names the parts).
+    """One row per saved epoch (at most :data:`MAX_IMAGE_ROWS`, titled with the epoch's
+    time and geometry): radiance in ``band`` (or the whole grid), its degree of linear
+    polarisation (when the images carry Stokes Q, U: ``render.polarization``), depth map,
+    and the part seen in each pixel (when the dataset names the parts).
 
     Pixel row 0 is the top of the image (the renderer's convention); axes are metres at
     the target, right and up as seen by the observer. The first image of each row carries a
-    compass (:mod:`speclight.plot.compass`): celestial north (N), the observer's zenith (Z)
-    and the Sun (☉) projected into the image plane, arrow length the sine of their angle
-    to the line of sight.
+    compass (:mod:`speclight.plot.compass`), in the corner that covers least of the
+    target: celestial north (N), the observer's zenith (Z) and the Sun (☉) projected into
+    the image plane, arrow length the sine of their angle to the line of sight.
     """
     from matplotlib import colormaps
     from matplotlib.colors import LogNorm
@@ -123,12 +124,16 @@ def images_figure(ds: xr.Dataset, band: str | None) -> Any:
         columns.insert(1, "image_dolp")
     if part_names(ds):
         columns.append("image_part")
-    fig = new_figure(height_in=0.8 + 3.6 * shown, width_in=4.6 * len(columns) + 0.6)
-    axes = np.atleast_2d(fig.subplots(shown, len(columns), squeeze=False))
+    figure = new_figure(height_in=0.8 + 3.9 * shown, width_in=4.6 * len(columns) + 0.6)
+    rows = np.atleast_1d(figure.subfigures(shown, 1))  # one per epoch, titled with it
+    axes = [row.subplots(1, len(columns), squeeze=False)[0] for row in rows]
     image_epochs = np.atleast_1d(ds["image_time"].values)
     time = ds["time"].values
+    name = ds.attrs.get("scenario_name", "speclight dataset")
     for k in range(shown):
         i = int(np.argmin(np.abs(time - image_epochs[k])))
+        fig = rows[k]
+        fig.suptitle(f"{name}: saved image {k + 1} of {n}, {epoch_summary(ds, i)}")
         for ax, col in zip(axes[k], columns, strict=True):
             if col in ("image_part", "image_dolp"):
                 what = (
@@ -136,7 +141,7 @@ def images_figure(ds: xr.Dataset, band: str | None) -> Any:
                     if col == "image_part"
                     else _draw_dolp(fig, ax, ds, k, band)
                 )
-                ax.set_title(f"{what}\n{epoch_summary(ds, i)}", fontsize="small")
+                ax.set_title(what, fontsize="small")
                 ax.set_xlabel("right [m]")
                 ax.set_ylabel("up [m]")
                 continue
@@ -148,7 +153,7 @@ def images_figure(ds: xr.Dataset, band: str | None) -> Any:
                 cmap = colormaps["inferno"].with_extremes(under="black", bad="0.85")
                 data = np.ma.masked_invalid(np.where(_on_target(ds, k, img), img, np.nan))
                 what = f"radiance in {band}" if band else "radiance, whole grid"
-                what += " (grey: off target)"
+                what += "\n(grey: off target)"
                 label = (
                     "∫ L R dλ [W m$^{-2}$ sr$^{-1}$]" if band else "∫ L dλ [W m$^{-2}$ sr$^{-1}$]"
                 )
@@ -170,7 +175,7 @@ def images_figure(ds: xr.Dataset, band: str | None) -> Any:
                     extent=_extent_m(ds, k, *depth.shape),
                     origin="upper",
                 )
-                what = "depth (grey: off target)"
+                what = "depth\n(grey: off target)"
                 label = "depth behind target centre [m]"
             fig.colorbar(
                 im,
@@ -179,13 +184,10 @@ def images_figure(ds: xr.Dataset, band: str | None) -> Any:
                 shrink=0.85,
                 extend="min" if col == "image_radiance" else "neither",
             )
-            ax.set_title(f"{what}\n{epoch_summary(ds, i)}", fontsize="small")
+            ax.set_title(what, fontsize="small")
             ax.set_xlabel("right [m]")
             ax.set_ylabel("up [m]")
-        drawn = draw_compass(axes[k][0], ds, k)
+        drawn = draw_compass(axes[k][0], ds, k, _on_target(ds, k, band_radiance(ds, k, band)))
         if drawn:
             axes[k][0].set_xlabel("right [m]; arrows: " + _caption(drawn))
-    name = ds.attrs.get("scenario_name", "speclight dataset")
-    more = f" (first {shown} of {n})" if n > shown else ""
-    fig.suptitle(f"{name}: saved images{more}")
-    return fig
+    return figure

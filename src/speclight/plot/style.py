@@ -7,6 +7,7 @@ current figure) of the caller.
 
 from __future__ import annotations
 
+import warnings
 from typing import Any
 
 import numpy as np
@@ -69,13 +70,45 @@ def utc_label(ds: xr.Dataset) -> str:
     return f"time [UTC] on {day}"
 
 
-def format_time_axis(ax: Any, ds: xr.Dataset, label: bool = True) -> None:
-    """HH:MM:SS UTC ticks; the date goes in the label."""
-    import matplotlib.dates as mdates
+#: Room one ``HH:MM:SS`` tick label takes along the axis, with the gap to the next one
+#: [em of the tick labels' font]: the label itself is about 4.5 em in DejaVu Sans (six
+#: digits of 0.64 em, two colons of 0.34 em).
+TIME_LABEL_PITCH_EM = 6.5
 
-    locator = mdates.AutoDateLocator(minticks=5, maxticks=13)
+
+def set_time_ticks(ax: Any) -> None:
+    """HH:MM:SS UTC ticks on the x axis of ``ax``, no more than fit side by side.
+
+    The number of ticks is chosen when the axes are drawn, from their width then (after
+    the layout), so the labels never run together (``02:20:0002:21:00`` on a 10-min pass).
+    """
+    import matplotlib.dates as mdates
+    from matplotlib import rcParams
+    from matplotlib.font_manager import FontProperties
+
+    class FittingLocator(mdates.AutoDateLocator):
+        def __call__(self) -> Any:
+            axes = getattr(self.axis, "axes", None)  # None before the locator is on an axis
+            if axes is not None:
+                width_pt = axes.get_window_extent().width * 72.0 / axes.figure.dpi
+                font = FontProperties(size=rcParams["xtick.labelsize"])
+                fitting = int(width_pt / (TIME_LABEL_PITCH_EM * font.get_size_in_points()))
+                self.maxticks = dict.fromkeys(self.maxticks, max(fitting, self.minticks))
+            with warnings.catch_warnings():  # too narrow for any step: it takes the longest
+                warnings.filterwarnings("ignore", "AutoDateLocator was unable", UserWarning)
+                return super().__call__()
+
+    locator = FittingLocator(minticks=3)
+    # steps of 2 and 20 besides matplotlib's 1, 5, 10, 15, 30: 5 ticks on a 10-min pass
+    locator.intervald[mdates.MINUTELY] = [1, 2, 5, 10, 15, 30]
+    locator.intervald[mdates.SECONDLY] = [1, 2, 5, 10, 15, 20, 30]
     ax.xaxis.set_major_locator(locator)
     ax.xaxis.set_major_formatter(mdates.DateFormatter("%H:%M:%S"))
+
+
+def format_time_axis(ax: Any, ds: xr.Dataset, label: bool = True) -> None:
+    """HH:MM:SS UTC ticks (:func:`set_time_ticks`); the date goes in the label."""
+    set_time_ticks(ax)
     if label:
         ax.set_xlabel(utc_label(ds))
 

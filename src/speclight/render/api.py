@@ -12,6 +12,7 @@ from speclight.errors import InputError
 from speclight.progress import stage
 from speclight.render.epoch_inputs import EpochInputs, epoch_inputs, irradiance_rows, unit_rows
 from speclight.render.polarization import rotate_linear, scattering_angle_on_sky
+from speclight.render.raycast import numpy_processes
 from speclight.render.result import RenderImage, RenderResult
 from speclight.render.session import RenderMode, RenderSession
 from speclight.target.parts import Target
@@ -68,8 +69,9 @@ def render_intensity(
         ``"numpy"`` or a ``scalar_*`` variant casts single-mode rays with numpy. Ignored when
         ``session`` is given.
     workers
-        Single mode with the numpy caster: number of processes over blocks of epochs.
-        Dr.Jit variants are already parallel over all cores and ignore it.
+        Single mode with the numpy caster: number of processes over blocks of epochs (fewer
+        where :func:`~speclight.render.raycast.numpy_processes` says so: one inside a Dask
+        worker). Dr.Jit variants are already parallel over all cores and ignore it.
     progress
         Show a progress bar (on a terminal).
     keep_images_for
@@ -173,7 +175,7 @@ def _render_single(
     """Single mode on the valid epochs: in this process, or the numpy caster in several."""
     v = inputs.valid
     sun, obs, e, polarization = inputs.sun[v], inputs.obs[v], inputs.e[v], inputs.pole is not None
-    n_workers = int(workers or 1)
+    n_workers = numpy_processes(int(workers or 1))  # one inside a Dask worker
     multi = n_workers > 1 and on_hits is None
     if multi and not session.variant.startswith(("llvm_", "cuda_")) and len(v) > 1:
         # Dr.Jit variants already use every core; the numpy caster runs one process per

@@ -4,17 +4,26 @@ Both casters answer the same two questions for arrays of rays: the first hit (di
 geometric normal, part index) and whether a ray is blocked (shadow test). The numpy caster is
 an independent implementation (Möller & Trumbore 1997, doi:10.1080/10867651.1997.10487468,
 for triangles; the quadratic for spheres) used without Mitsuba, with scalar variants, and to
-cross-check the Mitsuba one.
+cross-check the Mitsuba one. It may run in several processes over blocks of epochs
+(:func:`numpy_processes` says how many a process may start).
+
+A Mitsuba caster's scene belongs to the variant it was built in, while Mitsuba's variant is
+process-wide: a caster kept for later (a reflectivity map's engine, cached per process) may
+meet another variant set by a render in between (a path-mode map), so each of its calls sets
+its own variant again.
 """
 
 from __future__ import annotations
 
+import multiprocessing
+import os
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
+from speclight.render.variant import activate, render_threads
 from speclight.target.parts import Target
 
 F64 = NDArray[np.float64]
@@ -171,12 +180,24 @@ class NumpyCaster:
         return np.isfinite(np.minimum(t_tri, t_sph))
 
 
+def numpy_processes(requested: int | None) -> int:
+    """Processes the numpy ray caster may run in, at most ``requested`` (``None``: the cores).
+
+    One inside a daemonic process (a Dask worker, a pool's worker: such a process cannot
+    start others); at most ``SPECLIGHT_RENDER_THREADS`` where it gives this process's share of
+    the cores (each worker of a local Dask cluster); at least one.
+    """
+    if multiprocessing.current_process().daemon:
+        return 1
+    n = int(requested) if requested is not None else os.cpu_count() or 1
+    share = render_threads()
+    return max(1, min(n, share) if share is not None else n)
+
+
 class MitsubaCaster:
     """Ray casting with Mitsuba's vectorised ``ray_intersect`` / ``ray_test`` (llvm or cuda)."""
 
     def __init__(self, target: Target, variant: str) -> None:
-        from speclight.render.variant import activate
-
         mi = activate(variant)
         import drjit as dr
 
@@ -223,7 +244,7 @@ class MitsubaCaster:
         self.scene = mi.load_dict({"type": "scene", **shapes})
 
     def _rays(self, origin: F64, direction: F64):  # type: ignore[no-untyped-def]
-        mi = self.mi
+        mi = activate(self.name)  # the scene's variant, whatever ran since (module doc)
         o = np.ascontiguousarray(origin.T, dtype=np.float32)
         d = np.ascontiguousarray(direction.T, dtype=np.float32)
         return mi.Ray3f(mi.Point3f(o), mi.Vector3f(d))

@@ -7,6 +7,12 @@ besides ``speclight info``), and every render of the run activates that same var
 usable libLLVM (>= 16) is found, else ``scalar_*``.
 libLLVM must be chosen before Dr.Jit is first imported (``DRJIT_LIBLLVM_PATH``); version 15
 crashes Mitsuba's LLVM variants and is never used.
+
+``SPECLIGHT_HIDE_LLVM=1`` in the environment makes a process behave as on a machine without
+libLLVM 16-19 (the documented fallback: ``scalar_*`` variants and the numpy ray caster). It is
+read by :func:`find_libllvm`, so every process honours it, Dask workers included: a local
+cluster's workers inherit the environment of the process that starts them; the workers of an
+existing cluster need it in the shell that starts them.
 """
 
 from __future__ import annotations
@@ -26,6 +32,11 @@ from speclight.errors import InputError, did_you_mean
 
 #: libLLVM versions known to work with Dr.Jit 1.x, best first.
 _LLVM_OK = (19, 18, 17, 16)
+#: Environment variable: ``1`` hides every libLLVM (the LLVM backend is then unavailable).
+HIDE_LLVM_ENV = "SPECLIGHT_HIDE_LLVM"
+#: Environment variable: Dr.Jit threads (and numpy ray-caster processes) of one process, set
+#: for each worker of a local Dask cluster (its share of the cores).
+RENDER_THREADS_ENV = "SPECLIGHT_RENDER_THREADS"
 _LLVM_DIRS = (
     "/usr/lib/x86_64-linux-gnu",
     "/usr/lib64",
@@ -37,8 +48,22 @@ _LLVM_DIRS = (
 )
 
 
+def llvm_hidden() -> bool:
+    """True when ``SPECLIGHT_HIDE_LLVM`` is set (to anything but ``0`` or nothing)."""
+    return os.environ.get(HIDE_LLVM_ENV, "").strip() not in ("", "0")
+
+
+def render_threads() -> int | None:
+    """This process's share of the cores (``SPECLIGHT_RENDER_THREADS``), or ``None``."""
+    threads = os.environ.get(RENDER_THREADS_ENV, "").strip()
+    return int(threads) if threads.isdigit() and int(threads) > 0 else None
+
+
 def find_libllvm() -> str | None:
-    """Path of a libLLVM shared library with version 16-19, or ``None``."""
+    """Path of a libLLVM shared library with version 16-19, or ``None`` (also when
+    ``SPECLIGHT_HIDE_LLVM`` hides it)."""
+    if llvm_hidden():
+        return None
     env = os.environ.get("DRJIT_LIBLLVM_PATH")
     if env and os.path.exists(env) and _llvm_version(env) in _LLVM_OK:
         return env
@@ -102,9 +127,9 @@ def _backends() -> tuple[bool, bool]:
                 import drjit  # noqa: F401
     import drjit as dr
 
-    threads = os.environ.get("SPECLIGHT_RENDER_THREADS", "")
-    if threads.isdigit() and int(threads) > 0:  # a Dask worker's share of the cores
-        dr.set_thread_count(int(threads))
+    threads = render_threads()
+    if threads is not None:  # a Dask worker's share of the cores
+        dr.set_thread_count(threads)
     cuda = bool(dr.has_backend(dr.JitBackend.CUDA))
     llvm = bool(llvm_path) and bool(dr.has_backend(dr.JitBackend.LLVM))
     return cuda, llvm
@@ -120,8 +145,14 @@ def engine_versions() -> dict[str, str]:
             out[pkg] = version(pkg)
         except PackageNotFoundError:
             out[pkg] = "not installed"
-    out["libllvm"] = find_libllvm() or "not found (LLVM variants unavailable)"
+    out["libllvm"] = libllvm_status()
     return out
+
+
+def libllvm_status() -> str:
+    """The libLLVM used, or why there is none (for ``speclight info``)."""
+    missing = f"hidden by {HIDE_LLVM_ENV}" if llvm_hidden() else "not found"
+    return find_libllvm() or f"{missing} (LLVM variants unavailable)"
 
 
 def available_variants() -> list[str]:

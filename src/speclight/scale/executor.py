@@ -12,7 +12,9 @@ Scheduler addresses (``--scheduler``):
 * ``none`` (or ``serial``): in this process, one item after the other;
 * ``local`` (the default): a new :class:`distributed.LocalCluster` on this machine, on the
   loopback interface, one worker process per core with one Dask thread each, and Dr.Jit's
-  thread pool in each worker sized so that the workers together use the cores once;
+  thread pool in each worker sized so that the workers together use the cores once; never
+  more workers than cores, nor than the memory limit holds tasks of their estimated size
+  (:func:`local_workers`);
 * ``tcp://HOST:PORT`` (or any address :class:`distributed.Client` accepts): an existing
   cluster (``dask scheduler`` + ``dask worker`` with the same speclight installed).
 
@@ -108,6 +110,36 @@ def error_text(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {exc}".replace("\n", " ").strip()
 
 
+def local_workers(
+    requested: int | None, task_bytes: int = 0, limit_bytes: int | None = None
+) -> tuple[int, str | None]:
+    """Workers of a local cluster: ``requested`` (default: the cores), at most the cores and
+    at most as many tasks of ``task_bytes`` (their estimated peak memory) as the memory limit
+    (:func:`speclight.simulate.memory.memory_limit_bytes`) holds; at least one.
+
+    Returns the count and, when it is below what was asked, a one-line note saying why.
+    """
+    from speclight.simulate.memory import memory_limit_bytes
+
+    cores = os.cpu_count() or 1
+    asked = max(1, int(requested or cores))
+    limit = memory_limit_bytes() if limit_bytes is None else int(limit_bytes)
+    by_memory = max(1, limit // task_bytes) if task_bytes > 0 else asked
+    workers = min(asked, cores, by_memory)
+    if workers == asked:
+        return workers, None
+    why = []
+    if cores < asked:
+        why.append(f"{cores} cores here")
+    if by_memory < asked:
+        why.append(
+            f"memory for {by_memory} tasks of {task_bytes / 1024**3:.3g} GiB under the limit "
+            f"of {limit / 1024**3:.3g} GiB"
+        )
+    shown = f"--workers {asked}" if requested else f"{asked} workers (one per core)"
+    return workers, f"{shown}: using {workers} ({'; '.join(why)})"
+
+
 @contextmanager
 def open_executor(
     scheduler: str | None = "local",
@@ -115,6 +147,7 @@ def open_executor(
     n_workers: int | None = None,
     announce: bool = False,
     connect_timeout_s: float = 10.0,
+    task_bytes: int = 0,
 ) -> Iterator[Executor]:
     """The executor for a ``--scheduler`` value (see the module docstring).
 
@@ -123,11 +156,14 @@ def open_executor(
     scheduler
         ``none``/``serial``, ``local`` (or ``None``) or a scheduler address.
     n_workers
-        Workers of a local cluster (default: the cores of this machine).
+        Workers of a local cluster (default: the cores of this machine; capped by
+        :func:`local_workers`).
     announce
         Print one line on stderr: where the work runs and the dashboard address.
     connect_timeout_s
         How long to wait for an existing scheduler to answer.
+    task_bytes
+        The estimated peak memory of one task [bytes] (0: unknown).
     """
     name = (scheduler or "local").strip()
     if name.lower() in SERIAL_NAMES:
@@ -144,7 +180,9 @@ def open_executor(
     cluster = None
     if name.lower() in LOCAL_NAMES:
         cores = os.cpu_count() or 1
-        workers = max(1, int(n_workers or cores))
+        workers, note = local_workers(n_workers, task_bytes)
+        if note and announce:
+            print(note, file=sys.stderr)
         threads = max(1, cores // workers)
         with _lean_worker_defaults():
             cluster = LocalCluster(

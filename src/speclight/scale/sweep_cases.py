@@ -60,6 +60,8 @@ class SweepPlan:
     sha256: str
     #: Some case has ``render.polarization``: the store keeps ``dolp`` and ``aolp``.
     polarization: bool = False
+    #: The largest estimated peak memory of a case [bytes] (one case per worker at a time).
+    case_bytes: int = 0
 
 
 def load_base(spec: SweepSpec) -> LoadedScenario:
@@ -98,6 +100,7 @@ def plan_sweep(spec: SweepSpec, base: LoadedScenario | None = None) -> SweepPlan
     tasks: list[CaseTask] = []
     first: Scenario | None = None
     noise = polarization = False
+    case_bytes = 0
     for i, case in enumerate(values):
         data = copy.deepcopy({k: v for k, v in fixed_data.items() if k in varied_sections})
         for f in spec.fields:
@@ -112,11 +115,14 @@ def plan_sweep(spec: SweepSpec, base: LoadedScenario | None = None) -> SweepPlan
         source = f"{spec.source} case {i}"
         try:
             check_engines(sc, source)
-            check_run_limits(LoadedScenario(sc, "", source, base.base_dir), grid_epochs(sc))
+            estimate = check_run_limits(
+                LoadedScenario(sc, "", source, base.base_dir), grid_epochs(sc)
+            )
         except InputError as exc:
             raise InputError(
                 f"case {i} ({_shown(case)}): {exc.message}", source=spec.source, field=exc.field
             ) from None
+        case_bytes = max(case_bytes, estimate.total_bytes)
         # JSON is YAML: the worker reads it with the scenario loader (and fast)
         text = json.dumps({**fixed_data, **data}, default=str)
         tasks.append(CaseTask(i, text, source, str(base.base_dir), spec.spectra))
@@ -153,6 +159,7 @@ def plan_sweep(spec: SweepSpec, base: LoadedScenario | None = None) -> SweepPlan
         noise,
         sha,
         polarization,
+        case_bytes,
     )
 
 

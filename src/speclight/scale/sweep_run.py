@@ -11,6 +11,7 @@ per worker (:func:`~speclight.scale.worker_cached`).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import hashlib
 import os
@@ -23,8 +24,10 @@ from typing import Any
 import numpy as np
 
 from speclight.errors import InputError
+from speclight.orbit.orbit_sources import file_keys
 from speclight.scale import sweep_store as store
 from speclight.scale.executor import open_executor
+from speclight.scale.store_io import check_free_space, store_lock, store_writes
 from speclight.scale.sweep_cases import CaseTask, SweepPlan
 from speclight.scale.worker_cache import worker_cached
 from speclight.scenario import LoadedScenario, parse_scenario
@@ -48,12 +51,21 @@ class SweepRun:
     complete: bool = False
     seconds: float = 0.0
     where: str = ""
+    #: Cases marked done whose data did not read back (a chunk file cut short): run again.
+    damaged: list[int] = field(default_factory=list)
+
+    @property
+    def exit_code(self) -> int:
+        """1 when every case of the sweep file failed (nothing to read), else 0: failed cases
+        are data (their rows are NaN, ``error(case)`` says why; the command line has only
+        exit codes 0, 1 and 2: a partly failed batch is flagged row by row, not by its code)."""
+        return 1 if self.failed and len(self.failed) >= self.n_cases else 0
 
 
 def _geometry_key(loaded: LoadedScenario) -> str:
     sc = loaded.scenario
     parts = [sc.model_dump_json(include=GEOMETRY_SECTIONS), str(loaded.base_dir)]
-    for name in ("tle_file", "cpf_file", "ephemeris_file"):
+    for name in sorted(file_keys()):  # every orbit source that reads a file
         value = getattr(sc.orbit, name)
         if value:  # a file edited between two sweeps on a long-lived worker is read again
             try:
@@ -131,28 +143,38 @@ def run_sweep(
     if plan.base.source and Path(plan.base.source).exists():
         inputs["base scenario"] = Path(plan.base.source)
     path = store.check_store_path(output, inputs)
-    from speclight.estimate.reflectivity_map_store import store_lock
-
     started = time.perf_counter()
     with store_lock(path):
-        group, start, _ = store.open_store(path, plan, force=force, append=append)
+        with store_writes(path):
+            group, start, _ = store.open_store(path, plan, force=force, append=append)
         run = SweepRun(path, len(plan.tasks), start)
         state = store.states(group)[start : start + len(plan.tasks)]
+        run.damaged = store.damaged_cases(group, start + np.flatnonzero(state == store.DONE))
+        state[np.asarray(run.damaged, dtype=np.int64) - start] = store.TODO  # run them again
         todo = [
             dataclasses.replace(t, index=start + t.index)
             for t in plan.tasks
             if state[t.index] != store.DONE
         ]
+        check_free_space(path, len(todo) * store.case_bytes(plan), "the sweep", "the cases")
         run.skipped = len(plan.tasks) - len(todo)
         failed_before = {start + int(i) for i in np.flatnonzero(state == store.FAILED)}
         writer = store.CaseWriter(group, failed_before)
         try:
             if todo:
-                with open_executor(scheduler, n_workers=n_workers, announce=announce) as ex:
+                with open_executor(
+                    scheduler, n_workers=n_workers, announce=announce, task_bytes=plan.case_bytes
+                ) as ex:
                     run.where = ex.description
                     for outcome in ex.run(task, todo, label="cases", progress=progress):
-                        _write(writer, plan, outcome, run)
-        finally:
+                        with store_writes(path):
+                            _write(writer, plan, outcome, run)
+        except BaseException:  # keep what was done (a full disk may refuse this too)
+            with contextlib.suppress(OSError):
+                writer.flush()
+                store.finish(path, group)
+            raise
+        with store_writes(path):
             writer.flush()
             run.complete = store.finish(path, group)
         errors = store.errors(group, start, start + len(plan.tasks))

@@ -38,6 +38,7 @@ import numpy as np
 from speclight import schema
 from speclight.errors import InputError
 from speclight.io import zarr_store_path
+from speclight.scale.store_io import readable
 from speclight.scale.sweep_cases import SweepPlan
 
 FIELD = "--output"
@@ -59,12 +60,14 @@ def open_store(path: Path, plan: SweepPlan, *, force: bool, append: bool) -> tup
 
     A store holding a segment with the plan's cases (same ``sha256``) is resumed; with
     ``append``, a store of the same fields, axes and base gets the plan's cases after its
-    own; anything else is refused unless ``force`` (which replaces it).
+    own; anything else is refused unless ``force`` (which replaces it). A store whose
+    creation did not finish (an empty folder, or no segment recorded yet, e.g. on a full
+    disk) holds no case and is created again.
     """
     import zarr
 
     group: Any
-    if path.exists() and force:
+    if path.exists() and (force or _unfinished_creation(path)):
         if any(path.iterdir()) and _format_of(path) != FORMAT_NAME:
             raise InputError(
                 f"{path} is a folder but not a speclight sweep store; --force replaces only "
@@ -73,7 +76,10 @@ def open_store(path: Path, plan: SweepPlan, *, force: bool, append: bool) -> tup
             )
         shutil.rmtree(path)
     if not path.exists() or not any(path.iterdir()):
-        group = zarr.open_group(str(path), mode="w", zarr_format=3)
+        # the format first: a store cut short by a full disk is still known as a sweep's
+        group = zarr.open_group(
+            str(path), mode="w", zarr_format=3, attributes={"format": FORMAT_NAME}
+        )
         _create(group, plan)
         _add_segment(group, plan)
         return group, 0, True
@@ -99,12 +105,28 @@ def open_store(path: Path, plan: SweepPlan, *, force: bool, append: bool) -> tup
     return group, start, True
 
 
-def _format_of(path: Path) -> str | None:
+def _attributes(path: Path) -> dict[str, Any]:
     try:
-        meta = json.loads((path / "zarr.json").read_text())
-        return str(meta.get("attributes", {}).get("format"))
+        attrs = json.loads((path / "zarr.json").read_text()).get("attributes", {})
     except (OSError, ValueError, AttributeError):
-        return None
+        return {}
+    return attrs if isinstance(attrs, dict) else {}
+
+
+def _format_of(path: Path) -> str | None:
+    value = _attributes(path).get("format")
+    return None if value is None else str(value)
+
+
+def _unfinished_creation(path: Path) -> bool:
+    """A sweep store without a recorded segment (see :func:`open_store`)."""
+    attrs = _attributes(path)
+    return attrs.get("format") == FORMAT_NAME and not attrs.get("segments")
+
+
+def _segments_end(group: Any) -> int:
+    """The first case after the recorded segments (an append cut short left more rows)."""
+    return max((int(s["start"]) + int(s["n_cases"]) for s in group.attrs["segments"]), default=0)
 
 
 def _param_dtype(values: list[Any]) -> str:
@@ -228,8 +250,9 @@ def _check_compatible(group: Any, plan: SweepPlan, path: Path) -> None:
 
 
 def _add_segment(group: Any, plan: SweepPlan) -> int:
-    """Resize the per-case arrays for the plan's cases and write their parameters."""
-    start = int(group["case"].shape[0])
+    """Resize the per-case arrays for the plan's cases and write their parameters; the
+    segment is recorded last (a store is resumed from its segments)."""
+    start = _segments_end(group)
     stop = start + len(plan.tasks)
     nt, nb = plan.time_utc.size, len(plan.band_names)
     for name in _curves(plan):  # a noisy or polarised segment appended to a store without
@@ -305,6 +328,28 @@ class CaseWriter:
 
 def states(group: Any) -> np.ndarray:
     return np.asarray(group["case_state"][...], dtype=np.uint8)
+
+
+def damaged_cases(group: Any, cases: np.ndarray) -> list[int]:
+    """Cases among ``cases`` (marked done) whose per-case arrays do not read back (a chunk
+    file cut short: :func:`speclight.scale.store_io.readable`); the caller runs them again."""
+    arrays = [group[name] for name in (*CURVES, *SPECTRA) if name in group]
+    bad: list[int] = []
+    for lo in range(0, cases.size, SMALL_CHUNK):  # a block at once, one by one where it fails
+        block = cases[lo : lo + SMALL_CHUNK]
+        if block.size and readable(arrays, slice(int(block[0]), int(block[-1]) + 1)):
+            continue
+        bad += [int(i) for i in block if not readable(arrays, slice(int(i), int(i) + 1))]
+    return bad
+
+
+def case_bytes(plan: SweepPlan) -> int:
+    """The data of one case in the store, uncompressed [bytes]."""
+    nt = plan.time_utc.size
+    n = len(_curves(plan)) * nt * len(plan.band_names) * 8
+    if plan.spec.spectra:
+        n += len(SPECTRA) * nt * plan.wavelength_nm.size * 4
+    return n
 
 
 def finish(path: Path, group: Any) -> bool:

@@ -20,6 +20,7 @@ from pydantic import BaseModel, ValidationError
 from speclight.errors import InputError, did_you_mean
 from speclight.input_files import read_user_text
 from speclight.scenario.engines import check_engines
+from speclight.scenario.plausibility import warn_implausible_values
 from speclight.scenario.scenario_model import Scenario
 
 #: Largest scenario file read [bytes]; scenarios are a few kB (tables live in their own files).
@@ -132,6 +133,7 @@ def parse_scenario(
     except ValidationError as exc:
         raise InputError(_describe(exc, data, root), source=source) from None
     check_engines(scenario, source)  # a missing engine is reported now, not after rendering
+    warn_implausible_values(scenario)  # notices for values in a likely wrong unit
     loaded = LoadedScenario(
         scenario, text, source, base_dir or Path.cwd(), as_read=scenario.model_copy(deep=True)
     )
@@ -285,6 +287,9 @@ def _describe(exc: ValidationError, data: dict[str, Any], root: Any) -> str:
             path = [*path, loc[-1]] if path[-1:] != [loc[-1]] else path
         else:
             msg = err["msg"].removeprefix("Value error, ")
+            section, _, rest = msg.partition(": ")
+            if not loc and section in Scenario.model_fields:  # a rule between sections
+                path, msg = [section], rest  # names the section it is about first
             shown = "" if isinstance(value, dict) else f" = {value!r}"
             message = f"{shown}: {msg}" if shown else f": {msg}"
         field = ".".join(str(p) for p in path) or "(top level)"

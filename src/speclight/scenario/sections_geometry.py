@@ -12,6 +12,8 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
+from speclight.orbit.orbit_sources import ORBIT_SOURCES, orbit_problem
+
 MAX_EPOCHS = 10_000_000
 #: Span of the JPL DE421 ephemeris shipped in skyfield-data (``de421.bsp``: every segment
 #: covers Julian dates 2414864.5 .. 2471184.5 TDB, 1899-07-29 .. 2053-10-09; Folkner et al.
@@ -32,6 +34,10 @@ def _utc_of_jd(jd: float) -> datetime:
 #: First and last accepted epoch of a time window (UTC).
 FIRST_EPOCH_UTC = _utc_of_jd(EPHEMERIS_SPAN_TDB_JD[0]) + EPHEMERIS_MARGIN
 LAST_EPOCH_UTC = _utc_of_jd(EPHEMERIS_SPAN_TDB_JD[1]) - EPHEMERIS_MARGIN
+
+
+def _source(key: str) -> str:
+    return ORBIT_SOURCES[key].description
 
 
 class Strict(BaseModel):
@@ -126,40 +132,25 @@ class Telescope(Strict):
 
 
 class Orbit(Strict):
-    """Exactly one source of the target's trajectory."""
+    """Exactly one source of the target's trajectory: a key of
+    :data:`speclight.orbit.orbit_sources.ORBIT_SOURCES`, with that source's options."""
 
-    tle: str | None = Field(default=None, description="Two- or three-line element set")
-    tle_file: str | None = Field(default=None, description="File of TLEs; pick one by norad_id")
+    tle: str | None = Field(default=None, description=_source("tle"))
+    tle_file: str | None = Field(default=None, description=_source("tle_file"))
     norad_id: int | None = Field(default=None, ge=1, description="Catalogue number in tle_file")
-    cpf_file: str | None = Field(default=None, description="ILRS CPF prediction (v1 or v2)")
-    ephemeris_file: str | None = Field(default=None, description="CSV: time_utc, x, y, z")
-    oem_file: str | None = Field(default=None, description="CCSDS OEM, KVN or XML")
+    cpf_file: str | None = Field(default=None, description=_source("cpf_file"))
+    ephemeris_file: str | None = Field(default=None, description=_source("ephemeris_file"))
+    oem_file: str | None = Field(default=None, description=_source("oem_file"))
     object: str | None = Field(default=None, description="OBJECT_NAME or OBJECT_ID in oem_file")
-    sp3_file: str | None = Field(default=None, description="IGS SP3-c or SP3-d precise orbit")
+    sp3_file: str | None = Field(default=None, description=_source("sp3_file"))
     satellite: str | None = Field(default=None, description="Vehicle id in sp3_file, e.g. G01")
-
-    observed: bool = Field(
-        default=False,
-        description="No orbit: `speclight compare` places the target where each "
-        "observation saw it (elevation_deg, azimuth_deg, range_m or height_m)",
-    )
+    observed: bool = Field(default=False, description=_source("observed"))
 
     @model_validator(mode="after")
     def _exactly_one(self) -> Orbit:
-        sources = ("tle", "tle_file", "cpf_file", "ephemeris_file", "oem_file", "sp3_file")
-        given = [k for k in sources if getattr(self, k)]
-        given += ["observed"] if self.observed else []
-        if len(given) != 1:
-            raise ValueError(
-                f"give exactly one of {', '.join(sources)}, observed: true "
-                f"(found {', '.join(given) if given else 'none'})"
-            )
-        if self.norad_id is not None and not self.tle_file:
-            raise ValueError("norad_id selects a TLE from tle_file; it needs tle_file")
-        if self.object is not None and not self.oem_file:
-            raise ValueError("object selects an object of oem_file; it needs oem_file")
-        if self.satellite is not None and not self.sp3_file:
-            raise ValueError("satellite selects a satellite of sp3_file; it needs sp3_file")
+        problem = orbit_problem(self.model_dump())
+        if problem is not None:
+            raise ValueError(problem)
         return self
 
 

@@ -191,6 +191,7 @@ _SHAPE_SIZES: dict[str, tuple[str, ...]] = {
         "wing_gap_m",
         "dish_radius_m",
         "dish_depth_m",
+        "dish",
     ),
     "bus_array": ("bus_size_m", "array_size_m", "array_gap_m"),
 }
@@ -221,6 +222,7 @@ class Shape(Strict):
     wing_gap_m: float | None = Field(default=None, ge=0)
     dish_radius_m: float | None = Field(default=None, gt=0)
     dish_depth_m: float | None = Field(default=None, gt=0)
+    dish: bool | None = Field(default=None, description="box_wing: false leaves out the dish")
     array_size_m: Annotated[list[float], Field(min_length=2, max_length=2)] | None = None
     array_gap_m: float | None = Field(default=None, ge=0)
 
@@ -247,6 +249,8 @@ class Shape(Strict):
                 f"builtin '{self.builtin}' takes {', '.join(_SHAPE_SIZES[self.builtin])}, "
                 f"not {', '.join(extra)}"
             )
+        if self.dish is False and (self.dish_radius_m or self.dish_depth_m):
+            raise ValueError("dish: false leaves out the dish; drop dish_radius_m, dish_depth_m")
         _check_scale(self.builtin, {k: getattr(self, k) for k in sizes})
         return self
 
@@ -515,6 +519,14 @@ class Render(Strict):
 SpectralCurve = float | str | ReflectanceFile
 
 
+def _fraction(value: SpectralCurve | None) -> SpectralCurve | None:
+    """A curve given as one number must be a fraction (checked at load, as the instrument
+    stage would at run time: a sweep validates every case up front)."""
+    if isinstance(value, float | int) and not 0.0 <= float(value) <= 1.0:
+        raise ValueError(f"{value!r} must be a fraction in 0..1 (write 0.85, not 85)")
+    return value
+
+
 class GaussianBand(Strict):
     # the instrument stage's bound (a band wider than 100 um is flat across any grid)
     center_nm: float = Field(gt=0, le=MAX_GAUSSIAN_NM)
@@ -529,6 +541,7 @@ class Band(Strict):
     detector_qe: SpectralCurve | None = Field(
         default=None, description="This band's detector, if not instrument.detector_qe"
     )
+    _qe_fraction = field_validator("detector_qe")(_fraction)
 
     @model_validator(mode="after")
     def _one(self) -> Band:
@@ -572,3 +585,4 @@ class Instrument(Strict):
     exposure_s: float = Field(default=1.0, gt=0, le=MAX_EXPOSURE_S)
     bands: list[Band] = Field(default_factory=list)
     noise: Noise | None = None
+    _fractions = field_validator("optics_transmission", "detector_qe")(_fraction)

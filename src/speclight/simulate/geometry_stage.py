@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -14,9 +12,8 @@ from speclight import orbit
 from speclight import schema as v
 from speclight.constants import C_M_S
 from speclight.errors import InputError
-from speclight.orbit.oem import oem_position_gcrs_m, read_oem
-from speclight.orbit.sp3 import read_sp3, sp3_position_gcrs_m
-from speclight.orbit.staleness import warn_past_tables, warn_tle_age
+from speclight.orbit.orbit_sources import Trajectory, no_position_message, orbit_trajectory
+from speclight.orbit.staleness import warn_past_tables
 from speclight.orbit.timescale import time_from_utc
 from speclight.scenario import LoadedScenario
 from speclight.scenario.sections_attitude import (
@@ -81,36 +78,10 @@ def time_grid(grid: TimeGrid) -> NDArray[np.datetime64]:
     return start + offsets_ns
 
 
-Trajectory = Callable[[Any], tuple[NDArray[np.float64], NDArray[np.bool_]]]
-
-
 def _trajectory(loaded: LoadedScenario, time_utc: NDArray[np.datetime64]) -> Trajectory:
-    """Read the orbit source once; return ``t -> (r_gcrs_m (N, 3), ok (N,))``."""
-    cfg = loaded.scenario.orbit
-    if cfg.tle is not None or cfg.tle_file is not None:
-        if cfg.tle is not None:
-            tle = orbit.parse_tle(cfg.tle, source=f"{loaded.source}: orbit.tle")
-        else:
-            assert cfg.tle_file is not None
-            # of several element sets of the object, the one nearest the middle of the window
-            middle = time_utc[0] + (time_utc[-1] - time_utc[0]) / 2
-            tle = orbit.read_tle_file(
-                loaded.resolve(cfg.tle_file), norad_id=cfg.norad_id, near_epoch=middle
-            )
-        warn_tle_age(tle.epoch, time_utc, float(tle.line2[52:63]))  # mean motion [rev/day]
-        return lambda t: orbit.tle_position_gcrs_m(tle, t)
-    if cfg.cpf_file is not None:
-        cpf = orbit.read_cpf(loaded.resolve(cfg.cpf_file))
-        return lambda t: orbit.cpf_position_gcrs_m(cpf, t)
-    if cfg.oem_file is not None:
-        oem = read_oem(loaded.resolve(cfg.oem_file), cfg.object)
-        return lambda t: oem_position_gcrs_m(oem, t)
-    if cfg.sp3_file is not None:
-        sp3 = read_sp3(loaded.resolve(cfg.sp3_file), cfg.satellite)
-        return lambda t: sp3_position_gcrs_m(sp3, t)
-    assert cfg.ephemeris_file is not None
-    eph = orbit.read_ephemeris_csv(loaded.resolve(cfg.ephemeris_file))
-    return lambda t: orbit.ephemeris_position_gcrs_m(eph, t)
+    """Read the orbit source once (:func:`speclight.orbit.orbit_sources.orbit_trajectory`)."""
+    values = loaded.scenario.orbit.model_dump()
+    return orbit_trajectory(values, loaded.resolve, time_utc, loaded.source)
 
 
 def _orientation(o: AxesOrientation) -> NDArray[np.float64]:
@@ -124,9 +95,12 @@ def _orientation(o: AxesOrientation) -> NDArray[np.float64]:
 
 
 def attitude_quaternions(
-    cfg: FixedAttitude | SpinAttitude | TorqueFreeAttitude, t_s: NDArray[np.float64]
+    cfg: FixedAttitude | SpinAttitude | TorqueFreeAttitude | None, t_s: NDArray[np.float64]
 ) -> NDArray[np.float64]:
-    """Body-to-GCRS quaternions (N, 4) for the scenario's attitude model."""
+    """Body-to-GCRS quaternions (N, 4) for the scenario's attitude model (None, a
+    geometry-only scenario without one: the identity, the body frame is the GCRS)."""
+    if cfg is None:
+        return np.broadcast_to([1.0, 0.0, 0.0, 0.0], (t_s.size, 4)).copy()
     if isinstance(cfg, FixedAttitude):
         return np.broadcast_to(_orientation(cfg), (t_s.size, 4)).copy()
     if isinstance(cfg, SpinAttitude):
@@ -215,14 +189,6 @@ def scenario_geometry(
     t_s = (time_utc - start) / np.timedelta64(1, "s")
     site = orbit.Site(sc.observer.latitude_deg, sc.observer.longitude_deg, sc.observer.altitude_m)
     if trajectory is None:
-        if sc.orbit.observed:
-            raise InputError(
-                "observed: true has no orbit of its own: the positions come from an "
-                "observations file (speclight compare SCENARIO OBSERVATIONS); for simulate, "
-                "give tle, tle_file, cpf_file or ephemeris_file",
-                source=loaded.source,
-                field="orbit.observed",
-            )
         trajectory = _trajectory(loaded, time_utc)
     r_target, ok = trajectory(t)
     delay_s = np.zeros(t_s.size)
@@ -260,11 +226,7 @@ def scenario_geometry(
         flags[(geo.sunlit_fraction > 0.0) & (geo.sunlit_fraction < 1.0)] |= v.FLAG_PENUMBRA
     if not np.any(ok):
         raise InputError(
-            "the orbit gives no valid position in the time window: outside the span of the "
-            "CPF, ephemeris, OEM or SP3 file, inside a gap of the table or around its unusable "
-            "records, or SGP4 failed at every epoch",
-            source=loaded.source,
-            field="time",
+            no_position_message(sc.orbit.model_dump()), source=loaded.source, field="time"
         )
     return Geometry(
         time_utc=time_utc,

@@ -26,18 +26,18 @@ from typing import Any
 from pydantic import BaseModel
 
 from speclight.orbit.iers_files import finals_path
+from speclight.orbit.orbit_sources import file_keys
 from speclight.scenario import LoadedScenario
 from speclight.target.bsdf_models import bsdf_file_parameters
 
 #: Scenario fields (by their last name) whose string values may name a file or folder: the
-#: material parameters that name a file come from the table of BSDF models
+#: orbit sources that read a file come from their registry
+#: (:data:`speclight.orbit.orbit_sources.ORBIT_SOURCES`), so a new source is hashed too, and
+#: the material parameters that name a file from the table of BSDF models
 #: (:func:`speclight.target.bsdf_models.bsdf_file_parameters`).
 FILE_FIELDS = frozenset(
     {
         "file",
-        "tle_file",
-        "cpf_file",
-        "ephemeris_file",
         "mesh_file",
         "spectrum_file",
         "table_file",
@@ -45,6 +45,7 @@ FILE_FIELDS = frozenset(
         "detector_qe",
         "optics_transmission",
     }
+    | file_keys()
     | bsdf_file_parameters()
 )
 _CHUNK = 1 << 20

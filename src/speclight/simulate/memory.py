@@ -15,6 +15,14 @@ BENCHMARKS.md, "Memory"):
 * per ray of one render batch (single mode: at least one epoch, up to
   :data:`~speclight.render.material_channels.RAYS_PER_BATCH` rays), :data:`BYTES_PER_RAY`;
   path mode renders one epoch at a time, on :data:`PATH_BASE_BYTES` more;
+* single mode, per epoch and render channel (one per material, ``PLASTIC_NODES**2`` more per
+  ``plastic``, a file's wavelength nodes per RGL material: :func:`channel_count`, the
+  layout of :class:`speclight.render.material_channels.ChannelLayout`) the channel weights
+  ``w`` (N, C) of :func:`speclight.render.single.geometric_weights`, float64, and per batch
+  epoch its two (batch, C) temporaries, :data:`BYTES_PER_EPOCH_CHANNEL`; per epoch, material
+  and bin the materials' spectral factors (N, L), :data:`BYTES_PER_EPOCH_MATERIAL_FACTOR_BIN`
+  (counted from the allocations: a box-wing, 3 plastics, has 3,271 channels, 26 kB per
+  epoch);
 * per saved image: its radiance (float64 in the render, float32 in the dataset), depth and
   part maps, :data:`BYTES_PER_IMAGE_PIXEL_BIN` per pixel and bin;
 * with lasers: per epoch the range histograms (band x range bin, float64, accumulated and
@@ -35,7 +43,9 @@ from __future__ import annotations
 import math
 import os
 import resource
+from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 from speclight.errors import InputError
 from speclight.scenario import LoadedScenario
@@ -60,6 +70,14 @@ BYTES_PER_EPOCH_BAND = 5 * 8 * 2
 #: One primary ray of a single-mode batch with its hits, shadow rays and channel weights
 #: (measured: 1024 and 2048 px) [bytes].
 BYTES_PER_RAY = 341
+#: Single mode: one channel weight per epoch (float64, ``w`` of
+#: :func:`speclight.render.single.geometric_weights`) [bytes].
+BYTES_PER_EPOCH_CHANNEL = 8
+#: Single mode: a batch's weights as counted (``np.bincount``) and scaled by the pixel area,
+#: both (batch, C) float64 [bytes per batch epoch and channel].
+BYTES_PER_BATCH_EPOCH_CHANNEL = 2 * 8
+#: Single mode: each material's spectral factor (N, L), float64 [bytes].
+BYTES_PER_EPOCH_MATERIAL_FACTOR_BIN = 8
 #: Path mode's extra base: Mitsuba's spectral variant and scene (measured: a first path run
 #: at 128 px peaked at 1137 MiB; its memory did not grow with spp, 64 to 1024) [bytes].
 PATH_BASE_BYTES = 900 * MIB
@@ -100,8 +118,27 @@ def _bins(scenario: Scenario) -> int:
     return math.floor((sp.max_nm - sp.min_nm) / sp.step_nm + 1e-9) + 1
 
 
-def estimate_memory(scenario: Scenario, n_epochs: int) -> MemoryEstimate:
-    """The peak memory of a run of ``scenario`` at ``n_epochs`` epochs (model above)."""
+def channel_count(scenario: Scenario, resolve: Callable[[str], Path] | None = None) -> int:
+    """Render channels of the scenario's target in single mode: one per material, plus its
+    block (:func:`speclight.render.bsdfs.planned_channels`: ``PLASTIC_NODES**2`` per
+    ``plastic`` and the wavelength nodes of each RGL file, read through ``resolve``, a
+    relative path to a file; 0 where it cannot be read: the run reports that file itself).
+    0 without a target."""
+    from speclight.render.bsdfs import planned_channels
+
+    if scenario.target is None:
+        return 0
+    return sum(planned_channels(m, resolve) for m in scenario.target.materials.values())
+
+
+def estimate_memory(
+    scenario: Scenario, n_epochs: int, resolve: Callable[[str], Path] | None = None
+) -> MemoryEstimate:
+    """The peak memory of a run of ``scenario`` at ``n_epochs`` epochs (model above).
+
+    ``resolve`` turns a file name of the scenario into a path (``LoadedScenario.resolve``):
+    RGL material files give their channel count.
+    """
     from speclight.ranging.bins import RANGE_BINS
     from speclight.render.material_channels import RAYS_PER_BATCH
 
@@ -121,6 +158,13 @@ def estimate_memory(scenario: Scenario, n_epochs: int) -> MemoryEstimate:
         if render.mode == "single":
             epochs_per_batch = max(1, min(n, RAYS_PER_BATCH // pixels))
             parts["render batch"] = epochs_per_batch * pixels * BYTES_PER_RAY
+            # RGL materials make batches smaller (rays_per_batch): this one is an upper bound
+            n_channel = channel_count(scenario, resolve)
+            parts["channels"] = n_channel * (
+                n * BYTES_PER_EPOCH_CHANNEL + epochs_per_batch * BYTES_PER_BATCH_EPOCH_CHANNEL
+            )
+            n_mat = len(scenario.target.materials)
+            parts["channels"] += n * n_mat * n_bin * BYTES_PER_EPOCH_MATERIAL_FACTOR_BIN
         else:
             parts["render batch"] = PATH_BASE_BYTES + pixels * BYTES_PER_RAY
         images = len(set(render.save_images_at))
@@ -176,7 +220,9 @@ def _gib(n: float) -> str:
     return f"{n / 1024**3:.3g} GiB"
 
 
-def check_run_limits(loaded: LoadedScenario, n_epochs: int, limit_bytes: int | None = None) -> None:
+def check_run_limits(
+    loaded: LoadedScenario, n_epochs: int, limit_bytes: int | None = None
+) -> MemoryEstimate:
     """Refuse a run whose estimated peak memory exceeds the limit, or whose path-mode render
     would take longer than :data:`MAX_PATH_RENDER_S`, before any work.
 
@@ -188,6 +234,11 @@ def check_run_limits(loaded: LoadedScenario, n_epochs: int, limit_bytes: int | N
         Epochs the run will compute (the time grid's, or those given).
     limit_bytes
         The limit [bytes]; default :func:`memory_limit_bytes`.
+
+    Returns
+    -------
+    MemoryEstimate
+        The run's estimate (within the limit).
 
     Raises
     ------
@@ -208,9 +259,9 @@ def check_run_limits(loaded: LoadedScenario, n_epochs: int, limit_bytes: int | N
                 field="render.samples_per_pixel",
             )
     limit = memory_limit_bytes() if limit_bytes is None else int(limit_bytes)
-    est = estimate_memory(loaded.scenario, n_epochs)
+    est = estimate_memory(loaded.scenario, n_epochs, loaded.resolve)
     if est.total_bytes <= limit:
-        return
+        return est
     largest = sorted(est.parts.items(), key=lambda kv: -kv[1])[:3]
     shown = ", ".join(f"{k} {_gib(v)}" for k, v in largest)
     fields = ["time (fewer epochs: a larger step_s or a shorter window)", "spectrum.step_nm"]

@@ -31,7 +31,7 @@ BUILTIN_SHAPES = {
     "box_wing": (
         shapes.box_wing,
         ("bus_size_m", "wing_span_m", "wing_width_m", "wing_gap_m", "dish_radius_m",
-         "dish_depth_m"),
+         "dish_depth_m", "dish"),
     ),
     "bus_array": (shapes.bus_array, ("bus_size_m", "array_size_m", "array_gap_m")),
 }  # fmt: skip

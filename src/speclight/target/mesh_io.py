@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 
 from speclight.errors import InputError
 from speclight.input_files import read_user_bytes
+from speclight.plausible_ranges import TARGET_SIZE_M, warn_implausible
 from speclight.target.materials import Material
 from speclight.target.mesh_common import FIELD, Mesh, fan
 from speclight.target.mesh_common import mesh_error as _fail
@@ -190,4 +191,6 @@ def load_mesh(
     if radius < MIN_BOUNDING_RADIUS_M:
         reach = max(float(np.linalg.norm(p.vertices_m, axis=1).max()) for p in target.parts)
         raise _out_of_scale("the mesh", radius, reach, scale_m_per_unit, source)
+    size = f"{FIELD} (its bounding diameter with scale_m_per_unit = {scale_m_per_unit:g})"
+    warn_implausible(size, 2.0 * radius, TARGET_SIZE_M)
     return target

@@ -132,13 +132,31 @@ def box_wing(
     wing_gap_m: float = 0.2,
     dish_radius_m: float = 0.4,
     dish_depth_m: float = 0.1,
+    dish: bool = True,
 ) -> Target:
-    """Box-wing satellite: bus, two solar wings and a parabolic antenna dish.
+    """Box-wing satellite: bus, two solar wings and (unless ``dish`` is False) a parabolic
+    antenna dish. All sizes in metres, body frame (docs/scenario.md, "The box-wing").
 
-    The bus is a box centred on the origin; the wings are thin plates in the y-z plane
-    (normals ±x) reaching out along ±y from a gap beside the ±y bus faces, so wing and bus
-    face form concave corners; the dish opens towards -z below the bus (nadir).
-    Parts: ``bus``, ``wing_+y``, ``wing_-y``, ``antenna``.
+    * ``bus``: a box of edges ``bus_size_m`` (x, y, z) centred on the origin.
+    * ``wing_+y``, ``wing_-y``: flat rectangles in the body y-z plane (x = 0), normal +x as
+      built (both; every surface reflects on both sides), ``wing_span_m`` long along y and
+      ``wing_width_m`` wide along z, centred on z = 0, from ``wing_gap_m`` beyond the bus's
+      ±y face outwards: |y| from ``bus_y / 2 + gap`` to ``bus_y / 2 + gap + span``. Wing and
+      bus face form concave corners. A wing turning about y (``target.articulation``, axis
+      ``[0, 1, 0]``, normal ``[1, 0, 0]``) tracks the Sun.
+    * ``antenna``: a paraboloid dish of radius ``dish_radius_m`` (aperture plane) and depth
+      ``dish_depth_m`` on the body z axis below the bus: ``z = z0 + depth (1 - (rho / R)^2)``
+      with ``z0 = -bus_z / 2 - depth - 1 mm``, so its apex is 1 mm below the bus's -z face
+      and it opens towards -z (nadir when body +z points up). 8 rings of 32 sectors.
+
+    Parameters
+    ----------
+    materials
+        One material for every part, or part name -> material (``"*"`` for the rest).
+    bus_size_m, wing_span_m, wing_width_m, wing_gap_m, dish_radius_m, dish_depth_m
+        The sizes above [m].
+    dish
+        False: no ``antenna`` part (``dish_radius_m`` and ``dish_depth_m`` are then unused).
     """
     half = np.array([_positive("bus_size_m", s) for s in bus_size_m]) / 2
     span, width = _positive("wing_span_m", wing_span_m), _positive("wing_width_m", wing_width_m) / 2
@@ -147,13 +165,24 @@ def box_wing(
     y0, y1 = half[1] + gap, half[1] + gap + span
     wp = _quad((0, y0, -width), (0, y1, -width), (0, y1, width), (0, y0, width))
     wm = _quad((0, -y0, width), (0, -y1, width), (0, -y1, -width), (0, -y0, -width))
-    # Paraboloid dish z = z0 + depth * (rho / R)^2, apex touching the bus bottom.
-    R, d = _positive("dish_radius_m", dish_radius_m), _positive("dish_depth_m", dish_depth_m)
+    meshes = {"bus": bus, "wing_+y": wp, "wing_-y": wm}
+    if dish:
+        meshes["antenna"] = _dish(
+            _positive("dish_radius_m", dish_radius_m),
+            _positive("dish_depth_m", dish_depth_m),
+            -half[2],
+        )
+    return _build(meshes, materials)
+
+
+def _dish(R: float, d: float, z_bottom: float) -> Mesh:
+    """Paraboloid dish z = z0 + d (1 - (rho / R)^2) opening towards -z, apex 1 mm below
+    ``z_bottom`` (the bus's -z face)."""
     nr, nphi = 8, 32
     rho = np.linspace(0, R, nr + 1)[1:]
     phi = np.linspace(0, 2 * np.pi, nphi, endpoint=False)
     rr, pp = np.meshgrid(rho, phi, indexing="ij")
-    z0 = -half[2] - d - 1e-3
+    z0 = z_bottom - d - 1e-3
     ring = np.stack([rr * np.cos(pp), rr * np.sin(pp), z0 + d * (1 - (rr / R) ** 2)], -1)
     dv = np.vstack([[0, 0, z0 + d], ring.reshape(-1, 3)])
     idx = lambda i, j: 1 + i * nphi + (j % nphi)  # noqa: E731
@@ -164,8 +193,7 @@ def box_wing(
                 [idx(i, j), idx(i, j + 1), idx(i + 1, j + 1)],
                 [idx(i, j), idx(i + 1, j + 1), idx(i + 1, j)],
             ]
-    meshes = {"bus": bus, "wing_+y": wp, "wing_-y": wm, "antenna": (dv, np.array(df))}
-    return _build(meshes, materials)
+    return dv, np.array(df)
 
 
 def bus_array(

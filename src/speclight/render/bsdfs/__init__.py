@@ -8,8 +8,10 @@ roughness derivatives). A test checks that every registered model has one.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from pathlib import Path
 from types import MappingProxyType
+from typing import Any
 
 from speclight.errors import InputError
 from speclight.render.bsdfs.bsdf_interface import MaterialBsdf
@@ -55,4 +57,11 @@ def material_bsdf(m: Material, mode: str | None = None) -> MaterialBsdf:
     return RENDERERS[model.label](m)
 
 
-__all__ = ["RENDERERS", "MaterialBsdf", "material_bsdf"]
+def planned_channels(m: Any, resolve: Callable[[str], Path] | None = None) -> int:
+    """Single-mode channels of a scenario material (:class:`speclight.scenario.Material`,
+    not built yet): its main channel and its block (see
+    :meth:`MaterialBsdf.planned_block_size`)."""
+    return 1 + RENDERERS[m.model.label].planned_block_size(m.parameters(), resolve)
+
+
+__all__ = ["RENDERERS", "MaterialBsdf", "material_bsdf", "planned_channels"]

@@ -12,6 +12,8 @@ their parameters and the modes each supports is :mod:`speclight.target.bsdf_mode
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -62,6 +64,15 @@ class MaterialBsdf:
 
     def block_size(self) -> int:
         """Number of block channels (0: the main channel carries all the light)."""
+        return 0
+
+    @classmethod
+    def planned_block_size(
+        cls, given: Mapping[str, Any], resolve: Callable[[str], Path] | None
+    ) -> int:
+        """:meth:`block_size` of a material not built yet, from its parameters ``given``
+        (files named relative to the scenario found through ``resolve``; 0 for a file that
+        cannot be read: the run reports that file itself)."""
         return 0
 
     def block_weights(self, cos_i: F64, cos_o: F64, cos_d: F64) -> tuple[I64, I64, F64]:

@@ -13,13 +13,17 @@ have no polarisation model.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from speclight.errors import InputError
 from speclight.render import rgl
 from speclight.render.bsdfs.bsdf_interface import F64, I64, MaterialBsdf
 from speclight.target.brdf_table import load_brdf_table
+from speclight.target.rgl_file import load_rgl_info
 
 
 class MeasuredTableBsdf(MaterialBsdf):
@@ -54,6 +58,17 @@ class MeasuredRglBsdf(MaterialBsdf):
 
     def block_size(self) -> int:
         return rgl.node_count(self.material)
+
+    @classmethod
+    def planned_block_size(
+        cls, given: Mapping[str, Any], resolve: Callable[[str], Path] | None
+    ) -> int:
+        if resolve is None:
+            return 0
+        try:
+            return len(load_rgl_info(str(resolve(str(given["brdf_table"])))).wavelength_nm)
+        except (InputError, OSError, ValueError, KeyError):
+            return 0
 
     def entries_per_pixel(self) -> int:
         return rgl.node_count(self.material)

@@ -16,6 +16,8 @@ plugins per group of bins, :mod:`.path_plastic`).
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -85,6 +87,12 @@ class PlasticBsdf(MaterialBsdf):
         return fresnel_linear_factor(refl, cos_half_phase, wavelength_nm, real_index=True)
 
     def block_size(self) -> int:
+        return PLASTIC_NODES**2
+
+    @classmethod
+    def planned_block_size(
+        cls, given: Mapping[str, Any], resolve: Callable[[str], Path] | None
+    ) -> int:
         return PLASTIC_NODES**2
 
     def block_weights(self, cos_i: F64, cos_o: F64, cos_d: F64) -> tuple[I64, I64, F64]:
