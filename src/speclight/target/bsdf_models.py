@@ -325,16 +325,8 @@ def parameter_problems(
     model = bsdf_model(name, given)
     problems = []
     for p in PARAMETERS.values():
-        value = given.get(p.name)
-        if value is None:
-            if p in model.required:
-                problems.append((p.name, f"bsdf '{name}' needs {p.name} ({p.meaning})"))
-        elif not model.takes(p.name):
-            users = ", ".join(m.name for m in _MODELS if m.takes(p.name))
-            problems.append(
-                (p.name, f"{p.name} is not used by bsdf '{name}'; remove it (used by: {users})")
-            )
-        elif (why := p.range_problem(value)) is not None:
+        why = _parameter_problem(model, p, given.get(p.name))
+        if why is not None:
             problems.append((p.name, why))
     kinds = model.reflectance_kinds
     if reflectance_kind is not None and kinds is not None and reflectance_kind not in kinds:
@@ -346,6 +338,16 @@ def parameter_problems(
             )
         )
     return problems
+
+
+def _parameter_problem(model: BsdfModel, p: BsdfParameter, value: Any) -> str | None:
+    """What is wrong with the value of parameter ``p`` (None: left out) for ``model``."""
+    if value is None:
+        return f"bsdf '{model.name}' needs {p.name} ({p.meaning})" if p in model.required else None
+    if not model.takes(p.name):
+        users = ", ".join(m.name for m in _MODELS if m.takes(p.name))
+        return f"{p.name} is not used by bsdf '{model.name}'; remove it (used by: {users})"
+    return p.range_problem(value)
 
 
 def bsdf_file_parameters() -> frozenset[str]:
