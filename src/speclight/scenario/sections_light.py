@@ -240,19 +240,28 @@ class Shape(Strict):
             if sizes:
                 raise ValueError(f"{', '.join(sizes)} apply to builtin shapes, not mesh_file")
             return self
-        missing = [k for k in _SHAPE_REQUIRED[self.builtin] if getattr(self, k) is None]
-        if missing:
-            raise ValueError(f"builtin '{self.builtin}' needs {', '.join(missing)}")
-        extra = [k for k in sizes if k not in _SHAPE_SIZES[self.builtin]]
-        if extra:
-            raise ValueError(
-                f"builtin '{self.builtin}' takes {', '.join(_SHAPE_SIZES[self.builtin])}, "
-                f"not {', '.join(extra)}"
-            )
-        if self.dish is False and (self.dish_radius_m or self.dish_depth_m):
-            raise ValueError("dish: false leaves out the dish; drop dish_radius_m, dish_depth_m")
+        _check_sizes(self.builtin, sizes, [k for k in _SHAPE_FIELDS if getattr(self, k) is None])
+        _check_dish(self.dish, self.dish_radius_m, self.dish_depth_m)
         _check_scale(self.builtin, {k: getattr(self, k) for k in sizes})
         return self
+
+
+def _check_dish(dish: bool | None, radius_m: float | None, depth_m: float | None) -> None:
+    """No dish sizes for a box-wing without its dish."""
+    if dish is False and (radius_m or depth_m):
+        raise ValueError("dish: false leaves out the dish; drop dish_radius_m, dish_depth_m")
+
+
+def _check_sizes(builtin: str, given: list[str], left_out: list[str]) -> None:
+    """A built-in shape's sizes: every one it needs, none it does not take."""
+    missing = [k for k in _SHAPE_REQUIRED[builtin] if k in left_out]
+    if missing:
+        raise ValueError(f"builtin '{builtin}' needs {', '.join(missing)}")
+    extra = [k for k in given if k not in _SHAPE_SIZES[builtin]]
+    if extra:
+        raise ValueError(
+            f"builtin '{builtin}' takes {', '.join(_SHAPE_SIZES[builtin])}, not {', '.join(extra)}"
+        )
 
 
 def _check_scale(builtin: str, sizes: dict[str, Any]) -> None:
