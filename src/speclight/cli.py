@@ -334,7 +334,7 @@ def fit(
     def run() -> None:
         from speclight.estimate.measured import read_measured
         from speclight.estimate.scenario_fit import fit_scenario, parse_free, parse_method
-        from speclight.plot.figure_output import claim_outputs
+        from speclight.plot.figure_output import claim_outputs, write_outputs
         from speclight.scenario import load_scenario
 
         names = parse_free(free)
@@ -348,16 +348,17 @@ def fit(
                 progress=sys.stderr.isatty(), method=chosen,
             )  # fmt: skip
             _raise_if_signalled()
-            claim.write((json.dumps(result.to_json(), indent=2) + "\n").encode())
-            if figure is not None:
+
+            def draw() -> Any:
                 from speclight.plot.fit_figure import fit_figure
 
-                figure.write(
-                    fit_figure(
-                        result.time_utc, result.measured_per_s, result.fitted_per_s,
-                        result.band_names,
-                    )
-                )  # fmt: skip
+                return fit_figure(
+                    result.time_utc, result.measured_per_s, result.fitted_per_s, result.band_names
+                )
+
+            write_outputs(
+                claim, (json.dumps(result.to_json(), indent=2) + "\n").encode(), figure, draw
+            )
         if not result.converged:
             typer.echo(f"not converged: {result.message}", err=True)
         albedos = zip(result.band_names, result.albedo, strict=True)
@@ -391,17 +392,21 @@ def upsample(
     def run() -> None:
         from speclight.estimate.upsample_io import read_fit_albedos, spectrum_csv
         from speclight.estimate.upsample_io import upsample_scenario as upsample_from
-        from speclight.plot.figure_output import claim_outputs
+        from speclight.plot.figure_output import claim_outputs, write_outputs
         from speclight.scenario import load_scenario
 
         inputs = {"scenario file": scenario, "fit file": fit}
         with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
             result = upsample_from(load_scenario(scenario), read_fit_albedos(fit), str(fit))
-            claim.write(spectrum_csv(result, str(scenario), str(fit)).encode())
-            if figure is not None:
+
+            def draw() -> Any:
                 from speclight.plot.upsample_figure import upsample_figure
 
-                figure.write(upsample_figure(result, scenario.stem))
+                return upsample_figure(result, scenario.stem)
+
+            write_outputs(
+                claim, spectrum_csv(result, str(scenario), str(fit)).encode(), figure, draw
+            )
         if not result.spectrum.converged:
             typer.echo(
                 "notice: the fit did not converge: the spectrum reproduces the albedos only to "
@@ -493,7 +498,7 @@ def unmix(
     def run() -> None:
         from speclight.estimate.unmix_io import check_unmix_options, unmix_measured
         from speclight.io.netcdf import dataset_bytes
-        from speclight.plot.figure_output import claim_outputs
+        from speclight.plot.figure_output import claim_outputs, write_outputs
 
         members = _endmember_files(measured, endmembers)
         check_unmix_options(members, extract, n, method, source)
@@ -512,11 +517,13 @@ def unmix(
                 light=source,
             )
             _raise_if_signalled()
-            claim.write(dataset_bytes(ds))
-            if figure is not None:
+
+            def draw() -> Any:
                 from speclight.plot.unmix_figure import unmix_figure
 
-                figure.write(unmix_figure(ds))
+                return unmix_figure(ds)
+
+            write_outputs(claim, dataset_bytes(ds), figure, draw)
         if "mean_absolute_share_error" in ds.attrs:
             typer.echo(
                 f"against the ground truth: mean absolute share error "
@@ -597,7 +604,7 @@ def reflection_map_cmd(
         from speclight.estimate.reflection_map_io import reflection_map_measured
         from speclight.estimate.source_spectrum import check_light
         from speclight.io.netcdf import dataset_bytes
-        from speclight.plot.figure_output import claim_outputs
+        from speclight.plot.figure_output import claim_outputs, write_outputs
 
         members = _endmember_files(measured, endmembers)
         check_nside(nside)
@@ -616,14 +623,13 @@ def reflection_map_cmd(
                 progress=sys.stderr.isatty(),
             )
             _raise_if_signalled()
-            fig = None
-            if figure is not None:
+
+            def draw() -> Any:
                 from speclight.plot.reflection_map_figure import reflection_map_figure
 
-                fig = reflection_map_figure(ds, band)
-            claim.write(dataset_bytes(ds))
-            if figure is not None:
-                figure.write(fig)
+                return reflection_map_figure(ds, band)
+
+            write_outputs(claim, dataset_bytes(ds), figure, draw)
         mapped = int((ds["n_samples"].values > 0).sum())
         typer.echo(
             f"{int(ds['n_samples'].values.sum())} epochs in {mapped} of "
@@ -816,7 +822,7 @@ def spin_axis(
         from speclight.estimate.spin_axis_io import axis_dataset, spin_axis_measured
         from speclight.estimate.spin_axis_refine import check_refine_options
         from speclight.io.netcdf import dataset_bytes
-        from speclight.plot.figure_output import claim_outputs
+        from speclight.plot.figure_output import claim_outputs, write_outputs
         from speclight.scenario import load_scenario
 
         check_search_options(grid_deg, phases)
@@ -846,11 +852,13 @@ def spin_axis(
             )
             ds = axis_dataset(result, str(map_file), str(scenario))
             _raise_if_signalled()
-            claim.write(dataset_bytes(ds))
-            if figure is not None:
+
+            def draw() -> Any:
                 from speclight.plot.spin_axis_figure import spin_axis_figure
 
-                figure.write(spin_axis_figure(ds))
+                return spin_axis_figure(ds)
+
+            write_outputs(claim, dataset_bytes(ds), figure, draw)
         a = ds.attrs
         typer.echo(
             f"best axis RA {a['best_ra_deg']:.1f} Dec {a['best_dec_deg']:.1f} deg, phase "
@@ -955,7 +963,7 @@ def period(
 
         from speclight.estimate.period_decision import IfSymmetric
         from speclight.estimate.period_io import estimate_period
-        from speclight.plot.figure_output import claim_outputs
+        from speclight.plot.figure_output import claim_outputs, write_outputs
 
         if if_symmetric not in ("auto", "double", "keep"):
             raise InputError(
@@ -984,11 +992,13 @@ def period(
             )
             _raise_if_signalled()
             summary = result.to_json()
-            claim.write((json.dumps(summary, indent=2) + "\n").encode())
-            if figure is not None:
+
+            def draw() -> Any:
                 from speclight.plot.period_figure import period_figure
 
-                figure.write(period_figure(result))
+                return period_figure(result)
+
+            write_outputs(claim, (json.dumps(summary, indent=2) + "\n").encode(), figure, draw)
         typer.echo(
             f"rotation period {summary['period_s']:.6g} +- {summary['period_std_s']:.2g} s "
             f"(photometric {summary['photometric_period_s']:.6g} s, false-alarm probability "
@@ -1119,7 +1129,7 @@ def compare(
         from speclight.estimate.compare_stats import summary_lines
         from speclight.estimate.observations import read_observations
         from speclight.io.netcdf import dataset_bytes
-        from speclight.plot.figure_output import claim_outputs
+        from speclight.plot.figure_output import claim_outputs, write_outputs
         from speclight.scenario import load_scenario
 
         inputs = {"scenario file": scenario, "observations file": observations}
@@ -1128,14 +1138,65 @@ def compare(
                 load_scenario(scenario), read_observations(observations), sys.stderr.isatty()
             )
             _raise_if_signalled()
-            claim.write(dataset_bytes(result.dataset))
-            if figure is not None:
+
+            def draw() -> Any:
                 from speclight.plot.compare_figure import compare_figure
 
-                figure.write(compare_figure(result.dataset))
+                return compare_figure(result.dataset)
+
+            write_outputs(claim, dataset_bytes(result.dataset), figure, draw)
         for line in [*result.notes, *summary_lines(result.dataset.attrs)]:
             typer.echo(line)
         typer.echo(f"wrote {output}" + (f" and {plot_file}" if plot_file else ""))
+
+    _guarded(run)
+
+
+@app.command()
+def passes(
+    scenario: Annotated[Path, typer.Argument(help="Scenario YAML: its orbit and observer.")],
+    output: Annotated[
+        str | None,
+        typer.Option("--output", "-o", metavar="FILE", help="Also write PASSES.csv or .json."),
+    ] = None,
+    start: Annotated[
+        str | None,
+        typer.Option(help="Search from this UTC time (ISO 8601); default the scenario's start."),
+    ] = None,
+    end: Annotated[
+        str | None,
+        typer.Option(help="Search until this UTC time (ISO 8601); default the scenario's stop."),
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite an existing output.")] = False,
+) -> None:
+    """Rise, culmination and set of every pass of the target above observer.min_elevation_deg,
+    with the parts where it is sunlit, the sky is dark (the Sun at or below
+    observer.max_sun_elevation_deg) and both (observable). See docs/passes.md.
+
+    Example: speclight passes calsphere.yaml --start 2020-02-29T18:00Z --end 2020-03-01T06:00Z
+    """
+
+    def run() -> None:
+        from speclight.io.output import OutputClaim
+        from speclight.io.pass_table import check_passes_output, passes_file_bytes, print_passes
+        from speclight.scenario import load_scenario
+        from speclight.simulate.pass_search import parse_utc, scenario_passes
+
+        start_utc = parse_utc(start, "--start") if start is not None else None
+        end_utc = parse_utc(end, "--end") if end is not None else None
+        if output is None:
+            loaded = load_scenario(scenario)
+            result = scenario_passes(loaded, start_utc, end_utc)
+        else:
+            suffix = check_passes_output(output)
+            with OutputClaim(output, force=force, inputs={"scenario file": scenario}) as claim:
+                loaded = load_scenario(scenario)
+                result = scenario_passes(loaded, start_utc, end_utc)
+                _raise_if_signalled()
+                claim.write(passes_file_bytes(result, loaded.scenario.name, suffix))
+        print_passes(result, f"passes of {loaded.scenario.name}")
+        if output is not None:
+            typer.echo(f"wrote {output}")
 
     _guarded(run)
 

@@ -5,6 +5,8 @@ All values are in SI units (the unit is part of every name).
 
 from __future__ import annotations
 
+import math
+
 #: Speed of light in vacuum [m s-1] (SI 2019, exact).
 C_M_S = 299_792_458.0
 #: Planck constant [J s] (SI 2019, exact).
@@ -19,6 +21,9 @@ SUN_RADIUS_M = 695_700_000.0
 #: Mean radius of the Earth [m] (IUGG: R1 = (2a + b) / 3 of WGS84; Moritz 2000, J. Geodesy
 #: 74, 128, doi:10.1007/s001900050278): the sphere Earthshine is reflected from.
 EARTH_MEAN_RADIUS_M = 6_371_008.8
+#: Rotation rate of the Earth [rad s-1]: the rate of the Earth rotation angle per second of
+#: UT1, 2 pi x 1.00273781191135448 / 86400 (IERS Conventions 2010, eq. 5.15).
+EARTH_ROTATION_RATE_RAD_S = 2.0 * math.pi * 1.00273781191135448 / 86400.0
 #: AB magnitude zero point: flux density of a source of AB magnitude 0 [W m-2 Hz-1]
 #: (3631 Jy; Oke & Gunn 1983, ApJ 266, 713, doi:10.1086/160817).
 AB_ZERO_W_M2_HZ = 3631.0e-26
@@ -28,6 +33,7 @@ __all__ = [
     "AU_M",
     "C_M_S",
     "EARTH_MEAN_RADIUS_M",
+    "EARTH_ROTATION_RATE_RAD_S",
     "HC_J_M",
     "H_J_S",
     "SUN_RADIUS_M",

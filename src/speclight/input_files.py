@@ -1,16 +1,19 @@
 """Safe reading of the files a user names (scenario, orbit files, tables, meshes, materials).
 
-:func:`read_user_bytes` and :func:`read_user_text` turn every way a named file can be
-unusable into an :class:`~speclight.errors.InputError` that names the file and the scenario
-field: a path that does not exist, a folder, anything that is not a regular file (a FIFO or
-a device such as ``/dev/zero``: refused from ``os.stat`` before opening, so nothing blocks
-or reads forever), a file above a size limit, and (for text) bytes that are not UTF-8 (the
-message says where the first bad byte is).
+:func:`check_user_file`, :func:`read_user_bytes` and :func:`read_user_text` turn every way a
+named file can be unusable into an :class:`~speclight.errors.InputError` that names the file
+and the scenario field: a path that does not exist, a folder, anything that is not a regular
+file (a FIFO or a device such as ``/dev/zero``: refused from ``os.stat`` before opening, so
+nothing blocks or reads forever), a loop of symbolic links, a file this user may not read,
+a file above a size limit, and (for text) bytes that are not UTF-8 (the message says where
+the first bad byte is). NetCDF datasets are read by :mod:`speclight.io.user_dataset`
+after the same checks.
 """
 
 from __future__ import annotations
 
 import codecs
+import errno
 import os
 import stat
 from collections.abc import Callable
@@ -31,6 +34,72 @@ _KINDS = (
 _UTF16_BOMS = (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)
 
 
+def check_user_file(
+    path: str | Path,
+    field: str | None = None,
+    *,
+    what: str = "file",
+    max_bytes: int | None = MAX_TEXT_BYTES,
+) -> os.stat_result:
+    """Refuse a path that is not a readable regular file, before anything opens it.
+
+    Parameters
+    ----------
+    path
+        The file (``~`` is expanded).
+    field
+        Scenario field or command-line argument that names the file, for the message.
+    what
+        What the file is, for the message (e.g. ``"TLE file"``).
+    max_bytes
+        Size limit [bytes], or None for none (a NetCDF dataset is read a variable at a time).
+
+    Returns
+    -------
+    os.stat_result
+        The file's status.
+
+    Raises
+    ------
+    InputError
+        Missing path, a folder, a symbolic-link loop, not a regular file (a FIFO or device:
+        refused from ``os.stat`` before opening, so nothing blocks), an invalid path, larger
+        than ``max_bytes``, or not readable (permission denied: found by opening it).
+    """
+    path = Path(path).expanduser()
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise _refusal(path, field, what, "no such file: it does not exist") from None
+    except NotADirectoryError:
+        raise _refusal(
+            path,
+            field,
+            what,
+            "no such file: it does not exist (a part of the path is a file, not a folder)",
+        ) from None
+    except OSError as exc:
+        raise _refusal(path, field, what, _os_problem(exc)) from None
+    except ValueError:  # a NUL character in the path
+        raise _refusal(path, field, what, "not a valid path (it holds a NUL character)") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise _refusal(path, field, what, "it is a folder; give the path of a file in it")
+    if not stat.S_ISREG(st.st_mode):
+        kind = next((name for test, name in _KINDS if test(st.st_mode)), "not a regular file")
+        raise _refusal(
+            path, field, what, f"it is {kind}, not a regular file; give the path of a file"
+        )
+    if max_bytes is not None and st.st_size > max_bytes:
+        problem = f"it is {_size(st.st_size)}, above the limit of {_size(max_bytes)}"
+        raise _refusal(path, field, what, problem)
+    try:
+        with open(path, "rb"):
+            pass
+    except OSError as exc:
+        raise _refusal(path, field, what, _os_problem(exc)) from None
+    return st
+
+
 def read_user_bytes(
     path: str | Path,
     field: str | None = None,
@@ -41,79 +110,37 @@ def read_user_bytes(
     """The bytes of a user's file (tables, meshes, material files), refusing anything that is
     not a readable regular file with a clear error.
 
-    Parameters
-    ----------
-    path
-        The file (``~`` is expanded).
-    field
-        Scenario field that names the file (e.g. ``orbit.tle_file``), for the message.
-    what
-        What the file is, for the message (e.g. ``"TLE file"``).
-    max_bytes
-        Size limit [bytes].
+    Parameters are those of :func:`check_user_file`.
 
     Raises
     ------
     InputError
-        Missing path, a folder, not a regular file (a FIFO or device: refused from
-        ``os.stat`` before opening, so nothing blocks), an invalid path, larger than
-        ``max_bytes``, or not readable.
+        As :func:`check_user_file`, and a file that grew above ``max_bytes`` or failed to
+        read.
     """
     path = Path(path).expanduser()
-
-    def refuse(problem: str) -> InputError:
-        return _refusal(path, field, what, problem)
-
     check_user_file(path, field, what=what, max_bytes=max_bytes)
     try:
         with open(path, "rb") as f:
             data = f.read(max_bytes + 1)
     except OSError as exc:
-        raise refuse(exc.strerror or str(exc)) from None
+        raise _refusal(path, field, what, _os_problem(exc)) from None
     if len(data) > max_bytes:  # grew since os.stat
-        raise refuse(f"it is larger than the limit of {_size(max_bytes)}")
+        raise _refusal(path, field, what, f"it is larger than the limit of {_size(max_bytes)}")
     return data
-
-
-def check_user_file(
-    path: str | Path,
-    field: str | None = None,
-    *,
-    what: str = "file",
-    max_bytes: int | None = MAX_TEXT_BYTES,
-) -> None:
-    """Refuse a path that is not a regular file of at most ``max_bytes`` (None: any size),
-    with the errors of :func:`read_user_bytes`, from ``os.stat`` alone (nothing is opened:
-    for files another library reads, such as a NetCDF dataset).
-    """
-    path = Path(path).expanduser()
-
-    def refuse(problem: str) -> InputError:
-        return _refusal(path, field, what, problem)
-
-    try:
-        st = os.stat(path)
-    except FileNotFoundError:
-        raise refuse("no such file: it does not exist") from None
-    except NotADirectoryError:
-        raise refuse(
-            "no such file: it does not exist (a part of the path is a file, not a folder)"
-        ) from None
-    except OSError as exc:
-        raise refuse(exc.strerror or str(exc)) from None
-    except ValueError:  # a NUL character in the path
-        raise refuse("not a valid path (it holds a NUL character)") from None
-    if stat.S_ISDIR(st.st_mode):
-        raise refuse("it is a folder; give the path of a file in it")
-    if not stat.S_ISREG(st.st_mode):
-        kind = next((name for test, name in _KINDS if test(st.st_mode)), "not a regular file")
-        raise refuse(f"it is {kind}, not a regular file; give the path of a file")
-    if max_bytes is not None and st.st_size > max_bytes:
-        raise refuse(f"it is {_size(st.st_size)}, above the limit of {_size(max_bytes)}")
 
 
 def _refusal(path: Path, field: str | None, what: str, problem: str) -> InputError:
     return InputError(f"cannot read {what}: {problem}", source=str(path), field=field)
+
+
+def _os_problem(exc: OSError) -> str:
+    """The reason of an ``OSError`` in words, with what to do where there is something."""
+    if exc.errno == errno.ELOOP:
+        return "a loop of symbolic links (a link that points back to itself); fix the link"
+    if isinstance(exc, PermissionError):
+        return "permission denied: this user may not read it (see its mode, ls -l)"
+    return exc.strerror or str(exc)
 
 
 def read_user_text(
@@ -140,10 +167,10 @@ def read_user_text(
         Latin-1...): the message says where the first bad byte is.
     """
     data = read_user_bytes(path, field, what=what, max_bytes=max_bytes)
-    source = str(Path(path).expanduser())
+    source = Path(path).expanduser()
 
     def refuse(problem: str) -> InputError:
-        return InputError(f"cannot read {what}: {problem}", source=source, field=field)
+        return _refusal(source, field, what, problem)
 
     return _decode(data, refuse).replace("\r\n", "\n").replace("\r", "\n")
 

@@ -89,6 +89,45 @@ VARIABLES: dict[str, VariableInfo] = {
         ("time", "wxyz"), "1", "body-to-GCRS rotation quaternion, scalar first (w, x, y, z)"
     ),
     "flags": V(T, "1", "why an epoch is not fully observable (bit mask)"),
+    # where to point (speclight.orbit.sky_position)
+    "sun_elevation_site": V(
+        T,
+        "degree",
+        "elevation of the Sun's centre above the observer's horizon",
+        comment="geometric (no refraction), as the twilight limits are defined: civil -6, "
+        "nautical -12, astronomical -18 degree",
+    ),
+    "ra": V(
+        T,
+        "degree",
+        "topocentric right ascension of the target, astrometric, ICRS",
+        comment="light-time corrected (barycentric), no aberration: comparable with star "
+        "catalogue (Gaia) positions",
+    ),
+    "dec": V(T, "degree", "topocentric declination of the target, astrometric, ICRS"),
+    "ra_apparent": V(
+        T,
+        "degree",
+        "topocentric apparent right ascension of the target, true equator and equinox of date",
+        comment="aberration by the observer's velocity (Earth and site rotation) applied: "
+        "where a telescope points",
+    ),
+    "dec_apparent": V(
+        T,
+        "degree",
+        "topocentric apparent declination of the target, true equator and equinox of date",
+    ),
+    "angular_rate": V(
+        T,
+        "degree s-1",
+        "angular rate of the target across the sky",
+        comment="of the astrometric direction; a streak on a sidereally tracking telescope "
+        "is the rate times the exposure",
+    ),
+    "ra_cos_dec_rate": V(
+        T, "degree s-1", "rate of right ascension times cos(declination), ICRS, east positive"
+    ),
+    "dec_rate": V(T, "degree s-1", "rate of declination, ICRS, north positive"),
     # the observer's site (scalars; also the global attributes observer_*)
     "observer_latitude": V(
         (), "degrees_north", "geodetic latitude of the observer (WGS84)", "latitude"
@@ -104,6 +143,12 @@ VARIABLES: dict[str, VariableInfo] = {
     ),
     "min_elevation": V(
         (), "degree", "minimum elevation: epochs below it are flagged below_min_elevation"
+    ),
+    "max_sun_elevation": V(
+        (),
+        "degree",
+        "highest elevation of the Sun at the site for a dark sky: epochs above it are "
+        "flagged daylight",
     ),
     # spectra and bands
     "solar_irradiance": V(
@@ -327,6 +372,8 @@ FLAG_LASER_BELOW_HORIZON = 32
 #: The attitude model gives no attitude: an epoch outside an attitude table, or a pointing
 #: profile whose two directions are parallel there.
 FLAG_ATTITUDE_UNDEFINED = 64
+#: The Sun is above ``observer.max_sun_elevation_deg`` at the site: no dark sky.
+FLAG_DAYLIGHT = 128
 
 FLAG_MEANINGS = {
     FLAG_ORBIT_FAILED: "orbit_failed",
@@ -336,6 +383,7 @@ FLAG_MEANINGS = {
     FLAG_RENDER_FAILED: "render_failed",
     FLAG_LASER_BELOW_HORIZON: "laser_below_horizon",
     FLAG_ATTITUDE_UNDEFINED: "attitude_undefined",
+    FLAG_DAYLIGHT: "daylight",
 }
 #: Epochs with any of these bits have no measurement of the Sun's reflection.
 NOT_OBSERVABLE = (
@@ -344,6 +392,7 @@ NOT_OBSERVABLE = (
     | FLAG_IN_SHADOW
     | FLAG_RENDER_FAILED
     | FLAG_ATTITUDE_UNDEFINED
+    | FLAG_DAYLIGHT
 )
 
 

@@ -103,7 +103,7 @@ def test_window_without_visibility_succeeds_and_says_so(tmp_path: Path) -> None:
     out = tmp_path / "out.nc"
     result = runner.invoke(app, ["simulate", str(scenario), "-o", str(out)])
     assert result.exit_code == 0, result.output
-    assert "never both sunlit and above the minimum elevation" in result.stdout
+    assert "the target is never observable in this time window" in result.stdout
     ds = xr.open_dataset(out)
     assert np.all(ds["elevation"].values < 10.0)
     assert np.all(ds["flags"].values & 2)

@@ -12,6 +12,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+import numpy as np
 import pytest
 import xarray as xr
 import yaml
@@ -192,3 +193,97 @@ def test_plot_to_a_figure_another_run_is_writing_fails_at_once(tmp_path: Path) -
         result = runner.invoke(app, ["plot", str(data), "-o", str(fig)])
     assert result.exit_code == 2
     assert f"being written by another speclight run (PID {first.pid})" in result.stderr
+
+
+def test_a_full_disk_when_the_lock_is_written_is_one_line_and_exit_1(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    scenario = _geometry_scenario(tmp_path)
+    out = tmp_path / "out.nc"
+
+    def disk_full(fd: int, data: bytes) -> int:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, "write", disk_full)
+    result = runner.invoke(app, ["simulate", str(scenario), "-o", str(out)])
+    monkeypatch.undo()
+    assert result.exit_code == 1
+    assert result.stderr.splitlines() == [
+        f"error: cannot write {out}: No space left on device (its lock file in {tmp_path}); "
+        "nothing was written"
+    ]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scenario.yaml"]
+
+
+def test_plot_on_a_full_disk_is_one_line_and_exit_1(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from speclight.plot import figures
+
+    data = tmp_path / "pass.nc"
+    ran = runner.invoke(app, ["simulate", str(_geometry_scenario(tmp_path)), "-o", str(data)])
+    assert ran.exit_code == 0, ran.output
+
+    def full_device(path: Path) -> int:  # /dev/full: every write fails with ENOSPC
+        return os.open("/dev/full", os.O_WRONLY)
+
+    monkeypatch.setattr(figures, "create_new_file", full_device)
+    result = runner.invoke(app, ["plot", str(data), "-o", str(tmp_path / "fig.png")])
+    assert result.exit_code == 1, result.output
+    assert result.stderr.splitlines() == [
+        f"error: cannot write {tmp_path / 'fig.png'}: No space left on device; no figure was "
+        "written"
+    ]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pass.nc", "scenario.yaml"]
+
+
+def _period_csv(tmp_path: Path) -> Path:
+    """60 epochs of a 7 s sinusoid in one band: enough for `speclight period`."""
+    t = np.arange(60)
+    rate = 1000.0 * (1.0 + 0.3 * np.sin(2 * np.pi * t / 7.0))
+    start = np.datetime64("2020-02-29T21:16:00", "s")
+    rows = [f"{start + np.timedelta64(int(k), 's')}Z,{r:.3f}" for k, r in zip(t, rate, strict=True)]
+    path = tmp_path / "lc.csv"
+    path.write_text("time,B\n" + "\n".join(rows) + "\n")
+    return path
+
+
+def test_a_signal_while_the_figure_draws_leaves_nothing_and_the_rerun_works(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from speclight.plot import period_figure
+
+    args = ["period", str(_period_csv(tmp_path)), "-o", str(tmp_path / "p.json")]
+    args += ["--plot", str(tmp_path / "p.png"), "--draws", "2"]
+
+    def interrupted(*args: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(period_figure, "period_figure", interrupted)
+    result = runner.invoke(app, args)
+    assert (result.exit_code, result.stderr.splitlines()) == (130, ["error: interrupted"])
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["lc.csv"]
+    monkeypatch.undo()
+    rerun = runner.invoke(app, args)  # no --force needed: nothing was left
+    assert rerun.exit_code == 0, rerun.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["lc.csv", "p.json", "p.png"]
+
+
+def test_a_figure_that_cannot_be_written_takes_its_output_back(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from speclight.io.output import OutputClaim, OutputWriteError
+
+    real_write = OutputClaim.write
+
+    def no_room_for_figures(self: OutputClaim, data: bytes) -> Path:
+        if self.path.suffix == ".png":
+            raise OutputWriteError(f"cannot write {self.output}: No space left on device")
+        return real_write(self, data)
+
+    monkeypatch.setattr(OutputClaim, "write", no_room_for_figures)
+    args = ["period", str(_period_csv(tmp_path)), "-o", str(tmp_path / "p.json")]
+    result = runner.invoke(app, [*args, "--plot", str(tmp_path / "p.png"), "--draws", "2"])
+    assert result.exit_code == 1, result.output
+    assert "p.png: No space left on device" in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["lc.csv"]

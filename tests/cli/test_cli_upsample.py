@@ -112,6 +112,8 @@ def test_plot_is_written(tmp_path: Path, scenario: Path) -> None:
         ("above-one", "must be in (0, 1]"),
         ("not-json", "not JSON"),
         ("no-bands", 'no "bands" mapping'),
+        ("deep", "nested deeper than Python's JSON reader goes"),
+        ("digits", "an integer of more than 4300 digits"),
         ("exists", "exists; choose another name or pass --force"),
         ("output-is-fit", "is the fit file"),
         ("plot-is-output", "is the output"),
@@ -138,6 +140,10 @@ def test_bad_input_exits_2_and_writes_nothing(
         fit.write_text("{bands: R 0.5}")
     elif case == "no-bands":
         fit.write_text('{"albedo": 0.5}')
+    elif case == "deep":
+        fit.write_text("[" * 100_000 + "]" * 100_000)
+    elif case == "digits":
+        fit.write_text('{"bands": {"G-520/25": {"albedo": ' + "1" * 5001 + "}}}")
     elif case == "exists":
         out.write_text("precious")
     elif case == "output-is-fit":

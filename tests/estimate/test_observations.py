@@ -66,8 +66,9 @@ ROW = "2020-02-29T21:16:00Z,7.5,0.05,V,48.5,9.25\n"
          r"line 2, column 'latitude_deg': '95' is not accepted; expected a geodetic latitude "
          r"\[deg\] within -90..90"),
         (HEADER + "2020-02-29 25:00,7.5,0.1,V,45,9.25\n",
-         r"line 2: '2020-02-29 25:00' is not an ISO 8601 time .* \(column 'time'\)"),
-        (HEADER + "2020-02-29T21:16:10+01:00,7.5,0.1,V,45,9.25\n", r"line 2: .* give UTC"),
+         r"line 2, column 'time': '2020-02-29 25:00' is not an ISO 8601 time"),
+        (HEADER + "2020-02-29T21:16:10+01:00,7.5,0.1,V,45,9.25\n",
+         r"line 2, column 'time': .* give UTC"),
         (HEADER + "2020-02-29T21:16:10Z,7.5,0.1,,45,9.25\n", r"line 2, column 'band': a band"),
         (HEADER + "2020-02-29T21:16:10Z,7.5,0.1,V,45\n", r"line 2: 5 cells, the header names 6"),
         ("time,magnitude,magnitude_sigma,bnd,latitude_deg,longitude_deg\n" + ROW,

@@ -139,6 +139,24 @@ def test_tables_that_are_not_complete_finals_files_are_refused(
     assert not data_dir.exists() or not any(data_dir.rglob("*"))
 
 
+def test_a_table_cut_in_the_middle_of_a_line_is_not_installed(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    table, _ = _extended_table(tmp_path)
+    text = table.read_text()
+    cut = tmp_path / "cut.all"
+    # cut inside the last row's UT1-UTC (columns 59-68): '0.05000' of '0.0500000' still parses
+    cut.write_text(text[: text.rstrip("\n").rfind("\n") + 1 + 65])
+    result = runner.invoke(app, ["update-data", "--from", str(cut)])
+    assert result.exit_code == 2, result.output
+    assert "ends in the middle of line" in result.stderr and "cut short" in result.stderr
+    assert not data_dir.exists() or not any(data_dir.rglob("*"))
+    # a complete table without the final line end is a table
+    whole = tmp_path / "whole.all"
+    whole.write_text(text.rstrip("\n"))
+    assert runner.invoke(app, ["update-data", "--from", str(whole)]).exit_code == 0
+
+
 def test_nothing_is_downloaded_when_tables_are_loaded(
     data_dir: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

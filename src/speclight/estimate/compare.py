@@ -8,7 +8,8 @@ then added to the scenario's bands (its AB magnitude: band response only). Where
 scenario has ``orbit: {observed: true}``, the target is placed where each row saw it
 (:mod:`speclight.orbit.observed_position`). Epochs where the target is not observable
 (below the minimum elevation, in the Earth's shadow, no attitude) keep their row with a
-NaN simulated magnitude and their ``flags``.
+NaN simulated magnitude and their ``flags``; where no row is observable the comparison is
+refused (an :class:`~speclight.errors.InputError`: the times or the scenario are wrong).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from speclight import orbit
 from speclight.constants import C_M_S
 from speclight.errors import InputError
 from speclight.estimate.compare_stats import residual_statistics
+from speclight.estimate.measured_checks import no_usable_epochs
 from speclight.estimate.observations import FIELD, Observations
 from speclight.orbit.observed_position import (
     observed_trajectory,
@@ -182,6 +184,8 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
         flags[idx] = ds["flags"].values[k]
         for name, var in GEOMETRY.items():
             geo[name][idx] = ds[var].values[k]
+    if not np.any(np.isfinite(sim) & np.isfinite(obs.magnitude)):
+        raise no_usable_epochs(n, loaded.source, obs.source, FIELD, "observed")
     return CompareResult(dataset=_dataset(loaded, obs, sim, flags, geo), notes=notes)
 
 

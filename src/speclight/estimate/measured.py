@@ -1,21 +1,29 @@
 """Measured light curves in: a CSV of count rates per band, or a speclight NetCDF dataset.
 
-CSV: the first column is ``time`` (ISO 8601, UTC: ``2020-02-29T21:16:00Z``, a ``+00:00``
-offset or no offset), the others are count rates [s-1] named exactly as the scenario's
-bands, optionally with ``<band>_sigma`` columns (the rates' standard deviations [s-1]);
-lines starting with ``#`` are comments. NetCDF: a speclight dataset; its
-``count_rate_measured`` is used where present, else ``count_rate``, and ``count_rate_sigma``
-where present; with ``source="laser"`` its laser reflectance factors per band,
-``laser_reflectance_factor`` (the returns normalised by the range and the laser irradiance,
-which the returns fall with as ``range^-4``; the Sun's light left out, as a range-gated
-detector sees it), with the shot noise of ``return_rate`` over one epoch spacing as sigma.
+CSV (:mod:`.measured_csv`): a ``time`` column (ISO 8601 UTC), then count rates [s-1] per
+band named exactly as the scenario's bands, optionally ``<band>_sigma`` columns (the rates'
+standard deviations [s-1]); ``#`` lines are comments. NetCDF: a speclight dataset (read by
+:func:`speclight.io.user_dataset.read_user_dataset`, which refuses damaged files, other
+dimensions and times without CF units); its ``count_rate_measured`` is used where present,
+else ``count_rate``, and ``count_rate_sigma`` where present; with ``source="laser"`` its
+laser reflectance factors per band, ``laser_reflectance_factor`` (the returns normalised by
+the range and the laser irradiance, which the returns fall with as ``range^-4``; the Sun's
+light left out, as a range-gated detector sees it), with the shot noise of ``return_rate``
+over one epoch spacing as sigma.
 
 What is refused (an :class:`~speclight.errors.InputError` naming the file and line or
-column) and what is kept:
+time index, the column or band and the value) and what is kept:
 
-* unreadable files, a missing ``time`` column, a column that is neither a band nor a band's
-  sigma, unparseable numbers or times, a time with another UTC offset, duplicate or
-  unsorted times, negative or non-finite sigmas: refused;
+* unreadable files, a missing ``time`` column, an empty or repeated column name, a
+  ``_sigma`` column of no band, a row with fewer cells than the header or a value in a
+  column without a name, unparseable numbers or times, a time with another UTC offset,
+  duplicate or unsorted times: refused;
+* epochs outside the Sun ephemeris, infinite, subnormal or huge rates, sigmas that are
+  not above 0, below the rate's rounding or huge, a band without any rate above 0:
+  refused (:mod:`.measured_checks` says why each);
+* a column that is not a band of the scenario, where a scenario gives the bands (``fit``,
+  ``unmix``, ``reflection-map``, ``spin-axis``): refused by
+  :meth:`MeasuredLightCurve.select_bands` (extra bands of a NetCDF are ignored);
 * an empty cell or ``nan``: kept as NaN (no measurement of that band at that epoch; fits
   skip it);
 * negative rates: kept. Measured rates are background-subtracted (as speclight's own
@@ -27,19 +35,30 @@ camera's exposures), as the reference paper did (Nussbaum et al. 2022, section 4
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError, did_you_mean
-from speclight.input_files import read_user_text
+from speclight.estimate.measured_checks import (
+    MAX_RATE_PER_S,
+    check_epochs,
+    check_order,
+    check_rates,
+    check_sigmas,
+    check_signal,
+    dataset_namers,
+)
+from speclight.estimate.measured_csv import read_csv_columns
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 F64 = NDArray[np.float64]
 FIELD = "MEASURED"
-_OFFSET = re.compile(r"(Z|[+-]\d\d:?\d\d)$")
 
 
 @dataclass
@@ -61,6 +80,9 @@ class MeasuredLightCurve:
         (N,) measurements averaged into each epoch (1 unless binned).
     source
         Where the data came from (a file name).
+    extra_bands_refused
+        Whether :meth:`select_bands` refuses bands that it is not asked for (a CSV's columns
+        are all the user's; a NetCDF holds every band of its scenario).
     """
 
     time_utc: NDArray[np.datetime64]
@@ -69,10 +91,13 @@ class MeasuredLightCurve:
     sigma_per_s: F64 | None
     n_samples: NDArray[np.int64]
     source: str
+    extra_bands_refused: bool = False
 
-    def select_bands(self, band_names: list[str]) -> MeasuredLightCurve:
+    def select_bands(self, band_names: list[str], *, subset: bool = False) -> MeasuredLightCurve:
         """The same light curve with its bands in the order of ``band_names`` (e.g. the
-        scenario's), checked: a band that is not measured is an error with a did-you-mean."""
+        scenario's), checked: a band that is not measured is an error with a did-you-mean,
+        and so is a measured band that is not asked for where ``extra_bands_refused`` (a CSV
+        column that is no band of the scenario), unless ``subset`` (a choice of bands)."""
         index = []
         for name in band_names:
             if name not in self.band_names:
@@ -84,6 +109,17 @@ class MeasuredLightCurve:
                     field=FIELD,
                 )
             index.append(self.band_names.index(name))
+        if self.extra_bands_refused and not subset:
+            extra = [b for b in self.band_names if b not in band_names]
+            if extra:
+                raise InputError(
+                    f"column '{extra[0]}' is not a band of the scenario"
+                    f"{did_you_mean(extra[0], band_names)} (bands: {', '.join(band_names)}); "
+                    "give one column per scenario band, named as in the scenario, and "
+                    "optionally '<band>_sigma'",
+                    source=self.source,
+                    field=FIELD,
+                )
         sigma = None if self.sigma_per_s is None else self.sigma_per_s[:, index]
         return replace(
             self,
@@ -110,174 +146,90 @@ def read_measured(path: str | Path, source: str = "sun") -> MeasuredLightCurve:
             source=str(p),
             field="--source",
         )
-    return _read_csv(p)
+    c = read_csv_columns(p)
+    ones = np.ones(c.time_utc.size, np.int64)
+    return MeasuredLightCurve(
+        c.time_utc,
+        c.band_names,
+        c.rate_per_s,
+        c.sigma_per_s,
+        ones,
+        str(p),
+        extra_bands_refused=True,
+    )
 
 
-def _read_csv(path: Path) -> MeasuredLightCurve:
-    src = str(path)
-    lines = [
-        (k, line.strip())
-        for k, line in enumerate(read_user_text(path, FIELD, what="measurements").splitlines(), 1)
-        if line.strip() and not line.lstrip().startswith("#")
-    ]
-    if not lines:
-        raise InputError("the file holds no header and no rows", source=src, field=FIELD)
-    header_line, header = lines[0]
-    columns = [c.strip() for c in header.split(",")]
-    if columns[0] != "time":
-        raise InputError(
-            f"line {header_line}: the first column must be 'time' (ISO 8601 UTC), got "
-            f"'{columns[0]}'",
-            source=src,
-            field=FIELD,
-        )
-    names = columns[1:]
-    bands = [c for c in names if not c.endswith("_sigma")]
-    if not bands or len(set(names)) != len(names):
-        raise InputError(
-            f"line {header_line}: give one column per band (and optionally '<band>_sigma'), "
-            f"each once; got {', '.join(names) or 'none'}",
-            source=src,
-            field=FIELD,
-        )
-    for c in names:
-        if c.endswith("_sigma") and c.removesuffix("_sigma") not in bands:
-            raise InputError(
-                f"line {header_line}: column '{c}' is the sigma of no band column "
-                f"(bands: {', '.join(bands)})",
-                source=src,
-                field=FIELD,
-            )
-    if len(lines) < 2:
-        raise InputError("the file holds a header but no rows", source=src, field=FIELD)
-    times, values = [], []
-    for k, line in lines[1:]:
-        cells = [c.strip() for c in line.split(",")]
-        if len(cells) != len(columns):
-            raise InputError(
-                f"line {k}: {len(cells)} cells, the header names {len(columns)}",
-                source=src,
-                field=FIELD,
-            )
-        times.append(_time(cells[0], k, src))
-        values.append([_number(c, k, col, src) for c, col in zip(cells[1:], names, strict=True)])
-    t = np.array(times, dtype="datetime64[ns]")
-    _check_order(t, [k for k, _ in lines[1:]], src)
-    data = np.array(values, dtype=float).reshape(len(times), len(names))
-    rate = data[:, [names.index(b) for b in bands]]
-    sigma = None
-    if any(f"{b}_sigma" in names for b in bands):
-        sigma = np.full(rate.shape, np.nan)
-        for j, b in enumerate(bands):
-            if f"{b}_sigma" in names:
-                sigma[:, j] = data[:, names.index(f"{b}_sigma")]
-        _check_sigma(sigma, src)
-    return MeasuredLightCurve(t, bands, rate, sigma, np.ones(len(t), np.int64), src)
-
-
-def _time(text: str, line: int, src: str) -> np.datetime64:
-    m = _OFFSET.search(text)
-    body = text
-    if m:
-        if m.group(1) not in ("Z", "+00:00", "+0000", "-00:00"):
-            raise InputError(
-                f"line {line}: time '{text}' has the UTC offset {m.group(1)}; give UTC "
-                "(a 'Z' or '+00:00' suffix, or none)",
-                source=src,
-                field=FIELD,
-            )
-        body = text[: m.start()]
-    try:
-        t = np.datetime64(body, "ns")
-    except ValueError:
-        raise InputError(
-            f"line {line}: '{text}' is not an ISO 8601 time (e.g. 2020-02-29T21:16:00Z)",
-            source=src,
-            field=FIELD,
-        ) from None
-    if np.isnat(t):
-        raise InputError(f"line {line}: time '{text}' is not a time", source=src, field=FIELD)
-    return t
-
-
-def _number(text: str, line: int, column: str, src: str) -> float:
-    if text == "" or text.lower() == "nan":
-        return np.nan
-    try:
-        x = float(text)
-    except ValueError:
-        raise InputError(
-            f"line {line}: '{text}' in column '{column}' is not a number", source=src, field=FIELD
-        ) from None
-    if np.isinf(x):
-        raise InputError(
-            f"line {line}: '{text}' in column '{column}' is infinite", source=src, field=FIELD
-        )
-    return x
-
-
-def _check_order(t: NDArray[np.datetime64], lines: list[int], src: str) -> None:
-    step = np.diff(t)
-    bad = np.flatnonzero(step <= np.timedelta64(0, "ns"))
-    if bad.size:
-        k = int(bad[0])
-        what = "repeats" if step[k] == np.timedelta64(0, "ns") else "comes before"
-        raise InputError(
-            f"line {lines[k + 1]}: time {t[k + 1]} {what} the time of line {lines[k]}; "
-            "give each epoch once, in increasing order",
-            source=src,
-            field=FIELD,
-        )
-
-
-def _check_sigma(sigma: F64, src: str) -> None:
-    bad = np.isfinite(sigma) & (sigma < 0)
-    if np.any(bad):
-        i, j = np.argwhere(bad)[0]
-        raise InputError(
-            f"row {i + 1}, band {j + 1}: sigma {sigma[i, j]:g} is negative",
-            source=src,
-            field=FIELD,
-        )
+#: What the NetCDF reader reads of a dataset.
+NETCDF_VARIABLES = (
+    "count_rate_measured",
+    "count_rate",
+    "count_rate_sigma",
+    "laser_reflectance_factor",
+    "return_rate",
+)
 
 
 def _read_netcdf(path: Path, source: str = "sun") -> MeasuredLightCurve:
-    import xarray as xr
+    from speclight.io.user_dataset import read_user_dataset
 
-    src = str(path)
-    try:
-        ds = xr.open_dataset(path, engine="h5netcdf")
-    except (OSError, ValueError) as exc:
-        raise InputError(f"cannot read it as NetCDF: {exc}", source=src, field=FIELD) from None
-    with ds:
-        name = "count_rate_measured" if "count_rate_measured" in ds else "count_rate"
-        if source == "laser":
-            if "return_rate" not in ds:
-                raise InputError(
-                    "--source laser: no laser return rates (return_rate) in it: the scenario "
-                    "had no lasers (use --source sun)",
-                    source=src,
-                    field="--source",
-                )
-            name = "laser_reflectance_factor"
-        if name not in ds or "band" not in ds.coords:
+    ds = read_user_dataset(path, FIELD, what="measurements", variables=NETCDF_VARIABLES)
+    return measured_from_dataset(ds, str(path), source)
+
+
+def measured_from_dataset(ds: xr.Dataset, src: str, source: str = "sun") -> MeasuredLightCurve:
+    """The light curve of a dataset read by :func:`speclight.io.user_dataset.read_user_dataset`
+    (module docstring: which variables; every check of the CSV reader)."""
+    from speclight.io.user_dataset import values
+
+    name = "count_rate_measured" if "count_rate_measured" in ds else "count_rate"
+    if source == "laser":
+        if "return_rate" not in ds:
             raise InputError(
-                "not a speclight dataset with band count rates (count_rate_measured or "
-                "count_rate on (time, band))",
+                "--source laser: no laser return rates (return_rate) in it: the scenario "
+                "had no lasers (use --source sun)",
+                source=src,
+                field="--source",
+            )
+        name = "laser_reflectance_factor"
+    if name not in ds or "band" not in ds.coords:
+        raise InputError(
+            "not a speclight dataset with band count rates (count_rate_measured or "
+            "count_rate on (time, band))",
+            source=src,
+            field=FIELD,
+        )
+    if ds.sizes["time"] == 0:
+        raise InputError("the dataset holds no epochs ('time' is empty)", source=src, field=FIELD)
+    bands = [str(b) for b in ds["band"].values]
+    _check_band_names(bands, src)
+    t_in = ds["time"].values
+    row, column = dataset_namers(t_in, bands)
+    t = check_epochs(t_in, row, src, FIELD)
+    check_order(t, row, src, FIELD)
+    rate = values(ds, name, ("time", "band"), src, FIELD)
+    laser = source == "laser"
+    what = "laser reflectance factor" if laser else "rate"
+    check_rates(rate, row, column, src, FIELD, max_abs=None if laser else MAX_RATE_PER_S, what=what)
+    sigma = None
+    if "count_rate_sigma" in ds and not laser:
+        sigma = values(ds, "count_rate_sigma", ("time", "band"), src, FIELD)
+        check_sigmas(sigma, rate, row, column, src, FIELD)
+    if laser:
+        returns = values(ds, "return_rate", ("time", "band"), src, FIELD)
+        sigma = _laser_sigma(rate, returns, t)
+    check_signal(rate, bands, src, FIELD, what)
+    return MeasuredLightCurve(t, bands, rate, sigma, np.ones(t.size, np.int64), src)
+
+
+def _check_band_names(bands: list[str], src: str) -> None:
+    for j, b in enumerate(bands):
+        if not b.strip() or b in bands[:j]:
+            what = "an empty name" if not b.strip() else f"the name '{b}' of an earlier band"
+            raise InputError(
+                f"band {j + 1} of the band coordinate has {what}; give each band a name, once",
                 source=src,
                 field=FIELD,
             )
-        t = ds["time"].values.astype("datetime64[ns]")
-        _check_order(t, list(range(1, t.size + 1)), src)
-        rate = ds[name].transpose("time", "band").values.astype(float)
-        sigma = None
-        if "count_rate_sigma" in ds and source == "sun":
-            sigma = ds["count_rate_sigma"].transpose("time", "band").values.astype(float)
-            _check_sigma(sigma, src)
-        if source == "laser":
-            sigma = _laser_sigma(rate, ds["return_rate"].transpose("time", "band").values, t)
-        bands = [str(b) for b in ds["band"].values]
-    return MeasuredLightCurve(t, bands, rate, sigma, np.ones(t.size, np.int64), src)
 
 
 def _laser_sigma(factor: F64, returns: F64, t: np.ndarray) -> F64:

@@ -35,14 +35,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError, did_you_mean
-from speclight.estimate.measured import _time as _measured_time
+from speclight.estimate.measured_csv import parse_utc_time
 from speclight.input_files import read_user_text
-from speclight.scenario.sections_geometry import FIRST_EPOCH_UTC, LAST_EPOCH_UTC
 
 F64 = NDArray[np.float64]
 FIELD = "OBSERVATIONS"
-FIRST_EPOCH = np.datetime64(FIRST_EPOCH_UTC.replace(tzinfo=None), "ns")
-LAST_EPOCH = np.datetime64(LAST_EPOCH_UTC.replace(tzinfo=None), "ns")
 SITE_KEYS = ("latitude_deg", "longitude_deg", "altitude_m")
 POSITION_KEYS = ("elevation_deg", "azimuth_deg", "range_m", "height_m")
 REQUIRED = ("time", "magnitude", "magnitude_sigma", "band")
@@ -232,17 +229,8 @@ def _rows(
     for i, (lineno, cells) in enumerate(rows):
         if len(cells) != len(header):
             raise _error(f"line {lineno}: {len(cells)} cells, the header names {len(header)}", src)
-        try:
-            times.append(_measured_time(cells[col["time"]], lineno, src))
-        except InputError as exc:
-            raise _error(f"{exc.message} (column 'time')", src) from None
-        if not FIRST_EPOCH <= times[-1] <= LAST_EPOCH:
-            raise _error(
-                f"line {lineno}, column 'time': {cells[col['time']]} is outside what the "
-                f"shipped Sun ephemeris (JPL DE421) covers; accepted: {FIRST_EPOCH_UTC.date()} "
-                f"to {LAST_EPOCH_UTC.date()} UTC",
-                src,
-            )
+        where = f"line {lineno}, column 'time'"
+        times.append(parse_utc_time(cells[col["time"]], where, src, FIELD))
         band = cells[col["band"]]
         if not band:
             raise _error(

@@ -19,25 +19,30 @@ from speclight.scenario import LoadedScenario
 
 def _dataset_bisector(path: Path, source: str) -> tuple[np.ndarray, F64, F64] | None:
     """(time, PAB in GCRS, phase angle [deg]) from a speclight dataset, if it has the
-    attitude and the phase vector (observer direction for lasers)."""
-    import xarray as xr
-
+    attitude and the phase vector (observer direction for lasers) at two epochs at least."""
     from speclight.attitude.quaternion import quat_rotate
+    from speclight.io.user_dataset import read_user_dataset, values
 
+    src = str(path)
     vector = "observer_direction_body" if source == "laser" else "phase_vector_body"
-    with xr.open_dataset(path, engine="h5netcdf") as ds:
-        if "attitude_quaternion" not in ds or vector not in ds:
-            return None
-        q = ds["attitude_quaternion"].transpose("time", "wxyz").values.astype(float)
-        pv = ds[vector].transpose("time", "xyz").values.astype(float)
-        t = ds["time"].values.astype("datetime64[ns]")
-        if source == "laser":
-            phase = np.zeros(t.size)
-        elif "phase_angle" in ds:
-            phase = ds["phase_angle"].values.astype(float)
-        else:
-            return None
-    return t, quat_rotate(q, pv), phase
+    wanted = ("attitude_quaternion", vector, "phase_angle")
+    ds = read_user_dataset(path, "MEASURED", what="measurements", variables=wanted)
+    if "attitude_quaternion" not in ds or vector not in ds:
+        return None
+    if source != "laser" and "phase_angle" not in ds:
+        return None
+    q = values(ds, "attitude_quaternion", ("time", "wxyz"), src, "MEASURED")
+    pv = values(ds, vector, ("time", "xyz"), src, "MEASURED")
+    t = ds["time"].values.astype("datetime64[ns]")
+    if source == "laser":
+        phase = np.zeros(t.size)
+    else:
+        phase = values(ds, "phase_angle", ("time",), src, "MEASURED")
+    with np.errstate(invalid="ignore"):
+        gcrs = quat_rotate(q, pv)
+    if np.sum(np.all(np.isfinite(gcrs), axis=1)) < 2:
+        return None  # NaN at (nearly) every epoch: the geometry is not known
+    return t, gcrs, phase
 
 
 def _at(t_out: np.ndarray, t_in: np.ndarray, v: F64) -> F64:
@@ -66,7 +71,8 @@ def pass_geometry(
     source: str = "sun",
 ) -> tuple[F64, F64 | None, F64] | None:
     """(PAB in GCRS at the light curve's epochs (N, 3), spin axis or None, phase angle at
-    the epochs (N,) [deg]), or None when the geometry is unknown (a CSV without a scenario).
+    the epochs (N,) [deg]), or None when the geometry is unknown (a CSV without a scenario,
+    or NaN at all epochs but one).
 
     The PAB comes from the dataset (``attitude_quaternion`` and ``phase_vector_body``, or
     ``observer_direction_body`` for lasers, interpolated to binned epochs) or else from the
@@ -89,6 +95,8 @@ def pass_geometry(
         phase = np.zeros(t_in.size) if source == "laser" else geo.phase_angle_deg
     else:
         return None
+    if np.sum(np.all(np.isfinite(gcrs), axis=1)) < 2:
+        return None  # no geometry at (nearly) any epoch: as unknown as without a scenario
     pab = _at(lc.time_utc, t_in, gcrs)
     x_in = (t_in - t_in[0]) / np.timedelta64(1, "s")
     x_out = (lc.time_utc - t_in[0]) / np.timedelta64(1, "s")

@@ -252,7 +252,7 @@ def estimate_period(
         )
     lc = read_measured(measured, source)
     if bands:
-        lc = lc.select_bands(list(bands))
+        lc = lc.select_bands(list(bands), subset=True)
     if bin_s is not None:
         lc = bin_light_curve(lc, bin_s)
     loaded = loaded if loaded is not None else _carried_scenario(measured)
@@ -334,12 +334,11 @@ def _apply_synodic(mode: str, phase_deg: F64) -> tuple[bool, str]:
 def _carried_scenario(measured: str | Path) -> LoadedScenario | None:
     if Path(measured).suffix.lower() not in (".nc", ".nc4", ".netcdf", ".h5"):
         return None
-    import xarray as xr
-
+    from speclight.io.user_dataset import read_user_dataset
     from speclight.scenario import parse_scenario
 
-    with xr.open_dataset(measured, engine="h5netcdf") as ds:
-        text = ds.attrs.get("scenario_yaml")
+    ds = read_user_dataset(measured, "MEASURED", what="measurements", variables=())
+    text = ds.attrs.get("scenario_yaml")
     if text is None:
         return None
     return parse_scenario(str(text), source=f"{measured} (scenario_yaml)")

@@ -55,6 +55,7 @@ from speclight.estimate.unmix_inputs import (
 )
 from speclight.estimate.unmix_io import SCENARIO_ENDMEMBERS, check_distinct, check_unmix_options
 from speclight.estimate.unmixing_epochs import unmix_per_epoch
+from speclight.io.user_dataset import read_user_dataset, values
 
 if TYPE_CHECKING:
     from speclight.scenario import LoadedScenario
@@ -109,10 +110,18 @@ def reflection_map_measured(
     p = Path(measured)
     is_nc = p.suffix.lower() in NETCDF_SUFFIXES
     if endmembers == [SCENARIO_ENDMEMBERS] and loaded is None and is_nc:
-        with xr.open_dataset(p, engine="h5netcdf") as head:
-            loaded = dataset_scenario(head, str(p))
+        head = read_user_dataset(p, "MEASURED", what="measurements", variables=())
+        loaded = dataset_scenario(head, str(p))
     data = read_reflectance_factors(p, loaded, bin_s, progress, light)
     direction, offset, origin = _directions(p, is_nc, data, loaded, bin_s)
+    mappable = np.all(np.isfinite(direction), axis=1) & np.any(np.isfinite(data.factor), axis=1)
+    if not np.any(mappable):
+        raise InputError(
+            f"no epoch has both a reflectance factor and a direction ({origin}): the map "
+            "would be empty; the directions are NaN where the factors are known",
+            source=str(p),
+            field="MEASURED",
+        )
     rmap = reflection_map(direction, data.factor, nside)
     ds = _dataset(data, rmap, direction, origin)
     if offset is not None:
@@ -145,17 +154,18 @@ def _directions(
     var = DIRECTION[data.light]
     offset = None
     if is_nc:
-        with xr.open_dataset(p, engine="h5netcdf") as ds:
-            if "range_offset" in ds:
-                offset = ds["range_offset"].transpose("time", "band").values.astype(float)
-            if var in ds:
-                d = ds[var].transpose("time", "xyz").values.astype(float)
-                t0 = ds["time"].values.astype("datetime64[ns]")
-                if bin_s is not None:
-                    _, d = bin_factors(t0, d, bin_s, str(p))
-                    if offset is not None:
-                        _, offset = bin_factors(t0, offset, bin_s, str(p))
-                return unit_vectors(d), offset, f"{p}: {var}"
+        src = str(p)
+        ds = read_user_dataset(p, "MEASURED", what="measurements", variables=(var, "range_offset"))
+        if "range_offset" in ds:
+            offset = values(ds, "range_offset", ("time", "band"), src, "MEASURED")
+        if var in ds:
+            d = values(ds, var, ("time", "xyz"), src, "MEASURED")
+            t0 = ds["time"].values.astype("datetime64[ns]")
+            if bin_s is not None:
+                _, d = bin_factors(t0, d, bin_s, src)
+                if offset is not None:
+                    _, offset = bin_factors(t0, offset, bin_s, src)
+            return unit_vectors(d), offset, f"{p}: {var}"
         if loaded is None:
             raise InputError(
                 f"the dataset has no {var}(time, xyz): give --scenario SCENARIO.yaml for the "

@@ -32,6 +32,7 @@ from speclight import schema
 from speclight.errors import InputError
 from speclight.estimate.fit import F64, fit_scales, shot_noise_sigma
 from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve
+from speclight.estimate.measured_checks import no_usable_epochs
 from speclight.estimate.scenario_roughness import (
     fit_rough_gradient,
     fit_rough_slsqp,
@@ -50,6 +51,7 @@ _SKIP = (
     | schema.FLAG_BELOW_MIN_ELEVATION
     | schema.FLAG_IN_SHADOW
     | schema.FLAG_RENDER_FAILED
+    | schema.FLAG_DAYLIGHT
 )
 
 
@@ -212,6 +214,8 @@ def fit_scenario(
     sigma = shot if sigma is None else np.where(np.isfinite(sigma), sigma, shot)
     usable = (ds["flags"].values.astype(np.int64) & _SKIP) == 0
     m = np.where(usable[:, None], lc.rate_per_s, np.nan)
+    if not np.any(np.isfinite(m)):
+        raise no_usable_epochs(lc.time_utc.size, loaded.source, lc.source)
     rho = _band_reflectance(loaded, ds)
     notes: list[str] = []
     if rough:

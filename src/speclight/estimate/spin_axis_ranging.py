@@ -36,7 +36,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import xarray as xr
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
@@ -159,10 +158,12 @@ def resolve_weight(term: RangingTerm, e_i: F64, e_r: F64) -> RangingTerm:
 
 def measured_offsets(measured: str | Path, n_t: int) -> F64 | None:
     """``range_offset(time, band)`` [m] of a simulate NetCDF, or None where it has none."""
-    with xr.open_dataset(measured, engine="h5netcdf") as ds:
-        if "range_offset" not in ds:
-            return None
-        off = ds["range_offset"].transpose("time", "band").values.astype(float)
+    from speclight.io.user_dataset import read_user_dataset, values
+
+    ds = read_user_dataset(measured, "MEASURED", what="measurements", variables=["range_offset"])
+    if "range_offset" not in ds:
+        return None
+    off = values(ds, "range_offset", ("time", "band"), str(measured), "MEASURED")
     if off.shape[0] != n_t or not np.any(np.isfinite(off)):
         return None
     return np.asarray(off)

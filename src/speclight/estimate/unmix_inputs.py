@@ -34,7 +34,14 @@ import xarray as xr
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
-from speclight.estimate.measured import MeasuredLightCurve, bin_light_curve, read_measured
+from speclight.estimate.measured import (
+    NETCDF_VARIABLES,
+    MeasuredLightCurve,
+    bin_light_curve,
+    measured_from_dataset,
+    read_measured,
+)
+from speclight.estimate.measured_checks import check_rates, dataset_namers, no_usable_epochs
 from speclight.estimate.scenario_bands import BandResponses, dataset_band_responses
 from speclight.estimate.source_spectrum import (
     Light,
@@ -43,12 +50,29 @@ from speclight.estimate.source_spectrum import (
     laser_source_W_m2_nm,
     sun_source_W_m2_nm,
 )
+from speclight.io.user_dataset import read_user_dataset, values
 
 if TYPE_CHECKING:
     from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
 FIELD = "MEASURED"
+#: What :func:`read_reflectance_factors` reads of a dataset (factors, band responses, the
+#: source spectrum, ground truth), besides the rates of the MEASURED checks.
+DATASET_VARIABLES = (
+    *NETCDF_VARIABLES,
+    "reflectance_factor",
+    "reflectance_factor_material",
+    "laser_reflectance_factor_material",
+    "material_reflectance",
+    "band_response",
+    "optics_transmission",
+    "detector_qe",
+    "solar_irradiance",
+    "transmission",
+    "sunlit",
+    "laser_irradiance",
+)
 
 
 @dataclass(frozen=True)
@@ -142,47 +166,49 @@ def read_reflectance_factors(
             )
         lc = read_measured(p)
         return _factors_from_rates(lc, loaded, bin_s, progress, light)
-    read_measured(p)  # the file checks of every MEASURED reader (times, rates, sigmas)
-    with xr.open_dataset(p, engine="h5netcdf") as ds:
-        chosen: Light = default_light(ds) if light is None else light  # type: ignore[assignment]
-        var = "laser_reflectance_factor" if chosen == "laser" else "reflectance_factor"
-        if var not in ds:
-            raise InputError(
-                f"the dataset has no {var}(time, band) (simulate writes it for a "
-                f"{'laser-lit' if chosen == 'laser' else 'sunlit'} target with bands); "
-                "give a CSV of rates with --scenario instead",
-                source=src,
-                field=FIELD,
-            )
-        bands = dataset_band_responses(ds, src)
-        factor = ds[var].transpose("time", "band").values.astype(float)
-        if not np.any(np.isfinite(factor)):
-            other = "sun" if chosen == "laser" else "laser"
-            raise InputError(
-                f"{var} is NaN at every epoch (no {'laser' if chosen == 'laser' else 'Sun'} "
-                f"light); try --source {other}",
-                source=src,
-                field="--source",
-            )
-        what = var
-        if chosen == "sun":
-            source = sun_source_W_m2_nm(ds)
-            if "count_rate_measured" in ds and "count_rate" in ds:
-                rate = ds["count_rate"].transpose("time", "band").values.astype(float)
-                measured = ds["count_rate_measured"].transpose("time", "band").values
-                with np.errstate(invalid="ignore", divide="ignore"):
-                    factor = np.where(rate > 0, factor * measured / rate, np.nan)
-                what = "reflectance_factor x count_rate_measured / count_rate (the noisy rates)"
-        else:
-            source = laser_source_W_m2_nm(ds, loaded or dataset_scenario(ds, src))
-        truth, names, labels = None, None, None
-        if f"{var}_material" in ds:
-            da = ds[f"{var}_material"].transpose("time", ..., "band")
-            truth = da.values.astype(float)
-            names = [str(m) for m in ds[da.dims[1]].values]
-            if "material_reflectance" in ds:
-                labels = [str(m) for m in ds["material_reflectance"].values]
-        time = ds["time"].values.astype("datetime64[ns]")
+    ds = read_user_dataset(p, FIELD, what="measurements", variables=DATASET_VARIABLES)
+    chosen: Light = default_light(ds) if light is None else light  # type: ignore[assignment]
+    var = "laser_reflectance_factor" if chosen == "laser" else "reflectance_factor"
+    if var not in ds:
+        raise InputError(
+            f"the dataset has no {var}(time, band) (simulate writes it for a "
+            f"{'laser-lit' if chosen == 'laser' else 'sunlit'} target with bands); "
+            "give a CSV of rates with --scenario instead",
+            source=src,
+            field=FIELD,
+        )
+    bands = dataset_band_responses(ds, src)
+    factor = values(ds, var, ("time", "band"), src, FIELD)
+    if not np.any(np.isfinite(factor)):
+        other = "sun" if chosen == "laser" else "laser"
+        raise InputError(
+            f"{var} is NaN at every epoch (no {'laser' if chosen == 'laser' else 'Sun'} "
+            f"light); try --source {other}",
+            source=src,
+            field="--source",
+        )
+    checked = measured_from_dataset(ds, src, chosen)  # the checks of every MEASURED reader
+    row, column = dataset_namers(checked.time_utc, checked.band_names)
+    check_rates(factor, row, column, src, FIELD, max_abs=None, what=var)
+    what = var
+    if chosen == "sun":
+        source = sun_source_W_m2_nm(ds)
+        if "count_rate_measured" in ds and "count_rate" in ds:
+            rate = values(ds, "count_rate", ("time", "band"), src, FIELD)
+            measured = values(ds, "count_rate_measured", ("time", "band"), src, FIELD)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                factor = np.where(rate > 0, factor * measured / rate, np.nan)
+            what = "reflectance_factor x count_rate_measured / count_rate (the noisy rates)"
+    else:
+        source = laser_source_W_m2_nm(ds, loaded or dataset_scenario(ds, src))
+    truth, names, labels = None, None, None
+    if f"{var}_material" in ds:
+        da = ds[f"{var}_material"].transpose("time", ..., "band")
+        truth = da.values.astype(float)
+        names = [str(m) for m in ds[da.dims[1]].values]
+        if "material_reflectance" in ds:
+            labels = [str(m) for m in ds["material_reflectance"].values]
+    time = checked.time_utc
     if bin_s is not None:
         t0 = time
         time, factor = bin_factors(t0, factor, bin_s, src)
@@ -245,6 +271,8 @@ def _factors_from_rates(
         ones,
         bands.response,
     )
+    if not np.any(np.isfinite(factor)):
+        raise no_usable_epochs(lc.time_utc.size, loaded.source, lc.source)
     return ReflectanceFactors(
         lc.time_utc,
         factor,

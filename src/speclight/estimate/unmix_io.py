@@ -48,6 +48,7 @@ from speclight.estimate.unmix_inputs import (
 from speclight.estimate.unmix_truth import compare_with_truth
 from speclight.estimate.unmixing import UNMIX_METHODS
 from speclight.estimate.unmixing_epochs import unmix_per_epoch
+from speclight.io.user_dataset import read_user_dataset
 
 if TYPE_CHECKING:
     from speclight.scenario import LoadedScenario
@@ -145,14 +146,14 @@ def unmix_measured(
             raise InputError(
                 "--endmembers scenario needs --scenario SCENARIO.yaml", field="--scenario"
             )
-        with xr.open_dataset(measured, engine="h5netcdf") as head:
-            if "scenario_yaml" not in head.attrs:
-                raise InputError(
-                    "--endmembers scenario needs --scenario SCENARIO.yaml (the dataset does "
-                    "not carry the scenario it was simulated from)",
-                    field="--scenario",
-                )
-            loaded = dataset_scenario(head, str(measured))
+        head = read_user_dataset(measured, "MEASURED", what="measurements", variables=())
+        if "scenario_yaml" not in head.attrs:
+            raise InputError(
+                "--endmembers scenario needs --scenario SCENARIO.yaml (the dataset does "
+                "not carry the scenario it was simulated from)",
+                field="--scenario",
+            )
+        loaded = dataset_scenario(head, str(measured))
     data = read_reflectance_factors(measured, loaded, bin_s, progress, light)
     n_bands = len(data.bands.band_names)
     if extract is not None:

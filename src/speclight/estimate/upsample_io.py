@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -63,14 +64,30 @@ def read_fit_albedos(path: str | Path) -> dict[str, float]:
     Raises
     ------
     InputError
-        If the file is not JSON, has no ``bands`` mapping, or a band lacks a numeric
-        ``albedo`` in (0, 1].
+        If the file is not JSON (or nested too deep, or holds an integer of more digits than
+        Python converts), has no ``bands`` mapping, or a band lacks a numeric ``albedo`` in
+        (0, 1].
     """
     src = str(path)
+    text = read_user_text(Path(path), FIELD, what="fit results")
     try:
-        data = json.loads(read_user_text(Path(path), FIELD, what="fit results"))
+        data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise InputError(f"not JSON: {exc}", source=src, field=FIELD) from None
+    except RecursionError:
+        raise InputError(
+            "not a fit result: its lists or objects are nested deeper than Python's JSON "
+            f"reader goes ({sys.getrecursionlimit()} levels)",
+            source=src,
+            field=FIELD,
+        ) from None
+    except ValueError:  # an integer of more digits than int() converts
+        raise InputError(
+            "not a fit result: it holds an integer of more than "
+            f"{sys.get_int_max_str_digits()} digits",
+            source=src,
+            field=FIELD,
+        ) from None
     bands = data.get("bands") if isinstance(data, dict) else None
     if not isinstance(bands, dict) or not bands:
         raise InputError(

@@ -43,6 +43,8 @@ _TEMP = re.compile(r"^\.(?P<name>.+)\.speclight-\d+-[0-9a-f]+\.tmp$")
 _CHUNK_BYTES = 1 << 20
 #: ``os.link`` errors of file systems without hard links: fall back to ``os.replace``.
 _NO_HARD_LINKS = {errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EMLINK, errno.ENOSYS}
+#: Errors of the disk rather than of the folder the user chose.
+_DISK_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EIO}
 
 
 class OutputWriteError(SpeclightError):
@@ -139,8 +141,8 @@ def check_output_path(
 def _same_file(a: Path, b: Path) -> bool:
     try:
         return os.path.samefile(a, b)
-    except OSError:  # one of them does not exist (yet)
-        return a.resolve() == b.resolve()
+    except OSError:  # one of them does not exist (yet), or is a loop of symbolic links
+        return os.path.realpath(a) == os.path.realpath(b)  # never raises, loops included
 
 
 class OutputClaim:
@@ -183,13 +185,16 @@ class OutputClaim:
         self.path = check_output_path(self.output, self.force, self.inputs)
         lock = lock_path(self.path)
         try:
-            fd = _take_lock(lock)
+            # held: a signal between creating the lock and keeping its descriptor would
+            # leave the lock behind (the signal acts when the block ends, and is caught below)
+            with hold_signals():
+                fd = _take_lock(lock)
+                self._lock_fd = fd
         except OSError as exc:
-            raise InputError(
-                f"cannot write in folder {self.path.parent} ({exc.strerror}); "
-                "choose another folder",
-                field=FIELD,
-            ) from exc
+            raise self._folder_error(exc) from exc
+        except BaseException:
+            self._release()
+            raise
         if fd is None:
             pid = _lock_owner(lock)
             who = f"another speclight run (PID {pid})" if pid else "another speclight run"
@@ -198,16 +203,31 @@ class OutputClaim:
                 "another name",
                 field=FIELD,
             )
-        self._lock_fd = fd
         try:
-            os.ftruncate(fd, 0)
-            os.write(fd, f"{os.getpid()}\n".encode())
+            try:
+                os.ftruncate(fd, 0)
+                os.write(fd, f"{os.getpid()}\n".encode())
+            except OSError as exc:  # a full disk or quota: the empty lock file was created
+                raise self._folder_error(exc) from exc
             check_output_path(self.output, self.force, self.inputs)  # a run may just have ended
             _sweep(self.path.parent, own=self.path.name)
         except BaseException:
             self._release()
             raise
         return self
+
+    def _folder_error(self, exc: OSError) -> InputError | OutputWriteError:
+        """Why the lock cannot be written: the disk (a full disk, a quota, an I/O error: exit
+        1, as when the output cannot be written) or the folder (permission...: exit 2)."""
+        if exc.errno in _DISK_ERRORS:
+            return OutputWriteError(
+                f"cannot write {self.output}: {exc.strerror or exc} (its lock file in "
+                f"{self.path.parent}); nothing was written"
+            )
+        return InputError(
+            f"cannot write in folder {self.path.parent} ({exc.strerror}); choose another folder",
+            field=FIELD,
+        )
 
     def __exit__(
         self,

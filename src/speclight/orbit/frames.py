@@ -22,6 +22,7 @@ computation.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TypeAlias
 
@@ -118,6 +119,22 @@ def _polar_motion(t: Time) -> NDArray[np.float64]:
 
 def _q_matrix_fast(t: Time) -> NDArray[np.float64]:
     """Q interpolated from a 1 h grid of exact values (see the module docstring)."""
+    return hourly_interpolated(t, _q_matrix)
+
+
+def _m_matrix(t: Time) -> NDArray[np.float64]:
+    """M, skyfield's bias-precession-nutation matrix, exactly, shape (N, 3, 3)."""
+    return _stack(t.M, np.size(t.whole))
+
+
+def hourly_interpolated(
+    t: Time, exact: Callable[[Time], NDArray[np.float64]]
+) -> NDArray[np.float64]:
+    """A slowly varying quantity at epochs ``t``, interpolated from a 1 h grid.
+
+    ``exact(grid_times)`` gives its values (M, ...) on the grid (padded by
+    ``GRID_PAD_STEPS`` each side); 10-point Lagrange interpolation in TT. Returns (N, ...).
+    """
     whole = np.asarray(t.whole, dtype=np.float64)
     w0 = float(np.floor(np.nanmin(whole)))
     x = (whole - w0) + np.asarray(t.tt_fraction, dtype=np.float64)  # TT days since w0
@@ -125,9 +142,35 @@ def _q_matrix_fast(t: Time) -> NDArray[np.float64]:
     hi = np.ceil(np.nanmax(x) / GRID_STEP_DAYS) + GRID_PAD_STEPS
     grid = np.arange(lo, hi + 1.0) * GRID_STEP_DAYS
     tg = load_timescale().tt_jd(np.full(grid.shape, w0), grid)
-    qg = _q_matrix(tg).reshape(-1, 9)
-    q, _ = lagrange_interpolate(grid, qg, x)
-    return q.reshape(-1, 3, 3)
+    values = exact(tg)
+    out, _ = lagrange_interpolate(grid, values.reshape(grid.size, -1), x)
+    return out.reshape(-1, *values.shape[1:])
+
+
+def icrs_to_true_of_date(t: TimeLike, exact: bool | None = None) -> NDArray[np.float64]:
+    """Rotation from the GCRS (ICRS) axes to the true equator and equinox of date.
+
+    skyfield's ``t.M`` (IAU 2000A bias, precession and nutation), the frame of its
+    ``radec(epoch='date')``: ``r_date = m @ r_gcrs``.
+
+    Parameters
+    ----------
+    t
+        Epochs (N), skyfield ``Time`` or UTC ``datetime64``.
+    exact
+        True: skyfield at every epoch; False: interpolated from a 1 h grid as the ``Q``
+        matrix of the module docstring (same error bound); None: interpolated for
+        N >= ``FAST_MIN_EPOCHS``.
+
+    Returns
+    -------
+    ndarray
+        (N, 3, 3) rotation matrices.
+    """
+    t = as_time(t)
+    if exact is None:
+        exact = int(np.size(t.whole)) < FAST_MIN_EPOCHS
+    return _m_matrix(t) if exact else hourly_interpolated(t, _m_matrix)
 
 
 @dataclass(frozen=True)

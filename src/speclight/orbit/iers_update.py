@@ -4,7 +4,8 @@ The table comes from the IERS Rapid Service (the address skyfield itself uses) o
 file the user has (``--from``). It is checked before it replaces anything: it must be a
 ``finals2000A.all`` (fixed columns, days increasing, UT1-UTC values) holding the whole
 history that the shipped one holds (from 1973), since skyfield takes the leap seconds and
-Delta T from it; a ``finals.daily`` (the last 90 days only) is refused. It is written
+Delta T from it; a ``finals.daily`` (the last 90 days only) is refused, and so is a table
+cut short in the middle of a line (an interrupted download or copy). It is written
 atomically into :func:`speclight.orbit.iers_files.installed_finals_path`, never into the
 package folder, and runs then use it when it reaches further than the shipped one.
 
@@ -87,7 +88,13 @@ def fetch(url: str, timeout_s: float = 60.0) -> bytes:
 
 
 def check_table(text: str, source: str) -> FinalsCoverage:
-    """The coverage of ``text`` if it is a complete ``finals2000A.all``, else InputError."""
+    """The coverage of ``text`` if it is a complete ``finals2000A.all``, else InputError.
+
+    A table cut short (a download or a copy stopped) is refused: its last line has no line
+    end and is shorter than the table's rows, and its last values may be cut (a UT1-UTC of
+    ``0.05`` for ``0.0512345``).
+    """
+    _refuse_cut_line(text, source)
     coverage = parse_coverage(text)
     if coverage is None:
         raise InputError(
@@ -105,6 +112,21 @@ def check_table(text: str, source: str) -> FinalsCoverage:
             source=source,
         )
     return coverage
+
+
+def _refuse_cut_line(text: str, source: str) -> None:
+    """Refuse a table whose last line has no line end and is shorter than the line before
+    (the rows of a finals2000A.all have one length)."""
+    if not text or text.endswith("\n"):
+        return
+    lines = text.split("\n")
+    if len(lines) > 1 and len(lines[-1]) < len(lines[-2]):
+        raise InputError(
+            f"the table ends in the middle of line {len(lines)} ({len(lines[-1])} characters "
+            f"and no line end, the row before has {len(lines[-2])}): it was cut short; "
+            f"download the complete {FINALS} again",
+            source=source,
+        )
 
 
 def install_table(text: str, source: str) -> UpdateResult:

@@ -34,6 +34,10 @@ class ObservationGeometry:
         (N,) Sun-target-observer angle [deg].
     sun_direction_gcrs, observer_direction_gcrs
         (N, 3) unit vectors from the target to the Sun and to the observer, GCRS axes.
+    sun_elevation_deg
+        (N,) elevation of the Sun's centre above the site's horizon [deg], geometric (no
+        refraction, as the twilight limits -6, -12, -18 deg are defined), from the apparent
+        geocentric Sun (the diurnal aberration, <= 0.32", is left out).
     """
 
     r_sun_gcrs_m: NDArray[np.float64]
@@ -46,6 +50,7 @@ class ObservationGeometry:
     phase_angle_deg: NDArray[np.float64]
     sun_direction_gcrs: NDArray[np.float64]
     observer_direction_gcrs: NDArray[np.float64]
+    sun_elevation_deg: NDArray[np.float64]
 
     def __getitem__(self, key: str) -> NDArray[np.float64]:
         if key not in self.keys():
@@ -101,8 +106,9 @@ def observation_geometry(
     ObservationGeometry
         ``r_sun_gcrs_m`` (N,3), ``r_site_gcrs_m`` (N,3), ``sun_distance_m`` (N,) from the
         target, ``sunlit_fraction`` (N,), ``range_m``, ``azimuth_deg``, ``elevation_deg``,
-        ``phase_angle_deg`` (N,), and unit vectors ``sun_direction_gcrs`` (target to Sun)
-        and ``observer_direction_gcrs`` (target to observer), (N,3).
+        ``phase_angle_deg`` (N,), unit vectors ``sun_direction_gcrs`` (target to Sun)
+        and ``observer_direction_gcrs`` (target to observer), (N,3), and the Sun's elevation
+        at the site ``sun_elevation_deg`` (N,).
     """
     t = as_time(t)
     eo = orientation if orientation is not None else earth_orientation(t)
@@ -110,6 +116,7 @@ def observation_geometry(
     r_sun = sun_position_gcrs_m(t)
     r_site = site_position_gcrs_m(site, t, orientation=eo)
     topo = topocentric(site, r, t, refraction, temperature_C, pressure_mbar, orientation=eo)
+    sun_topo = topocentric(site, r_sun, t, orientation=eo)  # geometric: no refraction
     to_sun = r_sun - r
     return ObservationGeometry(
         r_sun_gcrs_m=r_sun,
@@ -122,4 +129,5 @@ def observation_geometry(
         phase_angle_deg=phase_angle_deg(r, r_sun, r_site),
         sun_direction_gcrs=_unit(to_sun),
         observer_direction_gcrs=_unit(r_site - r),
+        sun_elevation_deg=sun_topo.elevation_deg,
     )

@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from skyfield.earthlib import refract
 from skyfield.toposlib import wgs84
 
+from speclight.constants import EARTH_ROTATION_RATE_RAD_S
 from speclight.errors import InputError
 from speclight.orbit.frames import EarthOrientation, TimeLike, earth_orientation
 
@@ -78,6 +79,21 @@ def site_position_gcrs_m(
     eo = orientation if orientation is not None else earth_orientation(t)
     n = eo.gcrs_to_itrs.shape[0]
     return eo.itrs_to_gcrs(np.broadcast_to(site.position_itrs_m, (n, 3)))
+
+
+def site_velocity_gcrs_m_s(
+    site: Site, t: TimeLike, orientation: EarthOrientation | None = None
+) -> NDArray[np.float64]:
+    """Velocity of the site in the GCRS [m s-1], shape (N, 3): the Earth's rotation.
+
+    ``omega x r`` with ``omega`` the rotation rate
+    (:data:`~speclight.constants.EARTH_ROTATION_RATE_RAD_S`) about the ITRS pole. The rates
+    of precession, nutation and polar motion (< 1e-7 of the rotation) are left out.
+    """
+    eo = orientation if orientation is not None else earth_orientation(t)
+    axis_gcrs = eo.gcrs_to_itrs[:, 2, :]  # the ITRS z axis in GCRS components
+    r_site = site_position_gcrs_m(site, t, orientation=eo)
+    return np.asarray(EARTH_ROTATION_RATE_RAD_S * np.cross(axis_gcrs, r_site), dtype=np.float64)
 
 
 @dataclass(frozen=True)

@@ -15,11 +15,8 @@ from numpy.typing import NDArray
 from skyfield.timelib import Time
 
 from speclight.constants import AU_M
-from speclight.orbit.frames import FAST_MIN_EPOCHS, TimeLike, as_time
-from speclight.orbit.interpolate import lagrange_interpolate
-from speclight.orbit.timescale import load_ephemeris, load_timescale
-
-SUN_GRID_STEP_DAYS = 1.0 / 24.0
+from speclight.orbit.frames import FAST_MIN_EPOCHS, TimeLike, as_time, hourly_interpolated
+from speclight.orbit.timescale import load_ephemeris
 
 
 def _sun_apparent_m(t: Time) -> NDArray[np.float64]:
@@ -52,15 +49,7 @@ def sun_position_gcrs_m(t: TimeLike, exact: bool | None = None) -> NDArray[np.fl
         exact = n < FAST_MIN_EPOCHS
     if exact:
         return _sun_apparent_m(t)
-    whole = np.asarray(t.whole, dtype=np.float64)
-    w0 = float(np.floor(np.nanmin(whole)))
-    x = (whole - w0) + np.asarray(t.tt_fraction, dtype=np.float64)
-    lo = np.floor(np.nanmin(x) / SUN_GRID_STEP_DAYS) - 6
-    hi = np.ceil(np.nanmax(x) / SUN_GRID_STEP_DAYS) + 6
-    grid = np.arange(lo, hi + 1.0) * SUN_GRID_STEP_DAYS
-    tg = load_timescale().tt_jd(np.full(grid.shape, w0), grid)
-    r, _ = lagrange_interpolate(grid, _sun_apparent_m(tg), x)
-    return r
+    return hourly_interpolated(t, _sun_apparent_m)
 
 
 def sun_distance_au(t: TimeLike) -> NDArray[np.float64]:

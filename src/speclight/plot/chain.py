@@ -80,7 +80,8 @@ def epoch_status(ds: xr.Dataset, i: int) -> str:
     """Why epoch ``i`` is not (fully) observed, from its flags: "" when it is.
 
     "eclipsed (in the Earth's shadow)", "in the penumbra (x % of the solar disk)", "below the
-    minimum elevation", "no orbit position", "render failed", joined by "; ".
+    minimum elevation", "in daylight (...)", "no orbit position", "render failed", joined by
+    "; ".
     """
     bits = int(flags(ds)[i])
     reasons = [
@@ -88,6 +89,7 @@ def epoch_status(ds: xr.Dataset, i: int) -> str:
         for bit, text in (
             (v.FLAG_ORBIT_FAILED, "no orbit position"),
             (v.FLAG_BELOW_MIN_ELEVATION, "below the minimum elevation"),
+            (v.FLAG_DAYLIGHT, "in daylight (the Sun above observer.max_sun_elevation_deg)"),
             (v.FLAG_IN_SHADOW, "eclipsed (in the Earth's shadow)"),
             (v.FLAG_RENDER_FAILED, "render failed"),
         )

@@ -24,8 +24,7 @@ from typing import Any
 import xarray as xr
 
 from speclight.errors import InputError, did_you_mean
-from speclight.input_files import check_user_file
-from speclight.io.output import create_new_file
+from speclight.io.output import OutputWriteError, create_new_file
 from speclight.plot.chain import chain_figure
 from speclight.plot.images import images_figure
 from speclight.plot.lightcurve import MAGNITUDES
@@ -178,25 +177,10 @@ def _check_output(output: Path) -> None:
         raise InputError(f"folder {output.parent} does not exist", field="--output")
 
 
-#: What h5py's messages about an unreadable file mean, for a one-line error.
-_HDF5_PROBLEMS = {
-    "file signature not found": "it is not a NetCDF4 (HDF5) file",
-    "truncated file": "it is cut short (truncated)",
-}
-
-
 def _load(dataset: Path) -> xr.Dataset:
-    check_user_file(dataset, what="dataset", max_bytes=None)  # missing, a folder, a FIFO...
-    try:
-        ds = xr.load_dataset(dataset, engine="h5netcdf")
-    except (OSError, ValueError, TypeError, KeyError) as exc:
-        said = " ".join(str(exc).split())  # h5py's can span lines
-        why = next((w for key, w in _HDF5_PROBLEMS.items() if key in said), said)
-        raise InputError(
-            f"cannot read it as a NetCDF dataset: {why}; give a file written by "
-            "`speclight simulate`",
-            source=str(dataset),
-        ) from exc
+    from speclight.io.user_dataset import read_user_dataset
+
+    ds = read_user_dataset(dataset, None, what="dataset", require_time=False)
     check_dataset(ds, source=str(dataset))
     return ds
 
@@ -271,6 +255,8 @@ def plot_files(
     InputError
         Bad options or dataset, an existing figure without ``force``, or matplotlib not
         installed (checked first).
+    OutputWriteError
+        A figure could not be written (full disk...); none was written.
     """
     _require_matplotlib()
     dataset, output = Path(dataset), Path(output)
@@ -295,10 +281,15 @@ def plot_files(
             target = paths[kind.name]
             fig = kind.build(ds, choices)
             temp = target.with_name(f".{target.name}.{secrets.token_hex(4)}{target.suffix}")
-            fd = create_new_file(temp)  # mode 0666 less the umask, like any new file
-            temporaries.append((temp, target))
-            with os.fdopen(fd, "wb") as f:
-                fig.savefig(f, dpi=dpi, format=target.suffix.lstrip(".").lower())
+            try:
+                fd = create_new_file(temp)  # mode 0666 less the umask, like any new file
+                temporaries.append((temp, target))
+                with os.fdopen(fd, "wb") as f:
+                    fig.savefig(f, dpi=dpi, format=target.suffix.lstrip(".").lower())
+            except OSError as exc:  # a full disk, a quota, an I/O error
+                raise OutputWriteError(
+                    f"cannot write {target}: {exc.strerror or exc}; no figure was written"
+                ) from exc
         for temp, target in temporaries:
             os.replace(temp, target)
     finally:

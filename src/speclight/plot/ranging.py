@@ -18,7 +18,10 @@ from speclight.plot.style import (
 )
 
 EXCLUDED_FOR_LASER = (
-    schema.FLAG_ORBIT_FAILED | schema.FLAG_BELOW_MIN_ELEVATION | schema.FLAG_RENDER_FAILED
+    schema.FLAG_ORBIT_FAILED
+    | schema.FLAG_BELOW_MIN_ELEVATION
+    | schema.FLAG_RENDER_FAILED
+    | schema.FLAG_DAYLIGHT
 )
 
 

@@ -18,6 +18,7 @@ from speclight.errors import InputError
 from speclight.schema import (  # the dataset's flag bits (CF flag_masks)
     FLAG_ATTITUDE_UNDEFINED,
     FLAG_BELOW_MIN_ELEVATION,
+    FLAG_DAYLIGHT,
     FLAG_IN_SHADOW,
     FLAG_ORBIT_FAILED,
     FLAG_PENUMBRA,
@@ -31,7 +32,11 @@ WIDTH_IN = 10.0
 # Shading of epochs along time axes: (flag bits, face colour, legend label).
 _SHADES = (
     (
-        FLAG_ORBIT_FAILED | FLAG_BELOW_MIN_ELEVATION | FLAG_RENDER_FAILED | FLAG_ATTITUDE_UNDEFINED,
+        FLAG_ORBIT_FAILED
+        | FLAG_BELOW_MIN_ELEVATION
+        | FLAG_RENDER_FAILED
+        | FLAG_ATTITUDE_UNDEFINED
+        | FLAG_DAYLIGHT,
         "0.85",
         "not observable",
     ),

@@ -106,6 +106,13 @@ class Observer(Strict):
     min_elevation_deg: float = Field(
         default=10.0, ge=-90, le=90, description="Epochs below this elevation are flagged [deg]"
     )
+    max_sun_elevation_deg: float = Field(
+        default=-6.0,
+        ge=-90,
+        le=90,
+        description="Epochs with the Sun higher at the site are flagged daylight [deg]; "
+        "-6 civil, -12 nautical, -18 astronomical twilight, 90 never",
+    )
     refraction: bool = Field(default=False, description="Apply atmospheric refraction to elevation")
     light_time: bool = Field(
         default=True,

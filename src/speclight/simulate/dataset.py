@@ -34,6 +34,14 @@ def geometry_dataset(geo: Geometry, flags: NDArray[np.uint8] | None = None) -> x
         "phase_vector_body": geo.phase_vector_body,
         "target_position_gcrs": geo.r_target_gcrs_m,
         "sun_distance": geo.sun_distance_m / AU_M,
+        "sun_elevation_site": geo.sun_elevation_deg,
+        "ra": geo.sky.ra_deg,
+        "dec": geo.sky.dec_deg,
+        "ra_apparent": geo.sky.ra_apparent_deg,
+        "dec_apparent": geo.sky.dec_apparent_deg,
+        "angular_rate": geo.sky.angular_rate_deg_s,
+        "ra_cos_dec_rate": geo.sky.ra_cos_dec_rate_deg_s,
+        "dec_rate": geo.sky.dec_rate_deg_s,
     }
     ds = xr.Dataset(
         {name: schema.variable(name, np.asarray(values)) for name, values in data.items()},
@@ -63,6 +71,7 @@ def describe_run(
         "observer_longitude": obs.longitude_deg,
         "observer_altitude": obs.altitude_m,
         "min_elevation": obs.min_elevation_deg,
+        "max_sun_elevation": obs.max_sun_elevation_deg,
     }
     for name, value in site.items():
         ds[name] = schema.variable(name, np.float64(value))
@@ -112,6 +121,7 @@ def global_attributes(
         "observer_longitude_deg": sc.observer.longitude_deg,
         "observer_altitude_m": sc.observer.altitude_m,
         "min_elevation_deg": sc.observer.min_elevation_deg,
+        "max_sun_elevation_deg": sc.observer.max_sun_elevation_deg,
     }
     for name, version in engine_versions().items():
         attrs[attribute_name(f"version_{name}")] = version

@@ -8,13 +8,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight import attitude as att
-from speclight import orbit
 from speclight import schema as v
-from speclight.constants import C_M_S
 from speclight.errors import InputError
-from speclight.orbit.orbit_sources import Trajectory, no_position_message, orbit_trajectory
+from speclight.orbit.orbit_sources import (
+    Trajectory,
+    choices_text,
+    no_position_message,
+    orbit_trajectory,
+)
+from speclight.orbit.sky_position import SkyPosition
 from speclight.orbit.staleness import warn_past_tables
-from speclight.orbit.timescale import time_from_utc
 from speclight.scenario import LoadedScenario
 from speclight.scenario.sections_attitude import (
     InertialPointingAttitude,
@@ -31,6 +34,7 @@ from speclight.scenario.sections_geometry import (
     TorqueFreeAttitude,
 )
 from speclight.simulate.attitude_stage import profile_attitude
+from speclight.simulate.observed_track import observed_track, track_sky_position
 
 
 @dataclass
@@ -52,21 +56,22 @@ class Geometry:
     observer_direction_body: NDArray[np.float64]
     phase_vector_body: NDArray[np.float64]
     flags: NDArray[np.uint8]
+    #: The Sun's elevation at the site [deg] (geometric, of its centre).
+    sun_elevation_deg: NDArray[np.float64]
+    #: Where to point: topocentric RA/Dec and the angular rate on the sky.
+    sky: SkyPosition
 
     @property
     def observable(self) -> NDArray[np.bool_]:
-        """Epochs whose target position and attitude are known and that are above the
-        minimum elevation."""
-        bad = v.FLAG_ORBIT_FAILED | v.FLAG_BELOW_MIN_ELEVATION | v.FLAG_ATTITUDE_UNDEFINED
+        """Epochs whose target position and attitude are known, above the minimum elevation,
+        in a dark sky (the Sun below ``observer.max_sun_elevation_deg``)."""
+        bad = (
+            v.FLAG_ORBIT_FAILED
+            | v.FLAG_BELOW_MIN_ELEVATION
+            | v.FLAG_ATTITUDE_UNDEFINED
+            | v.FLAG_DAYLIGHT
+        )
         return (self.flags & bad) == 0
-
-
-def standard_pressure_mbar(altitude_m: float) -> float:
-    """Pressure of the ICAO standard atmosphere at ``altitude_m`` [mbar].
-
-    ``p = 1013.25 (1 - 2.25577e-5 h)^5.25588`` (ICAO Doc 7488, troposphere).
-    """
-    return 1013.25 * (1.0 - 2.25577e-5 * altitude_m) ** 5.25588
 
 
 def time_grid(grid: TimeGrid) -> NDArray[np.datetime64]:
@@ -133,36 +138,6 @@ PROFILES = (
     TableAttitude,
 )
 
-#: Fixed-point iterations of the light-time equation; each gains a factor v/c ~ 3e-5, so two
-#: leave < 1e-9 s (0.3 mm) for targets up to GEO.
-LIGHT_TIME_ITERATIONS = 2
-
-
-def _at_emission(
-    trajectory: Trajectory,
-    time_utc: NDArray[np.datetime64],
-    r_target: NDArray[np.float64],
-    ok: NDArray[np.bool_],
-    site: orbit.Site,
-    t: object,
-) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
-    """Target positions at the time the received light left it (one-way light time).
-
-    Solves ``|r(t - tau) - o(t)| = c tau`` by fixed-point iteration (Montenbruck & Gill,
-    Satellite Orbits, 2000, sec. 6.2.1), the observer ``o`` at reception in GCRS (so the
-    diurnal aberration of the moving site is included). Returns positions, the validity
-    mask and ``tau`` [s].
-    """
-    r_site = orbit.site_position_gcrs_m(site, t)
-    tau_s = np.zeros(time_utc.size)
-    for _ in range(LIGHT_TIME_ITERATIONS):
-        tau_s = np.nan_to_num(np.linalg.norm(r_target - r_site, axis=1) / C_M_S)
-        emitted = time_utc - np.rint(tau_s * 1e9).astype("timedelta64[ns]")
-        r_target, ok_emit = trajectory(time_from_utc(emitted))
-        ok = ok & ok_emit
-    tau_s = np.linalg.norm(r_target - r_site, axis=1) / C_M_S
-    return r_target, ok, np.nan_to_num(tau_s)
-
 
 def scenario_geometry(
     loaded: LoadedScenario,
@@ -185,27 +160,11 @@ def scenario_geometry(
         if time_utc.size == 0:
             raise InputError("no epochs given", source=loaded.source, field="time_utc")
     warn_past_tables(time_utc)
-    t = time_from_utc(time_utc)
     t_s = (time_utc - start) / np.timedelta64(1, "s")
-    site = orbit.Site(sc.observer.latitude_deg, sc.observer.longitude_deg, sc.observer.altitude_m)
     if trajectory is None:
         trajectory = _trajectory(loaded, time_utc)
-    r_target, ok = trajectory(t)
-    delay_s = np.zeros(t_s.size)
-    if sc.observer.light_time:
-        r_target, ok, delay_s = _at_emission(trajectory, time_utc, r_target, ok, site, t)
-    geo = orbit.observation_geometry(
-        t,
-        r_target,
-        site,
-        refraction=sc.observer.refraction,
-        temperature_C=sc.observer.temperature_C,
-        pressure_mbar=(
-            sc.observer.pressure_mbar
-            if sc.observer.pressure_mbar is not None
-            else standard_pressure_mbar(sc.observer.altitude_m)
-        ),
-    )
+    track = observed_track(sc.observer, time_utc, trajectory)
+    r_target, ok, delay_s, geo = track.r_target_gcrs_m, track.ok, track.delay_s, track.geometry
     # the attitude as it was when the light left the target
     if isinstance(sc.attitude, PROFILES):
         emitted = time_utc - np.rint(delay_s * 1e9).astype("timedelta64[ns]")
@@ -224,6 +183,7 @@ def scenario_geometry(
         flags[~(geo.elevation_deg >= sc.observer.min_elevation_deg)] |= v.FLAG_BELOW_MIN_ELEVATION
         flags[geo.sunlit_fraction <= 0.0] |= v.FLAG_IN_SHADOW
         flags[(geo.sunlit_fraction > 0.0) & (geo.sunlit_fraction < 1.0)] |= v.FLAG_PENUMBRA
+    flags[geo.sun_elevation_deg > sc.observer.max_sun_elevation_deg] |= v.FLAG_DAYLIGHT
     if not np.any(ok):
         raise InputError(
             no_position_message(sc.orbit.model_dump()), source=loaded.source, field="time"
@@ -244,7 +204,21 @@ def scenario_geometry(
         observer_direction_body=obs_b,
         phase_vector_body=phase_b,
         flags=flags,
+        sun_elevation_deg=geo.sun_elevation_deg,
+        sky=track_sky_position(track, trajectory, sc.observer),
     )
+
+
+def scenario_trajectory(loaded: LoadedScenario, time_utc: NDArray[np.datetime64]) -> Trajectory:
+    """The scenario's orbit source read once, ``t -> (r_gcrs_m (N, 3), ok (N,))``, for a
+    window spanning ``time_utc`` (``speclight passes``; ``observed: true`` has none)."""
+    if loaded.scenario.orbit.observed:
+        raise InputError(
+            f"observed: true has no orbit of its own; give {choices_text(loadable=True)}",
+            source=loaded.source,
+            field="orbit.observed",
+        )
+    return _trajectory(loaded, time_utc)
 
 
 def pole_body(geo: Geometry) -> NDArray[np.float64]:

@@ -55,9 +55,10 @@ from speclight.scenario.sections_light import PATH_SAMPLES_PER_S, PATH_SECONDS_P
 MIB = 1024**2
 #: Peak of a run of a few epochs at small resolution, above the pixel term (measured).
 BASE_BYTES = 230 * MIB
-#: Geometry, attitude and flags of one epoch, dataset and file copies included (measured:
-#: geometry-only runs of 2e4, 2e5 and 2e6 epochs, 1.13-1.19 KB per epoch) [bytes].
-BYTES_PER_EPOCH = 1200
+#: Geometry, attitude, pointing (RA/Dec, rates, the Sun's elevation) and flags of one epoch,
+#: dataset and file copies included (measured: geometry-only runs of 2e5 and 2e6 epochs,
+#: 1.50 KB per epoch between them) [bytes].
+BYTES_PER_EPOCH = 1550
 #: Solar irradiance and transmission (N, L) of a run with a target, per epoch and bin
 #: (measured before geometry-only runs stopped writing them: 941 vs 189 bins) [bytes].
 BYTES_PER_EPOCH_BIN = 21

@@ -13,6 +13,7 @@ from speclight.errors import InputError
 from speclight.progress import stage
 from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
+from speclight.scenario.sections_geometry import Observer
 from speclight.simulate.dataset import describe_run, geometry_dataset
 from speclight.simulate.geometry_stage import Geometry, scenario_geometry
 from speclight.simulate.map_reflection import map_reflection
@@ -44,18 +45,29 @@ class SimulationResult:
     notes: list[str] = field(default_factory=list)
 
 
-def _visibility_notes(geo: Geometry) -> list[str]:
+def _visibility_notes(geo: Geometry, observer: Observer) -> list[str]:
     n = geo.flags.size
-    observable = geo.observable
-    lit = observable & (geo.sunlit_fraction > 0)
+    high = (geo.flags & (v.FLAG_ORBIT_FAILED | v.FLAG_BELOW_MIN_ELEVATION)) == 0
+    dark = high & ((geo.flags & v.FLAG_DAYLIGHT) == 0)
+    lit = geo.observable & (geo.sunlit_fraction > 0)
     notes = [
-        f"{n} epochs: {int(observable.sum())} above the minimum elevation, "
-        f"{int(lit.sum())} of them sunlit"
+        f"{n} epochs: {int(high.sum())} above the minimum elevation "
+        f"({observer.min_elevation_deg:g} deg), {int(dark.sum())} of them in a dark sky (the "
+        f"Sun below {observer.max_sun_elevation_deg:g} deg), {int(lit.sum())} of those with "
+        "the target sunlit (observable)"
     ]
     if not np.any(~geo.orbit_ok) and not np.any(lit):
         notes.append(
-            "the target is never both sunlit and above the minimum elevation in this time "
-            "window: its brightness is zero or not observable at every epoch"
+            "the target is never observable in this time window (above the minimum "
+            "elevation, in a dark sky and sunlit at once): its brightness is zero or not "
+            "observable at every epoch"
+        )
+    if np.any(high) and not np.any(dark):
+        notes.append(
+            "every epoch above the minimum elevation is in daylight (flag daylight: the Sun "
+            f"above observer.max_sun_elevation_deg = {observer.max_sun_elevation_deg:g} deg at "
+            "the site); `speclight passes SCENARIO` lists the dark-sky passes, and "
+            "max_sun_elevation_deg: 90 renders daylight epochs too"
         )
     failed = int(np.count_nonzero(geo.flags & v.FLAG_ORBIT_FAILED))
     if failed:
@@ -140,7 +152,7 @@ def _simulate(
         ds = geometry_dataset(geo, flags)
         modes = {"render_mode": sc.render.mode, "atmosphere_model": sc.atmosphere.model}
         ds = describe_run(ds, loaded, modes)
-        return SimulationResult(dataset=ds, geometry=geo, notes=_visibility_notes(geo))
+        return SimulationResult(dataset=ds, geometry=geo, notes=_visibility_notes(geo, sc.observer))
     if map_mode:
         with stage("reflectivity map", enabled=progress):
             reflection = map_reflection(loaded, geo, wavelength_nm)
@@ -216,7 +228,7 @@ def _simulate(
     if reflection.variant:
         extra["render_variant"] = reflection.variant
     ds = describe_run(ds, loaded, extra)
-    notes = _visibility_notes(geo)
+    notes = _visibility_notes(geo, sc.observer)
     if ranging is not None:
         ds = ranging.add_to(ds)
         notes += ranging.notes
