@@ -1202,6 +1202,61 @@ def passes(
 
 
 @app.command()
+def frames(
+    dataset: Annotated[Path, typer.Argument(help="A dataset written by `speclight simulate`.")],
+    output: Annotated[
+        str, typer.Option("--output", "-o", metavar="DIR", help="Folder for the frames.")
+    ] = "frames",
+    imaging: Annotated[
+        Path | None,
+        typer.Option(
+            "--imaging",
+            metavar="FILE",
+            help="YAML imaging section to use instead of the scenario's instrument.imaging.",
+        ),
+    ] = None,
+    plot_file: Annotated[
+        str | None,
+        typer.Option("--plot", metavar="FIG", help="Figure of the first frames (.png, .pdf)."),
+    ] = None,
+    force: Annotated[
+        bool, typer.Option("--force", help="Replace an earlier run's frames in DIR.")
+    ] = False,
+) -> None:
+    """Detector frames of a simulated pass: FITS images with WCS (target streak or point,
+    Hipparcos stars, sky, PSF, noise) and their truth (truth.json, frames.csv) in DIR.
+
+    The camera is the scenario's instrument.imaging (or --imaging FILE). See docs/frames.md.
+
+    Example: speclight frames pass.nc -o frames/ --plot frames.png
+    """
+
+    def run() -> None:
+        from speclight.instrument.imaging import make_frame_files
+
+        if plot_file is None:
+            result = make_frame_files(dataset, output, imaging_file=imaging, force=force)
+        else:
+            from speclight.io.output import OutputClaim
+            from speclight.plot.figure_output import FigureClaim, figure_format
+            from speclight.plot.frames_figure import frames_figure
+
+            fmt = figure_format(plot_file)
+            with OutputClaim(plot_file, force=force, inputs={"dataset": dataset}) as claim:
+                result = make_frame_files(dataset, output, imaging_file=imaging, force=force)
+                _raise_if_signalled()
+                FigureClaim(claim, fmt).write(frames_figure(result.frames, result.records))
+        for note in result.notes:
+            typer.echo(f"notice: {note}", err=True)
+        typer.echo(
+            f"wrote {len(result.records)} frames to {result.folder}"
+            + (f" and {plot_file}" if plot_file else "")
+        )
+
+    _guarded(run)
+
+
+@app.command()
 def info() -> None:
     """Versions of speclight and its engines, render variants, and data coverage."""
 

