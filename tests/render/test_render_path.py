@@ -161,7 +161,7 @@ def test_path_smooth_plastic_plate_diffuse_base():
     # Off the glint a smooth-coated plastic plate shows its base:
     # I = rho_d (1 - F_i)(1 - F_o) / (eta^2 pi (1 - F_dr,int)) E A cos(theta_i) cos(theta_o)
     # (Weidlich & Wilkie 2007). Path mode's coated BSDF takes the index at each sampled
-    # wavelength (render/path_coat.py); the reference below takes the mean index: n of
+    # wavelength (render/bsdfs/path_coat.py); the reference below takes the mean index: n of
     # fused silica varies by 0.3 % over 500-700 nm, changing I by < 0.1 %.
     from speclight.target import plate, refractive_index
 

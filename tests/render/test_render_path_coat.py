@@ -1,4 +1,5 @@
-"""Path mode's spectral coated BSDF (render/path_coat.py) and sample loop (render/path_sampling.py).
+"""Path mode's spectral coated BSDF (render/bsdfs/path_coat.py) and sample loop
+(render/path_sampling.py).
 
 Run time: about 15 s on 2 cores.
 """
@@ -34,7 +35,7 @@ def _mi():
 
 
 def _bsdf(mi, material, lo=400.0, hi=800.0):
-    from speclight.render.path_coat import coat_tables, coated_diffuse
+    from speclight.render.bsdfs.path_coat import coat_tables, coated_diffuse
 
     return coated_diffuse(mi, coat_tables(material, lo, hi))
 

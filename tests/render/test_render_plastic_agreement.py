@@ -207,7 +207,7 @@ def test_single_rough_plastic_plate_matches_closed_form():
 @fast_spectral
 def test_path_follows_the_coat_index_across_the_grid():
     # Mitsuba's plastic takes one coat index per render; path mode's coated BSDF
-    # (speclight.render.path_coat) takes the index at each sampled wavelength. Near the
+    # (speclight.render.bsdfs.path_coat) takes the index at each sampled wavelength. Near the
     # mirror direction of a slightly rough coat the coat's Fresnel term dominates, and fused
     # silica's n falls from 1.488 to 1.462 over 300-500 nm: one mean index would put the UV
     # bins 3-4 % off.

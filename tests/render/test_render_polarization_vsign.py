@@ -26,8 +26,8 @@ import numpy as np
 import pytest
 
 from speclight.render import available_variants, render_intensity
-from speclight.render import material_channels as channels
 from speclight.render.polarization import fresnel_sp
+from speclight.render.shading import sun_disk_sin2
 from speclight.target import Material, Part, Reflectance, Target, refractive_index
 from speclight.wavelength_grid import grid_bin_bounds_nm
 
@@ -167,7 +167,7 @@ def test_path_mode_stokes_v_has_the_iau_sign() -> None:
     # over seeds 1-6), and the sign of V with them
     np.testing.assert_allclose(path[:, 1:] / path[:, :1], ref[:, 1:] / ref[:, :1], atol=2e-5)
     # absolute: the Sun's radiance (unit irradiance over its disk) times B's projected area
-    radiance = 1.0 / (np.pi * channels.sun_disk_sin2())
+    radiance = 1.0 / (np.pi * sun_disk_sin2())
     expect = radiance * (2 * B_HALF) ** 2 * (N_B @ OBS) * ref
     z = (path - expect) / np.hypot(std, 1e-3 * np.abs(expect))
     assert np.all(np.abs(z) < 4.0), z

@@ -9,7 +9,7 @@ import pytest
 
 from speclight.illumination import SOLAR_ANGULAR_RADIUS_RAD
 from speclight.render import available_variants, render_intensity
-from speclight.render.material_channels import sun_disk_sin2
+from speclight.render.shading import sun_disk_sin2
 from speclight.target import Material, Reflectance, plate, sphere
 
 pytestmark = pytest.mark.skipif(
@@ -21,7 +21,7 @@ pytestmark = pytest.mark.skipif(
 Z_MAX = 4.0
 WL = np.array([550.0, 650.0])
 #: Solid angle of the path mode's disk (radius rounded to whole float32 steps of 1 - cos,
-#: see speclight.render.material_channels.sun_disk_sin2) and of the nominal disk the single
+#: see speclight.render.shading.sun_disk_sin2) and of the nominal disk the single
 #: mode uses.
 OMEGA_PATH = np.pi * sun_disk_sin2()
 OMEGA_NOMINAL = 2 * np.pi * (1 - np.cos(SOLAR_ANGULAR_RADIUS_RAD))

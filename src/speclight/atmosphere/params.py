@@ -174,37 +174,10 @@ def parse_params(model: AtmosphereModel, params: Mapping[str, Any]) -> Atmospher
         For an unknown key (with a did-you-mean), a key of another model, or a value out
         of range; the field is ``atmosphere.<key>``.
     """
-    allowed = _ALLOWED[model]
-    every = sorted({k for keys in _ALLOWED.values() for k in keys})
     values: dict[str, Any] = {}
     for key, value in params.items():
-        if key not in allowed:
-            if key in every:
-                owners = [m for m, keys in _ALLOWED.items() if key in keys]
-                msg = f"{key} applies only to model {' or '.join(owners)}, not {model!r}"
-            else:
-                msg = f"unknown parameter {key!r}{did_you_mean(key, every)}"
-            accepted = ", ".join(allowed) if allowed else "none"
-            raise InputError(
-                f"{msg} (accepted for {model!r}: {accepted})", field=f"atmosphere.{key}"
-            )
-        if key in _RANGES:
-            values[key] = _number(key, value)
-        elif key == "atmosphere_profile":
-            values[key] = _choice(key, value, SIXS_ATMOSPHERE_PROFILES)
-        elif key == "aerosol_profile":
-            values[key] = _choice(key, value, SIXS_AEROSOL_PROFILES)
-        elif key == "airmass_nodes":
-            values[key] = _nodes(value)
-        elif key == "fallback_to_spectrl2":
-            if not isinstance(value, bool):
-                raise InputError(
-                    f"fallback_to_spectrl2 = {value!r} must be true or false",
-                    field="atmosphere.fallback_to_spectrl2",
-                )
-            values[key] = value
-        elif key in ("table_file", "cache_dir"):
-            values[key] = None if value is None else Path(value).expanduser()
+        _check_key(model, key)
+        values[key] = _value(key, value)
     if model == "table" and values.get("table_file") is None:
         raise InputError(
             "model 'table' needs table_file: a CSV of transmission vs wavelength and airmass",
@@ -221,6 +194,42 @@ def parse_params(model: AtmosphereModel, params: Mapping[str, Any]) -> Atmospher
             stacklevel=3,
         )
     return AtmosphereParams(**values, given=frozenset(values))
+
+
+def _check_key(model: AtmosphereModel, key: str) -> None:
+    """An InputError unless ``key`` is a parameter of ``model`` (naming the model it is a
+    parameter of, or the closest one)."""
+    allowed = _ALLOWED[model]
+    if key in allowed:
+        return
+    every = sorted({k for keys in _ALLOWED.values() for k in keys})
+    if key in every:
+        owners = [m for m, keys in _ALLOWED.items() if key in keys]
+        msg = f"{key} applies only to model {' or '.join(owners)}, not {model!r}"
+    else:
+        msg = f"unknown parameter {key!r}{did_you_mean(key, every)}"
+    accepted = ", ".join(allowed) if allowed else "none"
+    raise InputError(f"{msg} (accepted for {model!r}: {accepted})", field=f"atmosphere.{key}")
+
+
+def _value(key: str, value: Any) -> Any:
+    """The checked value of parameter ``key``."""
+    if key in _RANGES:
+        return _number(key, value)
+    if key == "atmosphere_profile":
+        return _choice(key, value, SIXS_ATMOSPHERE_PROFILES)
+    if key == "aerosol_profile":
+        return _choice(key, value, SIXS_AEROSOL_PROFILES)
+    if key == "airmass_nodes":
+        return _nodes(value)
+    if key == "fallback_to_spectrl2":
+        if not isinstance(value, bool):
+            raise InputError(
+                f"fallback_to_spectrl2 = {value!r} must be true or false",
+                field="atmosphere.fallback_to_spectrl2",
+            )
+        return value
+    return None if value is None else Path(value).expanduser()  # table_file, cache_dir
 
 
 def _nodes(value: Any) -> tuple[float, ...]:

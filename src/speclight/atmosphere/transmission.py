@@ -60,17 +60,14 @@ def transmission(
         ``fallback_to_spectrl2`` not set.
     """
     name = check_model(model)
-    if params is not None and keywords:
-        raise InputError("give params or keyword parameters, not both", field="atmosphere")
+    _one_way_of_giving(params, keywords)
     p = params if params is not None else parse_params(name, keywords)
     wl = check_wavelength_grid(wavelength_nm)
     el = np.atleast_1d(np.asarray(elevation_deg, dtype=np.float64))
     if el.ndim != 1:
         raise InputError(f"elevation must be 1-D (N,), got shape {el.shape}", field="elevation")
     if name == "none":
-        out = np.ones((el.size, wl.size))
-        out[~(np.isfinite(el) & (el > 0))] = np.nan
-        return out
+        return _no_atmosphere(wl, el)
     if name == "spectrl2":
         return spectrl2_transmission(wl, el, site_altitude_m, p)
     if name == "table":
@@ -86,3 +83,16 @@ def transmission(
             ) from exc
         warnings.warn(f"6S unavailable ({exc}); using SPECTRL2", UserWarning, stacklevel=2)
         return spectrl2_transmission(wl, el, site_altitude_m, p)
+
+
+def _one_way_of_giving(params: AtmosphereParams | None, keywords: dict[str, Any]) -> None:
+    """Parameters come as ``params`` or as keywords, not both."""
+    if params is not None and keywords:
+        raise InputError("give params or keyword parameters, not both", field="atmosphere")
+
+
+def _no_atmosphere(wl: NDArray[np.float64], el: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``none``: 1 where the line of sight leaves the atmosphere upward, else NaN."""
+    out = np.ones((el.size, wl.size))
+    out[~(np.isfinite(el) & (el > 0))] = np.nan
+    return out

@@ -89,15 +89,20 @@ def fixed_attitude(
     if quaternion is not None:
         q = validate_quaternion(quaternion, "attitude.quaternion")
     elif given:
-        missing = [name for name in radec if radec[name] is None]
-        if missing:
-            raise InputError(
-                f"a fixed frame from directions needs all of z_ra_deg, z_dec_deg, x_ra_deg, "
-                f"x_dec_deg; missing: {', '.join(missing)}",
-                field="attitude",
-            )
-        z_ra, z_dec, x_ra, x_dec = (float(v) for v in radec.values() if v is not None)
-        q = frame_from_axes_radec(z_ra, z_dec, x_ra, x_dec)
+        q = _from_directions(radec)
     else:
         q = np.array([1.0, 0.0, 0.0, 0.0])
     return np.tile(q, (int(n_epochs), 1))
+
+
+def _from_directions(radec: dict[str, float | None]) -> FloatArray:
+    """The quaternion of the axis directions, all four of which must be given."""
+    missing = [name for name in radec if radec[name] is None]
+    if missing:
+        raise InputError(
+            f"a fixed frame from directions needs all of z_ra_deg, z_dec_deg, x_ra_deg, "
+            f"x_dec_deg; missing: {', '.join(missing)}",
+            field="attitude",
+        )
+    z_ra, z_dec, x_ra, x_dec = (float(v) for v in radec.values() if v is not None)
+    return frame_from_axes_radec(z_ra, z_dec, x_ra, x_dec)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from speclight.attitude.quaternion import FloatArray
 from speclight.errors import InputError
@@ -44,6 +44,22 @@ def _fmt(value: ArrayLike) -> str:
     return str(np.asarray(value).tolist())
 
 
+def _tensor(inertia_kg_m2: ArrayLike) -> NDArray[np.float64]:
+    """The (3, 3) tensor of three principal moments or of a tensor, finite."""
+    tensor = np.asarray(inertia_kg_m2, dtype=np.float64)
+    if tensor.shape not in ((3,), (3, 3)):
+        raise InputError(
+            f"inertia_kg_m2 = {_fmt(inertia_kg_m2)} has shape {tensor.shape}; give the three "
+            "principal moments [I1, I2, I3] or a 3x3 symmetric tensor [kg m^2]",
+            field=FIELD,
+        )
+    if not np.all(np.isfinite(tensor)):
+        raise InputError(
+            f"inertia_kg_m2 = {_fmt(inertia_kg_m2)} contains a non-finite value", field=FIELD
+        )
+    return np.diag(tensor) if tensor.shape == (3,) else tensor
+
+
 def principal_frame(inertia_kg_m2: ArrayLike) -> PrincipalFrame:
     """Validate an inertia tensor and diagonalise it.
 
@@ -66,19 +82,7 @@ def principal_frame(inertia_kg_m2: ArrayLike) -> PrincipalFrame:
         moments violate the triangle inequality ``I1 + I2 >= I3`` (no rigid body has
         such moments; Goldstein, Poole & Safko, *Classical Mechanics*, 3rd ed., ch. 5).
     """
-    tensor = np.asarray(inertia_kg_m2, dtype=np.float64)
-    if tensor.shape not in ((3,), (3, 3)):
-        raise InputError(
-            f"inertia_kg_m2 = {_fmt(inertia_kg_m2)} has shape {tensor.shape}; give the three "
-            "principal moments [I1, I2, I3] or a 3x3 symmetric tensor [kg m^2]",
-            field=FIELD,
-        )
-    if not np.all(np.isfinite(tensor)):
-        raise InputError(
-            f"inertia_kg_m2 = {_fmt(inertia_kg_m2)} contains a non-finite value", field=FIELD
-        )
-    if tensor.shape == (3,):
-        tensor = np.diag(tensor)
+    tensor = _tensor(inertia_kg_m2)
     scale = float(np.max(np.abs(tensor)))
     asym = float(np.max(np.abs(tensor - tensor.T)))
     if asym > SYMMETRY_RTOL * scale:

@@ -114,37 +114,20 @@ def read_attitude_table(path: str | Path, field: str = "attitude.file") -> Attit
         except csv.Error as exc:
             raise InputError(f"line {lineno}: not a CSV row ({exc})", source=p) from None
         if header is None:
-            header = [c.lower() for c in cells]
-            if header != HEADER:
-                raise InputError(
-                    f"line {lineno}: column header {','.join(cells)!r} is not accepted; use "
-                    f"{','.join(HEADER)} (scalar first)",
-                    source=p,
-                    field="header",
-                )
+            header = _header(cells, lineno, p)
             continue
-        try:
-            if len(cells) != 5:
-                raise ValueError(f"{len(cells)} columns instead of 5")
-            t = _utc(cells[0])
-            q = [float(c) for c in cells[1:]]
-            if not all(np.isfinite(q)):
-                raise ValueError("a component is not finite")
-        except ValueError as exc:
-            raise InputError(
-                f"line {lineno}: cannot read {s!r} ({exc}); expected an ISO UTC time and "
-                "four numbers w, x, y, z",
-                source=p,
-            ) from None
-        norm = float(np.linalg.norm(q))
-        if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
-            raise InputError(
-                f"line {lineno}: quaternion {q} has norm {norm:.6g}; it must be within "
-                f"{QUATERNION_NORM_TOLERANCE} of 1",
-                source=p,
-            )
+        t, q = _row(s, cells, lineno, p)
         times.append(t)
-        quats.append([c / norm for c in q])
+        quats.append(q)
+    t_arr = _increasing(times, p)
+    q_arr = np.array(quats, dtype=np.float64)
+    if frame == "gcrs_to_body":
+        q_arr = quat_conjugate(q_arr)
+    return AttitudeTable(path=p, times_utc=t_arr, q_body_to_gcrs=q_arr)
+
+
+def _increasing(times: list[np.datetime64], p: str) -> NDArray[np.datetime64]:
+    """The rows' times: at least 2, strictly increasing."""
     if len(times) < 2:
         raise InputError(f"{len(times)} data rows; need at least 2", source=p)
     t_arr = np.array(times, dtype="datetime64[ns]")
@@ -155,10 +138,46 @@ def read_attitude_table(path: str | Path, field: str = "attitude.file") -> Attit
             "increase strictly",
             source=p,
         )
-    q_arr = np.array(quats, dtype=np.float64)
-    if frame == "gcrs_to_body":
-        q_arr = quat_conjugate(q_arr)
-    return AttitudeTable(path=p, times_utc=t_arr, q_body_to_gcrs=q_arr)
+    return t_arr
+
+
+def _header(cells: list[str], lineno: int, p: str) -> list[str]:
+    """The column header (it must be :data:`HEADER`)."""
+    header = [c.lower() for c in cells]
+    if header != HEADER:
+        raise InputError(
+            f"line {lineno}: column header {','.join(cells)!r} is not accepted; use "
+            f"{','.join(HEADER)} (scalar first)",
+            source=p,
+            field="header",
+        )
+    return header
+
+
+def _row(s: str, cells: list[str], lineno: int, p: str) -> tuple[np.datetime64, list[float]]:
+    """The time and the unit quaternion (normalised; its norm within the tolerance of 1)
+    of a data row."""
+    try:
+        if len(cells) != 5:
+            raise ValueError(f"{len(cells)} columns instead of 5")
+        t = _utc(cells[0])
+        q = [float(c) for c in cells[1:]]
+        if not all(np.isfinite(q)):
+            raise ValueError("a component is not finite")
+    except ValueError as exc:
+        raise InputError(
+            f"line {lineno}: cannot read {s!r} ({exc}); expected an ISO UTC time and "
+            "four numbers w, x, y, z",
+            source=p,
+        ) from None
+    norm = float(np.linalg.norm(q))
+    if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
+        raise InputError(
+            f"line {lineno}: quaternion {q} has norm {norm:.6g}; it must be within "
+            f"{QUATERNION_NORM_TOLERANCE} of 1",
+            source=p,
+        )
+    return t, [c / norm for c in q]
 
 
 def slerp_table(

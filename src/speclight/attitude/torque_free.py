@@ -94,6 +94,21 @@ def ivp_principal(
     return quat_normalize(out[:, 3:]), out[:, :3]
 
 
+def _check_method(method: str, rtol: float, atol: float) -> None:
+    """A known method and finite tolerances > 0."""
+    if method not in METHODS:
+        raise InputError(
+            f"unknown torque-free method {method!r}{did_you_mean(str(method), METHODS)} "
+            f"(choices: {', '.join(METHODS)})",
+            field="attitude.method",
+        )
+    for name, tol in (("rtol", rtol), ("atol", atol)):
+        if not (np.isfinite(tol) and tol > 0.0):
+            raise InputError(
+                f"{name} = {tol!r} must be a finite number > 0", field=f"attitude.{name}"
+            )
+
+
 def torque_free_attitude(
     t_s: ArrayLike,
     inertia_kg_m2: ArrayLike,
@@ -144,17 +159,7 @@ def torque_free_attitude(
     F. L. Markley and J. L. Crassidis, *Fundamentals of Spacecraft Attitude
     Determination and Control* (2014), ch. 3, doi:10.1007/978-1-4939-0802-8.
     """
-    if method not in METHODS:
-        raise InputError(
-            f"unknown torque-free method {method!r}{did_you_mean(str(method), METHODS)} "
-            f"(choices: {', '.join(METHODS)})",
-            field="attitude.method",
-        )
-    for name, tol in (("rtol", rtol), ("atol", atol)):
-        if not (np.isfinite(tol) and tol > 0.0):
-            raise InputError(
-                f"{name} = {tol!r} must be a finite number > 0", field=f"attitude.{name}"
-            )
+    _check_method(method, rtol, atol)
     t = np.atleast_1d(np.asarray(t_s, dtype=np.float64))
     if t.ndim != 1 or not np.all(np.isfinite(t)):
         raise InputError(

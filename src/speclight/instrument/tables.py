@@ -66,27 +66,47 @@ def read_table(path: str | Path, field: str) -> tuple[list[str] | None, NDArray[
                 source=str(p),
                 field=field,
             ) from None
-        bad = [c for c, v in zip(parts, values, strict=True) if not np.isfinite(v)]
-        if bad:
-            raise InputError(
-                f"line {lineno} {line!r} holds {bad[0]!r}, which is not a finite number; a "
-                "table needs a number in every column (cut the rows that have no value)",
-                source=str(p),
-                field=field,
-            )
-        if rows and len(values) != len(rows[0]):
-            raise InputError(
-                f"line {lineno} has {len(values)} columns, earlier lines {len(rows[0])}",
-                source=str(p),
-                field=field,
-            )
+        _check_row(f"line {lineno}", line, parts, values, rows, str(p), field)
         rows.append(values)
+    return _checked_data(header, rows, str(p), field)
+
+
+def _check_row(
+    where: str,
+    line: str,
+    parts: list[str],
+    values: list[float],
+    rows: list[list[float]],
+    source: str,
+    field: str,
+) -> None:
+    """A numeric row: finite numbers, as many columns as the rows before it."""
+    bad = [c for c, v in zip(parts, values, strict=True) if not np.isfinite(v)]
+    if bad:
+        raise InputError(
+            f"{where} {line!r} holds {bad[0]!r}, which is not a finite number; a "
+            "table needs a number in every column (cut the rows that have no value)",
+            source=source,
+            field=field,
+        )
+    if rows and len(values) != len(rows[0]):
+        raise InputError(
+            f"{where} has {len(values)} columns, earlier lines {len(rows[0])}",
+            source=source,
+            field=field,
+        )
+
+
+def _checked_data(
+    header: list[str] | None, rows: list[list[float]], source: str, field: str
+) -> tuple[list[str] | None, NDArray[np.float64]]:
+    """The rows as an array of at least 2 rows and 2 columns; the header if it fits them."""
     data = np.asarray(rows, dtype=np.float64)
     if data.ndim != 2 or data.shape[0] < 2 or data.shape[1] < 2:
         found = f"{len(rows)} row(s) of {len(rows[0])} column(s)" if rows else "no numeric row"
         raise InputError(
             f"a table needs at least 2 rows of 'wavelength, value' columns; found {found}",
-            source=str(p),
+            source=source,
             field=field,
         )
     if header is not None and len(header) != data.shape[1]:
@@ -116,6 +136,33 @@ def wavelength_to_nm(
     """Convert a wavelength column to nm, from its header name or its magnitude."""
     says_um = name is not None and _unit_in(name, ("um", "µm", "micron", "microns", "micrometre"))
     says_nm = name is not None and _unit_in(name, ("nm", "nanometre", "nanometer"))
+    top = _checked_wavelengths(values, name, (says_nm, says_um), source, field)
+    if says_um:
+        return values * 1000.0
+    if says_nm:
+        return values
+    if top < UM_THRESHOLD:
+        warnings.warn(
+            f"{source}: wavelengths {np.nanmin(values):g}..{top:g} have no unit in the "
+            f"header and are all below {UM_THRESHOLD:g}, so they are read as micrometres "
+            "(x1000 to nm); name the column 'wavelength_nm' or 'wavelength_um' to say so",
+            UserWarning,
+            stacklevel=3,
+        )
+        return values * 1000.0
+    return values
+
+
+def _checked_wavelengths(
+    values: NDArray[np.float64],
+    name: str | None,
+    says: tuple[bool, bool],
+    source: str,
+    field: str,
+) -> float:
+    """The largest wavelength, after checking that they are finite, > 0 and do not
+    contradict the unit the header ``says`` (nm, um)."""
+    says_nm, says_um = says
     _check_finite(values, "the wavelengths", source, field)
     if values.size == 0 or np.any(values <= 0):
         low = f"{values.min():g}" if values.size else "none"
@@ -137,30 +184,14 @@ def wavelength_to_nm(
             source=source,
             field=field,
         )
-    if says_um:
-        return values * 1000.0
-    if says_nm:
-        return values
-    if top < UM_THRESHOLD:
-        warnings.warn(
-            f"{source}: wavelengths {np.nanmin(values):g}..{top:g} have no unit in the "
-            f"header and are all below {UM_THRESHOLD:g}, so they are read as micrometres "
-            "(x1000 to nm); name the column 'wavelength_nm' or 'wavelength_um' to say so",
-            UserWarning,
-            stacklevel=3,
-        )
-        return values * 1000.0
-    return values
+    return top
 
 
 def value_to_fraction(
     values: NDArray[np.float64], name: str | None, source: str, field: str
 ) -> NDArray[np.float64]:
     """Convert a value column (efficiency, transmission) to a fraction 0..1."""
-    says_pct = name is not None and (
-        "%" in name or _unit_in(name, ("percent", "pct", "percentage"))
-    )
-    says_frac = name is not None and _unit_in(name, ("fraction", "frac"))
+    says_pct, says_frac = _fraction_unit(name)
     _check_finite(values, "the values", source, field)
     top = float(np.nanmax(values))
     if says_frac and top > PERCENT_THRESHOLD:
@@ -184,13 +215,26 @@ def value_to_fraction(
         out = values / 100.0
     else:
         out = values
+    _check_fraction(out, source, field)
+    return out
+
+
+def _fraction_unit(name: str | None) -> tuple[bool, bool]:
+    """Whether a column's header says percent, and whether it says fraction."""
+    if name is None:
+        return False, False
+    says_pct = "%" in name or _unit_in(name, ("percent", "pct", "percentage"))
+    return says_pct, _unit_in(name, ("fraction", "frac"))
+
+
+def _check_fraction(out: NDArray[np.float64], source: str, field: str) -> None:
+    """Fractions lie in 0..1 (to rounding)."""
     if np.any(out < 0) or np.any(out > 1.0 + 1e-6):
         raise InputError(
             f"values {np.nanmin(out):g}..{np.nanmax(out):g} (as a fraction) must lie in 0..1",
             source=source,
             field=field,
         )
-    return out
 
 
 def sort_unique(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[NDArray, NDArray]:

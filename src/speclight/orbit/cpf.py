@@ -6,9 +6,8 @@ formats/cpf.html. Header records H1 (format version, source, target name; v2 add
 sub-daily sequence number and a notes field), H2 (COSPAR/SIC/NORAD ids, span, step,
 reference frame; v2 adds target location/dynamics), H3-H5 (accuracy, transponder,
 centre-of-mass offset), H9 (end of header); data records 10 (position), 20 (velocity),
-30-70 (corrections, rotation angles...), 00 (comment), 99 (end). Records are read as
-blank-separated fields, as the ILRS/EDC validation does ("there must be 12 parameters in
-record H1"), which accepts both versions' column layouts.
+30-70 (corrections, rotation angles...), 00 (comment), 99 (end), read line by line in
+:mod:`speclight.orbit.cpf_records`.
 
 Supported: Earth-orbiting targets in reference frame 0 (geocentric true body-fixed, i.e.
 ITRF), common-epoch records (direction flag 0). Transmit/receive records (flags 1 and 2,
@@ -30,23 +29,15 @@ from numpy.typing import NDArray
 
 from speclight.errors import InputError
 from speclight.input_files import read_user_text
+from speclight.orbit.cpf_records import Records, h2_span, read_records
 from speclight.orbit.frames import EarthOrientation, TimeLike, as_time, earth_orientation
 from speclight.orbit.interpolate import lagrange_interpolate
 from speclight.orbit.timescale import time_from_utc
 
-MJD0 = np.datetime64("1858-11-17T00:00:00", "ns")
-FRAME_NAMES = {
-    0: "geocentric true body-fixed (ITRF)",
-    1: "geocentric space-fixed, true of date",
-    2: "geocentric space-fixed, mean of date J2000",
-}
-_SKIPPED = {"H3", "H4", "H6", "H7", "H8", "00", "30", "40", "50", "60", "70"}
 #: Geocentric distances [m] a position of an Earth-orbiting target can have: from below the
 #: Earth's polar radius (6,357 km) to beyond the Sun-Earth L1/L2 points (1.5 million km).
 #: A table position outside them is a corrupted record (or a unit mistake).
 PLAUSIBLE_RADIUS_M = (6.0e6, 2.0e9)
-#: Span of ``datetime64[ns]`` (beyond it numpy wraps around silently), as MJDs: 1678-2262.
-_MJD_RANGE = (-66_000, 147_000)
 
 
 @dataclass(frozen=True)
@@ -104,30 +95,6 @@ class Cpf:
     unusable_lines: tuple[int, ...] = ()
 
 
-def _err(path: str, lineno: int, line: str, what: str, fix: str) -> InputError:
-    return InputError(f"line {lineno}: {what}\n  {line}\n{fix}", source=path)
-
-
-def _datetime(fields: list[str]) -> np.datetime64:
-    y, mo, d, h, mi, s = (int(f) for f in fields)
-    if not 1678 < y < 2262:  # datetime64[ns] would wrap around silently
-        raise ValueError(f"year {y} is outside 1678-2262")
-    return np.datetime64(f"{y:04d}-{mo:02d}-{d:02d}T{h:02d}:{mi:02d}:{s:02d}", "ns")
-
-
-def _record_time(
-    lineno: int, line: str, path: str, mjd_field: str, sod_field: str
-) -> np.datetime64:
-    """UTC epoch of a record 10 from its MJD and seconds-of-day fields."""
-    fix = "Expected: 10 direction MJD seconds-of-day leap-second x y z."
-    mjd, sod = int(mjd_field), float(sod_field)
-    if not _MJD_RANGE[0] < mjd < _MJD_RANGE[1]:
-        raise _err(path, lineno, line, f"MJD {mjd_field} is not a day of 1678-2262", fix)
-    if not 0.0 <= sod < 86401.0:  # 86400.x only during a leap second
-        raise _err(path, lineno, line, f"seconds of day {sod_field} is outside 0-86400", fix)
-    return MJD0 + np.timedelta64(mjd, "D") + np.timedelta64(round(sod * 1e9), "ns")
-
-
 def read_cpf(path: str | Path) -> Cpf:
     """Read an ILRS CPF prediction file (format version 1 or 2).
 
@@ -148,143 +115,36 @@ def read_cpf(path: str | Path) -> Cpf:
     """
     p = str(path)
     lines = read_user_text(path, "orbit.cpf_file", what="CPF file").split("\n")
-    head: dict[str, list[str]] = {}
-    times: list[np.datetime64] = []
-    pos: list[list[float]] = []
-    pos_lines: list[int] = []
-    vel: list[list[float]] = []
-    vel_times: list[np.datetime64] = []
-    version = 0
-    com: float | None = None
-    for lineno, raw in enumerate(lines, start=1):
-        line = raw.rstrip()
-        if not line.strip():
-            continue
-        rec = line[:2].upper()
-        tok = line.split()
-        try:
-            if rec == "H1":
-                if len(tok) < 3 or tok[1].upper() != "CPF":
-                    raise _err(
-                        p,
-                        lineno,
-                        line,
-                        "H1 record does not start 'H1 CPF'",
-                        "This is not an ILRS CPF file.",
-                    )
-                version = int(tok[2])
-                if version not in (1, 2):
-                    raise _err(
-                        p,
-                        lineno,
-                        line,
-                        f"format version {version} is not supported",
-                        "Accepted: CPF format versions 1 and 2.",
-                    )
-                need = 10 if version == 1 else 11
-                if len(tok) < need:
-                    raise _err(
-                        p,
-                        lineno,
-                        line,
-                        f"H1 has {len(tok)} fields, version {version} needs {need}",
-                        "Expected: H1 CPF version source yyyy mm dd hh sequence "
-                        + ("" if version == 1 else "sub-daily-sequence ")
-                        + "target",
-                    )
-                head["H1"] = tok
-            elif rec == "H2":
-                if len(tok) < 20:
-                    raise _err(
-                        p,
-                        lineno,
-                        line,
-                        f"H2 has {len(tok)} fields, need at least 20",
-                        "Expected: H2 cospar sic norad start(y m d h m s) end(y m d h m"
-                        " s) step tiv target-class reference-frame ...",
-                    )
-                head["H2"] = tok
-            elif rec == "H5":
-                head["H5"] = tok
-                com = float(tok[1]) if len(tok) > 1 else None
-            elif rec == "H9":
-                head["H9"] = tok
-            elif rec == "10":
-                if len(tok) != 8:
-                    raise _err(
-                        p,
-                        lineno,
-                        line,
-                        f"position record has {len(tok)} fields, need 8",
-                        "Expected: 10 direction MJD seconds-of-day leap-second x y z.",
-                    )
-                if int(tok[1]) != 0:
-                    continue
-                times.append(_record_time(lineno, line, p, tok[2], tok[3]))
-                pos.append([float(v) for v in tok[5:8]])
-                pos_lines.append(lineno)
-            elif rec == "20":
-                if len(tok) != 5:
-                    raise _err(
-                        p,
-                        lineno,
-                        line,
-                        f"velocity record has {len(tok)} fields, need 5",
-                        "Expected: 20 direction vx vy vz.",
-                    )
-                if int(tok[1]) != 0:
-                    continue
-                vel.append([float(v) for v in tok[2:5]])
-                vel_times.append(times[-1] if times else MJD0)
-            elif rec == "99":
-                break
-            elif rec not in _SKIPPED:
-                raise _err(
-                    p,
-                    lineno,
-                    line,
-                    f"unknown record type {rec!r}",
-                    "CPF records are H1-H9, 00, 10, 20, 30, 40, 50, 60, 70, 99.",
-                )
-        except ValueError as exc:
-            if isinstance(exc, InputError):
-                raise
-            raise _err(
-                p,
-                lineno,
-                line,
-                f"record {rec} has an unreadable field ({exc})",
-                "Check the record against the CPF format description.",
-            ) from exc
-    for rec in ("H1", "H2"):
-        if rec not in head:
-            raise InputError(f"missing {rec} header record; is this an ILRS CPF file?", source=p)
-    r_arr = np.array(pos, dtype=np.float64).reshape(-1, 3)
+    rec = read_records(p, lines)
+    r_arr = np.array(rec.pos, dtype=np.float64).reshape(-1, 3)
     usable = plausible_position(r_arr)
     if np.count_nonzero(usable) < 2:
-        raise InputError(_too_few_records(r_arr, usable, pos_lines), source=p)
-    h1, h2 = head["H1"], head["H2"]
-    lineno_h2 = next(i for i, ln in enumerate(lines, 1) if ln[:2].upper() == "H2")
-    try:
-        start, end = _datetime(h2[4:10]), _datetime(h2[10:16])
-        step_s, frame = int(h2[16]), int(h2[19])
-    except ValueError as exc:
-        raise _err(
-            p,
-            lineno_h2,
-            lines[lineno_h2 - 1],
-            f"H2 has an unreadable field ({exc})",
-            "Expected integers for the dates, step and reference frame.",
-        ) from exc
-    if frame != 0:
-        raise _err(
-            p,
-            lineno_h2,
-            lines[lineno_h2 - 1],
-            f"reference frame {frame} ({FRAME_NAMES.get(frame, 'unknown')}) is not supported",
-            "Only frame 0 (geocentric true body-fixed, ITRF), the ILRS default for "
-            "Earth satellites, is read; obtain the frame-0 prediction.",
-        )
+        raise InputError(_too_few_records(r_arr, usable, rec.pos_lines), source=p)
+    h1, h2 = rec.head["H1"], rec.head["H2"]
+    start, end, step_s, frame = h2_span(p, lines, h2)
+    t_arr = _increasing_times(p, rec.times)
+    return Cpf(
+        path=p,
+        version=rec.version,
+        source=h1[3],
+        target_name=h1[9] if rec.version == 1 else h1[10],
+        cospar_id=h2[1],
+        sic=h2[2],
+        norad_id=h2[3],
+        start_utc=start,
+        end_utc=end,
+        step_s=step_s,
+        reference_frame=frame,
+        com_offset_m=rec.com,
+        times_utc=t_arr[usable],
+        r_itrf_m=r_arr[usable],
+        v_itrf_m_s=_velocities(rec, usable),
+        unusable_lines=tuple(ln for ln, ok in zip(rec.pos_lines, usable, strict=True) if not ok),
+    )
+
+
+def _increasing_times(p: str, times: list[np.datetime64]) -> NDArray[np.datetime64]:
+    """The position records' epochs, checked to increase strictly."""
     t_arr = np.array(times, dtype="datetime64[ns]")
     if np.any(np.diff(t_arr) <= np.timedelta64(0, "ns")):
         bad = int(np.argmax(np.diff(t_arr) <= np.timedelta64(0, "ns"))) + 1
@@ -293,27 +153,14 @@ def read_cpf(path: str | Path) -> Cpf:
             "records must be in strictly increasing time order",
             source=p,
         )
-    v_arr = None
-    if vel and len(vel) == len(times) and vel_times == times:
-        v_arr = np.array(vel, dtype=np.float64)[usable]
-    return Cpf(
-        path=p,
-        version=version,
-        source=h1[3],
-        target_name=h1[9] if version == 1 else h1[10],
-        cospar_id=h2[1],
-        sic=h2[2],
-        norad_id=h2[3],
-        start_utc=start,
-        end_utc=end,
-        step_s=step_s,
-        reference_frame=frame,
-        com_offset_m=com,
-        times_utc=t_arr[usable],
-        r_itrf_m=r_arr[usable],
-        v_itrf_m_s=v_arr,
-        unusable_lines=tuple(ln for ln, ok in zip(pos_lines, usable, strict=True) if not ok),
-    )
+    return t_arr
+
+
+def _velocities(rec: Records, usable: NDArray[np.bool_]) -> NDArray[np.float64] | None:
+    """The usable positions' velocities (records 20), when every position has one."""
+    if rec.vel and len(rec.vel) == len(rec.times) and rec.vel_times == rec.times:
+        return np.array(rec.vel, dtype=np.float64)[usable]
+    return None
 
 
 def plausible_position(r_m: NDArray[np.float64]) -> NDArray[np.bool_]:

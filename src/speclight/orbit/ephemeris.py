@@ -80,25 +80,35 @@ def read_ephemeris_csv(path: str | Path) -> Ephemeris:
         strictly increasing.
     """
     p = str(path)
+    text = read_user_text(path, "orbit.ephemeris_file", what="ephemeris file")
+    frame, header, rows = _lines(p, text)
+    unit = _unit(p, header)
+    if len(rows) < 2:
+        raise InputError(f"{len(rows)} data rows; need at least 2", source=p)
+    times, pos = _rows(p, rows)
+    t_arr = np.array(times, dtype="datetime64[ns]")
+    bad = np.flatnonzero(np.diff(t_arr) <= np.timedelta64(0, "ns"))
+    if bad.size:
+        raise InputError(
+            f"row {bad[0] + 2} ({t_arr[bad[0] + 1]}) is not after the previous row; times must "
+            "increase strictly",
+            source=p,
+        )
+    r_m = _positions_m(p, unit, np.array(pos, dtype=np.float64), [ln for ln, _ in rows])
+    return Ephemeris(path=p, frame=frame, times_utc=t_arr, r_m=r_m)  # type: ignore[arg-type]
+
+
+def _lines(p: str, text: str) -> tuple[str, list[str], list[tuple[int, list[str]]]]:
+    """The frame (its comment line), the column header and the data rows (line, cells)."""
     frame: str | None = None
     rows: list[tuple[int, list[str]]] = []
     header: list[str] | None = None
-    text = read_user_text(path, "orbit.ephemeris_file", what="ephemeris file")
     for lineno, line in enumerate(text.split("\n"), start=1):
         s = line.strip()
         if not s:
             continue
         if s.startswith("#"):
-            key, _, value = s.lstrip("#").partition(":")
-            if key.strip().lower() == "frame":
-                frame = value.strip().upper()
-                if frame not in FRAMES:
-                    raise InputError(
-                        f"line {lineno}: frame {value.strip()!r} is not accepted"
-                        f"{did_you_mean(frame, FRAMES)} (choices: GCRS, ITRF)",
-                        source=p,
-                        field="frame",
-                    )
+            frame = _frame_comment(p, lineno, s) or frame
             continue
         try:
             cells = [c.strip() for c in next(csv.reader([s]))]
@@ -108,6 +118,11 @@ def read_ephemeris_csv(path: str | Path) -> Ephemeris:
             header = [c.lower() for c in cells]
         else:
             rows.append((lineno, cells))
+    return _checked_head(p, frame, header), header or [], rows
+
+
+def _checked_head(p: str, frame: str | None, header: list[str] | None) -> str:
+    """The frame, after checking that the file gives one and an accepted column header."""
     if frame is None:
         raise InputError(
             "no frame given: add a comment line '# frame: GCRS' or '# frame: ITRF' before "
@@ -121,6 +136,27 @@ def read_ephemeris_csv(path: str | Path) -> Ephemeris:
             source=p,
             field="header",
         )
+    return frame
+
+
+def _frame_comment(p: str, lineno: int, s: str) -> str | None:
+    """The frame a comment line ``# frame: GCRS`` names (None for another comment)."""
+    key, _, value = s.lstrip("#").partition(":")
+    if key.strip().lower() != "frame":
+        return None
+    frame = value.strip().upper()
+    if frame not in FRAMES:
+        raise InputError(
+            f"line {lineno}: frame {value.strip()!r} is not accepted"
+            f"{did_you_mean(frame, FRAMES)} (choices: GCRS, ITRF)",
+            source=p,
+            field="frame",
+        )
+    return frame
+
+
+def _unit(p: str, header: list[str]) -> str:
+    """The one unit (m or km) of the x, y, z columns of the header."""
     units = set()
     for name, axis in zip(header[1:], "xyz", strict=True):
         pre, _, unit = name.partition("_")
@@ -138,9 +174,13 @@ def read_ephemeris_csv(path: str | Path) -> Ephemeris:
             source=p,
             field="header",
         )
-    unit = units.pop()
-    if len(rows) < 2:
-        raise InputError(f"{len(rows)} data rows; need at least 2", source=p)
+    return units.pop()
+
+
+def _rows(
+    p: str, rows: list[tuple[int, list[str]]]
+) -> tuple[list[np.datetime64], list[list[float]]]:
+    """The times and positions (in the file's unit) of the data rows."""
     times = []
     pos = []
     for lineno, cells in rows:
@@ -155,16 +195,7 @@ def read_ephemeris_csv(path: str | Path) -> Ephemeris:
                 "time and three numbers",
                 source=p,
             ) from exc
-    t_arr = np.array(times, dtype="datetime64[ns]")
-    bad = np.flatnonzero(np.diff(t_arr) <= np.timedelta64(0, "ns"))
-    if bad.size:
-        raise InputError(
-            f"row {bad[0] + 2} ({t_arr[bad[0] + 1]}) is not after the previous row; times must "
-            "increase strictly",
-            source=p,
-        )
-    r_m = _positions_m(p, unit, np.array(pos, dtype=np.float64), [ln for ln, _ in rows])
-    return Ephemeris(path=p, frame=frame, times_utc=t_arr, r_m=r_m)  # type: ignore[arg-type]
+    return times, pos
 
 
 def _utc(cell: str) -> np.datetime64:

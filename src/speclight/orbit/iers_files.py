@@ -85,7 +85,23 @@ _MJD0 = np.datetime64("1858-11-17", "D")
 
 
 def _coverage_of_lines(lines: list[str]) -> FinalsCoverage | None:
-    first = measured = last = None
+    days = _table_days(lines)
+    if not days:
+        return None
+    first, last = days[0][0], days[-1][0]
+    measured = next((mjd for mjd, flag in reversed(days) if flag == "I"), None)
+    day = np.timedelta64(1, "D")
+    return FinalsCoverage(
+        first=_MJD0 + first * day,
+        measured_until=_MJD0 + (measured if measured is not None else first) * day,
+        predicted_until=_MJD0 + last * day,
+    )
+
+
+def _table_days(lines: list[str]) -> list[tuple[int, str]] | None:
+    """(MJD, UT1 flag) of every row with UT1-UTC; None for an unreadable value or days that
+    do not increase."""
+    days: list[tuple[int, str]] = []
     for line in lines:
         # columns (1-based) 8-15 MJD, 17 polar-motion flag, 58 UT1 flag, 59-68 UT1-UTC
         if len(line) < 68 or not line[7:15].strip() or not line[58:68].strip():
@@ -95,20 +111,10 @@ def _coverage_of_lines(lines: list[str]) -> FinalsCoverage | None:
             float(line[58:68])
         except ValueError:
             return None
-        if last is not None and mjd <= last:
+        if days and mjd <= days[-1][0]:
             return None  # days must increase
-        first = mjd if first is None else first
-        last = mjd
-        if line[57] == "I":
-            measured = mjd
-    if first is None or last is None:
-        return None
-    day = np.timedelta64(1, "D")
-    return FinalsCoverage(
-        first=_MJD0 + first * day,
-        measured_until=_MJD0 + (measured if measured is not None else first) * day,
-        predicted_until=_MJD0 + last * day,
-    )
+        days.append((mjd, line[57]))
+    return days
 
 
 def parse_coverage(text: str) -> FinalsCoverage | None:

@@ -127,25 +127,7 @@ def read_oem(path: str | Path, object_name: str | None = None) -> Oem:
         version, raw = parse_oem_kvn(text, p)
     if not raw:
         raise InputError("no segment (META_START .. META_STOP and data lines)", source=p)
-    names = [(r.meta.get("OBJECT_NAME", ""), r.meta.get("OBJECT_ID", "")) for r in raw]
-    if object_name is not None:
-        want = object_name.strip().upper()
-        raw = [r for r, n in zip(raw, names, strict=True) if want in (n[0].upper(), n[1].upper())]
-        if not raw:
-            choices = sorted({x for n in names for x in n if x})
-            raise InputError(
-                f"object {object_name!r} is not in the file"
-                f"{did_you_mean(object_name, choices)} (objects: {', '.join(choices)})",
-                source=p,
-                field="orbit.object",
-            )
-    elif len({n[0] for n in names}) > 1:
-        raise InputError(
-            f"the file holds several objects ({', '.join(sorted({n[0] for n in names}))}); "
-            "choose one with orbit.object",
-            source=p,
-            field="orbit.object",
-        )
+    raw = _object_segments(p, raw, object_name)
     segments = [_segment(r, p) for r in raw]
     return Oem(
         path=p,
@@ -155,6 +137,39 @@ def read_oem(path: str | Path, object_name: str | None = None) -> Oem:
         segments=segments,
         metadata=[r.meta for r in raw],
     )
+
+
+def _object_segments(p: str, raw: list[RawSegment], object_name: str | None) -> list[RawSegment]:
+    """The segments of the object named (by OBJECT_NAME or OBJECT_ID), or of the file's one
+    object."""
+    names = [(r.meta.get("OBJECT_NAME", ""), r.meta.get("OBJECT_ID", "")) for r in raw]
+    if object_name is not None:
+        return _named_segments(p, raw, names, object_name)
+    if len({n[0] for n in names}) > 1:
+        raise InputError(
+            f"the file holds several objects ({', '.join(sorted({n[0] for n in names}))}); "
+            "choose one with orbit.object",
+            source=p,
+            field="orbit.object",
+        )
+    return raw
+
+
+def _named_segments(
+    p: str, raw: list[RawSegment], names: list[tuple[str, str]], object_name: str
+) -> list[RawSegment]:
+    """The segments whose OBJECT_NAME or OBJECT_ID is ``object_name`` (case ignored)."""
+    want = object_name.strip().upper()
+    kept = [r for r, n in zip(raw, names, strict=True) if want in (n[0].upper(), n[1].upper())]
+    if not kept:
+        choices = sorted({x for n in names for x in n if x})
+        raise InputError(
+            f"object {object_name!r} is not in the file"
+            f"{did_you_mean(object_name, choices)} (objects: {', '.join(choices)})",
+            source=p,
+            field="orbit.object",
+        )
+    return kept
 
 
 def _segment(raw: RawSegment, p: str) -> Segment:

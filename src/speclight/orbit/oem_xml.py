@@ -52,6 +52,17 @@ def _child(el: ET.Element, name: str) -> ET.Element | None:
 
 def parse_oem_xml(text: str, p: str) -> tuple[str, list[RawSegment]]:
     """``(version, segments)`` of an OEM in XML; InputError naming what is wrong."""
+    root = _root(text, p)
+    version = root.get("version", "")
+    body = _child(root, "body")
+    if body is None:
+        raise InputError("no <body> element", source=p)
+    segments = (c for c in body if _local(c.tag) == "segment")
+    return version, [_segment(seg, f"segment {k}", p) for k, seg in enumerate(segments, start=1)]
+
+
+def _root(text: str, p: str) -> ET.Element:
+    """The ``<oem>`` root element of the text (no DOCTYPE, well-formed)."""
     if "<!DOCTYPE" in text or "<!ENTITY" in text:
         raise InputError("XML with a DOCTYPE or entities is not accepted", source=p)
     try:
@@ -63,38 +74,38 @@ def parse_oem_xml(text: str, p: str) -> tuple[str, list[RawSegment]]:
             f"the root element is <{_local(root.tag)}>, not <oem>: not a CCSDS OEM in XML",
             source=p,
         )
-    version = root.get("version", "")
-    body = _child(root, "body")
-    if body is None:
-        raise InputError("no <body> element", source=p)
-    raw: list[RawSegment] = []
-    for k, seg in enumerate((c for c in body if _local(c.tag) == "segment"), start=1):
-        where = f"segment {k}"
-        meta_el = _child(seg, "metadata")
-        data_el = _child(seg, "data")
-        if meta_el is None or data_el is None:
-            raise InputError(f"{where}: needs <metadata> and <data>", source=p)
-        meta = {
-            _local(c.tag).upper(): (c.text or "").strip()
-            for c in meta_el
-            if _local(c.tag) != "COMMENT"
-        }
-        rows: list[tuple[str, list[str]]] = []
-        vectors = (c for c in data_el if _local(c.tag) == "stateVector")
-        for i, sv in enumerate(vectors, start=1):
-            at = f"{where} stateVector {i}"
-            cells = []
-            for key in STATE_KEYS:
-                el = _child(sv, key)
-                if el is None:
-                    raise InputError(f"{at}: no <{key}>", source=p)
-                unit = el.get("units")
-                if unit is not None and unit.strip().lower() != UNITS[key]:
-                    raise InputError(
-                        f"{at}: <{key} units={unit!r}> is not accepted (unit {UNITS[key]})",
-                        source=p,
-                    )
-                cells.append((el.text or "").strip())
-            rows.append((at, cells))
-        raw.append(RawSegment(meta, where, rows))
-    return version, raw
+    return root
+
+
+def _segment(seg: ET.Element, where: str, p: str) -> RawSegment:
+    """One ``<segment>``: its metadata keys and state vectors."""
+    meta_el = _child(seg, "metadata")
+    data_el = _child(seg, "data")
+    if meta_el is None or data_el is None:
+        raise InputError(f"{where}: needs <metadata> and <data>", source=p)
+    meta = {
+        _local(c.tag).upper(): (c.text or "").strip() for c in meta_el if _local(c.tag) != "COMMENT"
+    }
+    vectors = (c for c in data_el if _local(c.tag) == "stateVector")
+    rows = [
+        (f"{where} stateVector {i}", _state_cells(sv, f"{where} stateVector {i}", p))
+        for i, sv in enumerate(vectors, start=1)
+    ]
+    return RawSegment(meta, where, rows)
+
+
+def _state_cells(sv: ET.Element, at: str, p: str) -> list[str]:
+    """The texts of a ``<stateVector>``'s epoch and six values (units checked)."""
+    cells = []
+    for key in STATE_KEYS:
+        el = _child(sv, key)
+        if el is None:
+            raise InputError(f"{at}: no <{key}>", source=p)
+        unit = el.get("units")
+        if unit is not None and unit.strip().lower() != UNITS[key]:
+            raise InputError(
+                f"{at}: <{key} units={unit!r}> is not accepted (unit {UNITS[key]})",
+                source=p,
+            )
+        cells.append((el.text or "").strip())
+    return cells

@@ -28,7 +28,8 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -114,73 +115,113 @@ def read_sp3(path: str | Path, satellite: str | None = None) -> Sp3:
     """
     p = str(path)
     lines = read_user_text(path, FIELD, what="SP3 file").splitlines()
+    version, coord, interval_s = _header(p, lines)
+    body = _Body()
+    for lineno, line in enumerate(lines[2:], start=3):
+        if line.strip() == "EOF":
+            break
+        reader = _reader(line, body)
+        if reader is not None:
+            reader(p, lineno, line, body)
+    sat = _choose(p, satellite, body.listed or sorted(body.records), body.records)
+    code = "GPS" if body.code == "CCC" else body.code
+    return _table(p, version, sat, coord, code, interval_s, body.records.get(sat, []))
+
+
+def _header(p: str, lines: list[str]) -> tuple[str, str, float]:
+    """Version (``c``, ``d``), coordinate system and epoch interval [s] of lines 1-2."""
     if not lines or not lines[0].startswith(("#c", "#d")):
         head = lines[0][:3] if lines else "an empty file"
         raise InputError(
             f"line 1 starts {head!r}: not an SP3-c or SP3-d file (which start '#c' or '#d')",
             source=p,
         )
-    version = lines[0][1]
-    coord = lines[0][46:51].strip()
     try:
         interval_s = float(lines[1][24:38]) if lines[1].startswith("##") else math.nan
     except (IndexError, ValueError):
         interval_s = math.nan
     if not interval_s > 0:
         raise _err(p, 2, lines[1] if len(lines) > 1 else "", "no epoch interval in columns 25-38")
-    listed: list[str] = []
-    code = "GPS"
-    seen_c = False
+    return lines[0][1], lines[0][46:51].strip(), interval_s
+
+
+@dataclass
+class _Body:
+    """What the lines after the header hold, as read."""
+
+    listed: list[str] = field(default_factory=list)
+    code: str = "GPS"
+    seen_c: bool = False
     epoch: np.datetime64 | None = None
-    records: dict[str, list[tuple[np.datetime64, int, list[float]]]] = {}
-    for lineno, line in enumerate(lines[2:], start=3):
-        tag = line[:2]
-        if tag == "+ ":
-            ids = (line[i : i + 3] for i in range(9, min(len(line), 60), 3))
-            listed += [normalise_id(x) for x in ids if x.strip(" 0")]  # "  0" pads the list
-        elif tag == "%c" and not seen_c:
-            seen_c = True
-            code = line[9:12].strip().upper()
-            if code not in TIME_SYSTEMS:
-                raise _err(
-                    p,
-                    lineno,
-                    line,
-                    f"time system {code!r} is not known (accepted: "
-                    f"{', '.join(k for k in TIME_SYSTEMS if k != 'CCC')})",
-                )
-        elif line.startswith("* "):
-            try:
-                y, mo, d, h, mi = (int(v) for v in line[1:].split()[:5])
-                sec = float(line[1:].split()[5])
-                day = as_ns(np.datetime64(f"{y:04d}-{mo:02d}-{d:02d}T{h:02d}:{mi:02d}"))
-                epoch = day + np.timedelta64(round(sec * 1e9), "ns")
-            except (ValueError, IndexError):
-                raise _err(
-                    p, lineno, line, "not an epoch line '*  YYYY MM DD hh mm ss.ssss'"
-                ) from None
-        elif line.startswith("P"):
-            if epoch is None:
-                raise _err(p, lineno, line, "a position line before the first epoch line")
-            try:
-                xyz = [float(line[a:b]) for a, b in ((4, 18), (18, 32), (32, 46))]
-            except ValueError:
-                raise _err(
-                    p, lineno, line, "x y z [km] not in columns 5-18, 19-32, 33-46"
-                ) from None
-            records.setdefault(normalise_id(line[1:4]), []).append((epoch, lineno, xyz))
-        elif line.startswith("V") and line[1:2].strip():
-            try:
-                [float(line[a:b]) for a, b in ((4, 18), (18, 32), (32, 46))]
-            except ValueError:
-                raise _err(
-                    p, lineno, line, "vx vy vz [dm/s] not in columns 5-18, 19-32, 33-46"
-                ) from None
-        elif line.strip() == "EOF":
-            break
-    sat = _choose(p, satellite, listed or sorted(records), records)
-    code = "GPS" if code == "CCC" else code
-    return _table(p, version, sat, coord, code, interval_s, records.get(sat, []))
+    records: dict[str, list[tuple[np.datetime64, int, list[float]]]] = field(default_factory=dict)
+
+
+_LineReader = Callable[[str, int, str, _Body], None]
+
+
+def _reader(line: str, body: _Body) -> _LineReader | None:
+    """The reader of a body line (None: a line that is skipped)."""
+    if line[:2] == "+ ":
+        return _satellites
+    if line[:2] == "%c" and not body.seen_c:
+        return _time_system
+    if line.startswith("* "):
+        return _epoch
+    if line.startswith("P"):
+        return _position
+    if line.startswith("V") and line[1:2].strip():
+        return _velocity
+    return None
+
+
+def _satellites(p: str, lineno: int, line: str, body: _Body) -> None:
+    """A ``+`` line: satellite ids in columns 10-60 ("  0" pads the list)."""
+    ids = (line[i : i + 3] for i in range(9, min(len(line), 60), 3))
+    body.listed += [normalise_id(x) for x in ids if x.strip(" 0")]
+
+
+def _time_system(p: str, lineno: int, line: str, body: _Body) -> None:
+    """The first ``%c`` line: the time system in columns 10-12."""
+    body.seen_c = True
+    body.code = line[9:12].strip().upper()
+    if body.code not in TIME_SYSTEMS:
+        raise _err(
+            p,
+            lineno,
+            line,
+            f"time system {body.code!r} is not known (accepted: "
+            f"{', '.join(k for k in TIME_SYSTEMS if k != 'CCC')})",
+        )
+
+
+def _epoch(p: str, lineno: int, line: str, body: _Body) -> None:
+    """A ``*`` line: the epoch of the position lines that follow."""
+    try:
+        y, mo, d, h, mi = (int(v) for v in line[1:].split()[:5])
+        sec = float(line[1:].split()[5])
+        day = as_ns(np.datetime64(f"{y:04d}-{mo:02d}-{d:02d}T{h:02d}:{mi:02d}"))
+        body.epoch = day + np.timedelta64(round(sec * 1e9), "ns")
+    except (ValueError, IndexError):
+        raise _err(p, lineno, line, "not an epoch line '*  YYYY MM DD hh mm ss.ssss'") from None
+
+
+def _position(p: str, lineno: int, line: str, body: _Body) -> None:
+    """A ``P`` line: a satellite's x y z [km] at the current epoch."""
+    if body.epoch is None:
+        raise _err(p, lineno, line, "a position line before the first epoch line")
+    try:
+        xyz = [float(line[a:b]) for a, b in ((4, 18), (18, 32), (32, 46))]
+    except ValueError:
+        raise _err(p, lineno, line, "x y z [km] not in columns 5-18, 19-32, 33-46") from None
+    body.records.setdefault(normalise_id(line[1:4]), []).append((body.epoch, lineno, xyz))
+
+
+def _velocity(p: str, lineno: int, line: str, body: _Body) -> None:
+    """A ``V`` line: read for validation only."""
+    try:
+        [float(line[a:b]) for a, b in ((4, 18), (18, 32), (32, 46))]
+    except ValueError:
+        raise _err(p, lineno, line, "vx vy vz [dm/s] not in columns 5-18, 19-32, 33-46") from None
 
 
 def _choose(p: str, satellite: str | None, names: list[str], records: dict) -> str:
@@ -206,19 +247,13 @@ def _choose(p: str, satellite: str | None, names: list[str], records: dict) -> s
     return sat
 
 
-def _table(
-    p: str, version: str, sat: str, coord: str, code: str, interval_s: float, recs: list
-) -> Sp3:
-    def usable(xyz: list[float]) -> bool:
-        return any(v != 0.0 for v in xyz) and all(abs(v) != BAD_VALUE for v in xyz)
+def _usable(xyz: list[float]) -> bool:
+    """A position that is not the format's "bad or absent" (0.000000, 999999.999999)."""
+    return any(v != 0.0 for v in xyz) and all(abs(v) != BAD_VALUE for v in xyz)
 
-    good = [r for r in recs if usable(r[2])]
-    skipped = [r[1] for r in recs if not usable(r[2])]
-    if len(good) < 2:
-        raise InputError(
-            f"satellite {sat}: {len(good)} good position records of {len(recs)}; need at least 2",
-            source=p,
-        )
+
+def _epochs(p: str, good: list) -> tuple[np.ndarray, np.ndarray]:
+    """The records' epochs, checked to increase, and the steps between them [s]."""
     times = np.array([r[0] for r in good], dtype="datetime64[ns]")
     step = np.diff(times) / np.timedelta64(1, "s")
     if np.any(step <= 0):
@@ -226,27 +261,44 @@ def _table(
         raise InputError(
             f"line {good[i][1]}: epoch {times[i]} is not after the previous one", source=p
         )
+    return times, step
+
+
+def _table(
+    p: str, version: str, sat: str, coord: str, code: str, interval_s: float, recs: list
+) -> Sp3:
+    good = [r for r in recs if _usable(r[2])]
+    skipped = [r[1] for r in recs if not _usable(r[2])]
+    if len(good) < 2:
+        raise InputError(
+            f"satellite {sat}: {len(good)} good position records of {len(recs)}; need at least 2",
+            source=p,
+        )
+    times, step = _epochs(p, good)
     r_m = np.array([r[2] for r in good], dtype=np.float64) * 1e3
     whole, frac = tai_julian(times, TIME_SYSTEMS[code])
     cuts = [0, *(np.flatnonzero(step > MAX_GAP_STEPS * interval_s) + 1).tolist(), len(good)]
-    segments = []
-    for a, b in itertools.pairwise(cuts):
-        if b - a < 2:
-            continue  # a lone record between holes is not interpolable
-        w0 = float(whole[a])
-        segments.append(
-            Segment(
-                frame="itrs",
-                tai_whole=whole[a:b],
-                tai_fraction=frac[a:b],
-                r_m=r_m[a:b],
-                v_m_s=None,
-                method="lagrange",
-                n_points=N_POINTS,
-                valid_tai=(w0, float(frac[a]), float(whole[b - 1] - w0 + frac[b - 1])),
-            )
-        )
+    segments = [
+        _segment(whole[a:b], frac[a:b], r_m[a:b])
+        for a, b in itertools.pairwise(cuts)
+        if b - a >= 2  # a lone record between holes is not interpolable
+    ]
     return Sp3(p, version, sat, coord, code, interval_s, segments, skipped)
+
+
+def _segment(whole: np.ndarray, frac: np.ndarray, r_m: np.ndarray) -> Segment:
+    """An interpolable run of records (TAI Julian date parts, ITRS positions [m])."""
+    w0 = float(whole[0])
+    return Segment(
+        frame="itrs",
+        tai_whole=whole,
+        tai_fraction=frac,
+        r_m=r_m,
+        v_m_s=None,
+        method="lagrange",
+        n_points=N_POINTS,
+        valid_tai=(w0, float(frac[0]), float(whole[-1] - w0 + frac[-1])),
+    )
 
 
 def sp3_position_gcrs_m(

@@ -3,34 +3,22 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError
 from speclight.progress import stage
+from speclight.render.epoch_inputs import EpochInputs, epoch_inputs, irradiance_rows, unit_rows
 from speclight.render.polarization import rotate_linear, scattering_angle_on_sky
 from speclight.render.raycast import numpy_processes
-from speclight.render.result import RenderResult
+from speclight.render.result import RenderImage, RenderResult
 from speclight.render.session import RenderMode, RenderSession
 from speclight.target.parts import Target
 
 MIN_RESOLUTION_PX = 8
-
-
-def _unit_rows(
-    a: ArrayLike, name: str, n: int | None = None
-) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    x = np.asarray(a, dtype=float)
-    if x.ndim == 1 and x.shape == (3,):
-        x = x[None, :]
-    if x.ndim != 2 or x.shape[1] != 3 or (n is not None and len(x) != n):
-        want = f"({n}, 3)" if n is not None else "(N, 3)"
-        raise InputError(f"{name} must have shape {want}, got {x.shape}", field=name)
-    norm = np.linalg.norm(x, axis=1)
-    ok = np.isfinite(norm) & (norm > 0)
-    out = np.where(ok[:, None], x / np.where(ok, norm, 1.0)[:, None], np.nan)
-    return out, ok
+F64 = NDArray[np.float64]
 
 
 def render_intensity(
@@ -117,6 +105,49 @@ def render_intensity(
         epochs whose inputs are not finite; with ``polarization`` also ``stokes_W_sr_nm``
         (N, L, 3): Q, U, V.
     """
+    session = _checked_session(session, mode, variant, target, polarization, pole_body)
+    if int(resolution_px) < MIN_RESOLUTION_PX:
+        raise InputError(
+            f"render.resolution_px = {resolution_px} must be >= {MIN_RESOLUTION_PX}",
+            field="render.resolution_px",
+        )
+    inputs = epoch_inputs(
+        sun_dir_body, observer_dir_body, solar_irradiance_W_m2_nm, wavelength_nm,
+        keep_images_for, pole_body if polarization else None,
+    )  # fmt: skip
+    if session.mode == "single":
+        rendered = _render_single(
+            target, inputs, session, int(resolution_px), workers, progress, on_hits
+        )
+    else:
+        rendered = _render_path(
+            target, inputs, session, int(resolution_px), int(samples_per_pixel), int(seed),
+            progress, bool(solar_disk),
+        )  # fmt: skip
+    return _result(inputs, rendered, session.mode)
+
+
+@dataclass
+class _Rendered:
+    """What a mode's render gives for the valid epochs (see :func:`render_intensity`)."""
+
+    intensity: F64
+    std: F64 | float
+    images: dict[int, RenderImage]
+    variant: str
+    stokes: F64 | None = None
+    stokes_std: F64 | float | None = None
+
+
+def _checked_session(
+    session: RenderSession | None,
+    mode: RenderMode,
+    variant: str | None,
+    target: Target,
+    polarization: bool,
+    pole_body: ArrayLike | None,
+) -> RenderSession:
+    """The given session, or one for ``mode``; checked for polarisation."""
     if session is None:
         session = RenderSession.create(mode, variant, target.materials, polarization=polarization)
     if polarization and pole_body is None:
@@ -129,129 +160,109 @@ def render_intensity(
             f"(RenderSession.create(..., polarization=True)), got '{session.variant}'",
             field="render.variant",
         )
-    mode = session.mode
-    if int(resolution_px) < MIN_RESOLUTION_PX:
-        raise InputError(
-            f"render.resolution_px = {resolution_px} must be >= {MIN_RESOLUTION_PX}",
-            field="render.resolution_px",
-        )
-    wl = np.asarray(wavelength_nm, dtype=float).ravel()
-    sun, ok_s = _unit_rows(sun_dir_body, "sun_dir_body")
-    obs, ok_o = _unit_rows(observer_dir_body, "observer_dir_body", len(sun))
-    e = np.asarray(solar_irradiance_W_m2_nm, dtype=float)
-    if e.ndim == 1:
-        e = np.broadcast_to(e, (len(sun), len(wl)))
-    if e.shape != (len(sun), len(wl)):
-        raise InputError(
-            f"solar_irradiance_W_m2_nm must have shape (N, L) = ({len(sun)}, {len(wl)}), "
-            f"got {e.shape}",
-            field="solar_irradiance_W_m2_nm",
-        )
-    ok = ok_s & ok_o & np.all(np.isfinite(e), axis=1)
-    keep = sorted(int(k) for k in (keep_images_for or ()))
-    for k in keep:
-        if not 0 <= k < len(sun):
-            raise InputError(
-                f"keep_images_for index {k} is outside 0..{len(sun) - 1}", field="keep_images_for"
-            )
-    valid = np.flatnonzero(ok)
-    remap = {int(g): j for j, g in enumerate(valid)}
-    keep_local = [remap[k] for k in keep if k in remap]
-    intensity = np.full((len(sun), len(wl)), np.nan)
-    std = np.full((len(sun), len(wl)), np.nan)
-    stokes = np.full((len(sun), len(wl), 3), np.nan) if polarization else None
-    stokes_std = np.full((len(sun), len(wl), 3), np.nan) if polarization else None
-    pole = None
-    if polarization:
-        assert pole_body is not None
-        pole, ok_p = _unit_rows(pole_body, "pole_body", len(sun))
-        ok = ok & ok_p
-        valid = np.flatnonzero(ok)
-        remap = {int(g): j for j, g in enumerate(valid)}
-        keep_local = [remap[k] for k in keep if k in remap]
-    images = {}
-    if mode == "single":
-        chosen = session.variant
-        n_workers = numpy_processes(int(workers or 1))  # one inside a Dask worker
-        multi = n_workers > 1 and on_hits is None
-        if multi and not chosen.startswith(("llvm_", "cuda_")) and len(valid) > 1:
-            # Dr.Jit variants already use every core; the numpy caster runs one process per
-            # worker on contiguous blocks of epochs (Mitsuba scenes are never pickled).
-            inten, linear, imgs = _single_in_processes(
-                target,
-                sun[valid],
-                obs[valid],
-                e[valid],
-                wl,
-                int(resolution_px),
-                keep_local,
-                n_workers,
-                polarization,
-            )
-            used = "numpy"
-        else:
-            caster = session.caster(target)
-            from speclight.render.single import render_single_polarized
+    return session
 
-            with stage("rendering (single)", len(valid), enabled=progress) as advance:
-                inten, linear, imgs = render_single_polarized(
-                    target,
-                    sun[valid],
-                    obs[valid],
-                    e[valid],
-                    wl,
-                    caster,
-                    int(resolution_px),
-                    keep_local,
-                    on_batch=advance,
-                    on_hits=None if on_hits is None else _global_epochs(on_hits, valid),
-                    polarization=polarization,
-                )
-            used = caster.name
-        intensity[valid] = inten
-        std[valid] = 0.0
-        if stokes is not None and stokes_std is not None and pole is not None:
-            assert linear is not None
-            chi = scattering_angle_on_sky(sun[valid], obs[valid], pole[valid])
-            q, u = rotate_linear(linear, np.zeros_like(linear), chi)
-            stokes[valid] = np.stack([q, u, np.zeros_like(q)], axis=-1)
-            stokes_std[valid] = 0.0
-            for j, img in imgs.items():  # the kept pixels: the same rotation
-                if img.stokes_qu_W_m2_sr_nm is not None:
-                    qs = img.stokes_qu_W_m2_sr_nm
-                    qi, ui = rotate_linear(qs[..., 0], qs[..., 1], chi[j])
-                    img.stokes_qu_W_m2_sr_nm = np.stack([qi, ui], axis=-1)
+
+def _render_single(
+    target: Target,
+    inputs: EpochInputs,
+    session: RenderSession,
+    resolution_px: int,
+    workers: int | None,
+    progress: bool,
+    on_hits: Callable[..., None] | None,
+) -> _Rendered:
+    """Single mode on the valid epochs: in this process, or the numpy caster in several."""
+    v = inputs.valid
+    sun, obs, e, polarization = inputs.sun[v], inputs.obs[v], inputs.e[v], inputs.pole is not None
+    n_workers = numpy_processes(int(workers or 1))  # one inside a Dask worker
+    multi = n_workers > 1 and on_hits is None
+    if multi and not session.variant.startswith(("llvm_", "cuda_")) and len(v) > 1:
+        # Dr.Jit variants already use every core; the numpy caster runs one process per
+        # worker on contiguous blocks of epochs (Mitsuba scenes are never pickled).
+        inten, linear, imgs = _single_in_processes(
+            target, sun, obs, e, inputs.wl, resolution_px, inputs.keep_local, n_workers,
+            polarization,
+        )  # fmt: skip
+        used = "numpy"
     else:
-        chosen = session.variant
-        from speclight.render.path import render_path
+        caster = session.caster(target)
+        from speclight.render.single import render_single_polarized
 
-        with stage("rendering (path)", len(valid), enabled=progress) as advance:
-            inten, err, imgs, st, st_err = render_path(
-                target,
-                sun[valid],
-                obs[valid],
-                e[valid],
-                wl,
-                session,
-                int(resolution_px),
-                int(samples_per_pixel),
-                int(seed),
-                keep_local,
-                on_epoch=advance,
-                solar_disk=bool(solar_disk),
-                pole=None if pole is None else pole[valid],
-            )
-        intensity[valid] = inten
-        std[valid] = err
-        if stokes is not None and stokes_std is not None and st is not None:
-            stokes[valid] = st
-            stokes_std[valid] = st_err
-        used = chosen
-    for j, img in imgs.items():
-        g = int(valid[j])
+        with stage("rendering (single)", len(v), enabled=progress) as advance:
+            inten, linear, imgs = render_single_polarized(
+                target, sun, obs, e, inputs.wl, caster, resolution_px, inputs.keep_local,
+                on_batch=advance,
+                on_hits=None if on_hits is None else _global_epochs(on_hits, v),
+                polarization=polarization,
+            )  # fmt: skip
+        used = caster.name
+    rendered = _Rendered(inten, 0.0, imgs, used)
+    if inputs.pole is not None:
+        assert linear is not None
+        _stokes_on_sky(rendered, linear, scattering_angle_on_sky(sun, obs, inputs.pole[v]))
+    return rendered
+
+
+def _stokes_on_sky(rendered: _Rendered, linear: F64, chi: F64) -> None:
+    """Set the single mode's Stokes (Q_s, 0, 0) in the scattering plane's frame, turned by
+    ``chi`` (N,) to the sky's north-east frame; the kept images' pixels too."""
+    q, u = rotate_linear(linear, np.zeros_like(linear), chi)
+    rendered.stokes = np.stack([q, u, np.zeros_like(q)], axis=-1)
+    rendered.stokes_std = 0.0
+    for j, img in rendered.images.items():  # the kept pixels: the same rotation
+        if img.stokes_qu_W_m2_sr_nm is not None:
+            qs = img.stokes_qu_W_m2_sr_nm
+            qi, ui = rotate_linear(qs[..., 0], qs[..., 1], chi[j])
+            img.stokes_qu_W_m2_sr_nm = np.stack([qi, ui], axis=-1)
+
+
+def _render_path(
+    target: Target,
+    inputs: EpochInputs,
+    session: RenderSession,
+    resolution_px: int,
+    samples_per_pixel: int,
+    seed: int,
+    progress: bool,
+    solar_disk: bool,
+) -> _Rendered:
+    """Path mode on the valid epochs."""
+    from speclight.render.path import render_path
+
+    v = inputs.valid
+    with stage("rendering (path)", len(v), enabled=progress) as advance:
+        inten, err, imgs, st, st_err = render_path(
+            target, inputs.sun[v], inputs.obs[v], inputs.e[v], inputs.wl, session,
+            resolution_px, samples_per_pixel, seed, inputs.keep_local, on_epoch=advance,
+            solar_disk=solar_disk, pole=None if inputs.pole is None else inputs.pole[v],
+        )  # fmt: skip
+    return _Rendered(inten, err, imgs, session.variant, st, st_err)
+
+
+def _result(inputs: EpochInputs, rendered: _Rendered, mode: RenderMode) -> RenderResult:
+    """The rendered epochs placed among all inputs' (NaN rows for those not rendered)."""
+    n, n_wl = len(inputs.sun), len(inputs.wl)
+    v = inputs.valid
+    intensity = np.full((n, n_wl), np.nan)
+    std = np.full((n, n_wl), np.nan)
+    intensity[v] = rendered.intensity
+    std[v] = rendered.std
+    stokes = stokes_std = None
+    if inputs.pole is not None:
+        stokes = np.full((n, n_wl, 3), np.nan)
+        stokes_std = np.full((n, n_wl, 3), np.nan)
+        if rendered.stokes is not None:
+            stokes[v] = rendered.stokes
+            stokes_std[v] = rendered.stokes_std
+    images = {}
+    for j, img in rendered.images.items():
+        g = int(v[j])
         img.epoch = g
         images[g] = img
-    return RenderResult(intensity, std, ok, used, mode, images, stokes, stokes_std)
+    return RenderResult(
+        intensity, std, inputs.ok, rendered.variant, mode, images, stokes, stokes_std
+    )
 
 
 def _global_epochs(on_hits: Callable[..., None], valid: NDArray[np.int64]) -> Callable[..., None]:
@@ -337,16 +348,9 @@ def material_contributions(
     (1, 1, 2)
     """
     wl = np.asarray(wavelength_nm, dtype=float).ravel()
-    sun, ok_s = _unit_rows(sun_dir_body, "sun_dir_body")
-    obs, ok_o = _unit_rows(observer_dir_body, "observer_dir_body", len(sun))
-    e = np.asarray(solar_irradiance_W_m2_nm, dtype=float)
-    e = np.broadcast_to(e, (len(sun), len(wl))) if e.ndim == 1 else e
-    if e.shape != (len(sun), len(wl)):
-        raise InputError(
-            f"solar_irradiance_W_m2_nm must have shape (N, L) = ({len(sun)}, {len(wl)}), "
-            f"got {e.shape}",
-            field="solar_irradiance_W_m2_nm",
-        )
+    sun, ok_s = unit_rows(sun_dir_body, "sun_dir_body")
+    obs, ok_o = unit_rows(observer_dir_body, "observer_dir_body", len(sun))
+    e = irradiance_rows(solar_irradiance_W_m2_nm, len(sun), len(wl))
     if session is None:
         session = RenderSession.create("single", variant, target.materials)
     ok = ok_s & ok_o & np.all(np.isfinite(e), axis=1)

@@ -73,16 +73,9 @@ def render_articulated(
     """
     n, n_wl = len(sun_dir_body), len(wavelength_nm)
     keep = set(int(k) for k in (keep_images_for or ()))
-    intensity = np.full((n, n_wl), np.nan)
-    std = np.full((n, n_wl), np.nan)
-    ok = np.zeros(n, bool)
-    images = {}
-    variant, mode = session.variant, str(session.mode)
     on_hits = kwargs.pop("on_hits", None)
     pole = kwargs.pop("pole_body", None)
-    stokes = stokes_std = None
-    if kwargs.get("polarization"):
-        stokes, stokes_std = np.full((n, n_wl, 3), np.nan), np.full((n, n_wl, 3), np.nan)
+    out = _unrendered(n, n_wl, bool(kwargs.get("polarization")), session)
     for idx, posed in posed_groups(target, joints, angles_rad, angle_step_deg):
         if on_hits is not None:
             kwargs["on_hits"] = _in_group(on_hits, idx)  # type: ignore[arg-type]
@@ -99,17 +92,33 @@ def render_articulated(
             **kwargs,  # type: ignore[arg-type]
         )
         session.forget(posed)  # one scene alive at a time
-        intensity[idx] = res.intensity_W_sr_nm
-        std[idx] = res.intensity_std_W_sr_nm
-        ok[idx] = res.ok
-        if stokes is not None and stokes_std is not None:
-            stokes[idx] = res.stokes_W_sr_nm
-            stokes_std[idx] = res.stokes_std_W_sr_nm
-        variant, mode = res.variant, res.mode
-        for j, img in res.images.items():
-            img.epoch = int(idx[j])
-            images[int(idx[j])] = img
-    return RenderResult(intensity, std, ok, variant, mode, images, stokes, stokes_std)
+        _place(out, res, idx)
+    return out
+
+
+def _unrendered(n: int, n_wl: int, polarized: bool, session: RenderSession) -> RenderResult:
+    """A result of ``n`` epochs none of which is rendered yet (NaN, not ok)."""
+    stokes = stokes_std = None
+    if polarized:
+        stokes, stokes_std = np.full((n, n_wl, 3), np.nan), np.full((n, n_wl, 3), np.nan)
+    return RenderResult(
+        np.full((n, n_wl), np.nan), np.full((n, n_wl), np.nan), np.zeros(n, bool),
+        session.variant, str(session.mode), {}, stokes, stokes_std,
+    )  # fmt: skip
+
+
+def _place(out: RenderResult, res: RenderResult, idx: NDArray[np.int64]) -> None:
+    """Put the render ``res`` of the epochs ``idx`` (a group of one pose) into ``out``."""
+    out.intensity_W_sr_nm[idx] = res.intensity_W_sr_nm
+    out.intensity_std_W_sr_nm[idx] = res.intensity_std_W_sr_nm
+    out.ok[idx] = res.ok
+    if out.stokes_W_sr_nm is not None and out.stokes_std_W_sr_nm is not None:
+        out.stokes_W_sr_nm[idx] = res.stokes_W_sr_nm
+        out.stokes_std_W_sr_nm[idx] = res.stokes_std_W_sr_nm
+    out.variant, out.mode = res.variant, res.mode
+    for j, img in res.images.items():
+        img.epoch = int(idx[j])
+        out.images[int(idx[j])] = img
 
 
 def _in_group(on_hits: Callable[..., None], idx: NDArray[np.int64]) -> Callable[..., None]:

@@ -33,8 +33,7 @@ from collections.abc import Iterator
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.render import material_channels as channels
-from speclight.render.material_channels import ChannelLayout, pixel_contributions
+from speclight.render.material_channels import ChannelLayout
 from speclight.render.raycast import Caster
 from speclight.render.shading import VisibleHits, dot_rows, half_vectors, mirror_in_sun
 
@@ -44,7 +43,7 @@ I64 = NDArray[np.int64]
 
 def fcos_spectral(
     layout: ChannelLayout,
-    plastic: dict[int, F64],
+    blocks: dict[int, F64],
     wavelength_nm: F64,
     part_material: I64,
     n: F64,
@@ -53,10 +52,12 @@ def fcos_spectral(
 ) -> F64:
     """``f(to_light, to_viewer) cos(theta_light)`` (M, S) [sr-1] on the given wavelengths.
 
-    ``n`` faces ``to_viewer`` (two-sided surfaces); zero where the light is behind.
+    ``part_material`` (M,) is each point's material index in ``layout``; ``blocks`` the
+    block factors of its materials on these wavelengths
+    (:meth:`~speclight.render.bsdfs.MaterialBsdf.block_factor`). ``n`` faces ``to_viewer``
+    (two-sided surfaces); zero where the light is behind.
     """
-    m_count, s_count = len(n), len(wavelength_nm)
-    out = np.zeros((m_count, s_count))
+    out = np.zeros((len(n), len(wavelength_nm)))
     cos_i, cos_o = dot_rows(n, to_light), dot_rows(n, to_viewer)
     ok = np.flatnonzero((cos_i > 0) & (cos_o > 0))
     if ok.size == 0:
@@ -65,20 +66,14 @@ def fcos_spectral(
     half = half_vectors(s, v)
     cos_h, cos_d = dot_rows(nn, half), dot_rows(s, half)
     mirror_ok = mirror_in_sun(nn, cos_o[ok], v, s)
-    rows, chans, w = pixel_contributions(
-        layout, part_material[ok], cos_i[ok], cos_o[ok], cos_h, cos_d, mirror_ok
-    )
-    for c, m in enumerate(layout.mats):
-        sel = np.flatnonzero(chans == c)
+    for k, bsdf in enumerate(layout.bsdfs):
+        sel = np.flatnonzero(part_material[ok] == k)
         if sel.size:
-            r = rows[sel]
-            out[ok[r]] += w[sel, None] * channels.main_factor(m, cos_d[r], wavelength_nm)
-    for c, start in layout.block.items():
-        sel = np.flatnonzero((chans >= start) & (chans < start + plastic[c].shape[0]))
-        if sel.size:
-            vals = w[sel, None] * plastic[c][chans[sel] - start]
-            for j in range(s_count):
-                out[:, j] += np.bincount(ok[rows[sel]], vals[:, j], minlength=m_count)
+            p = ok[sel]
+            out[p] = bsdf.fcos(
+                cos_i[p], cos_o[p], cos_h[sel], cos_d[sel], mirror_ok[sel], wavelength_nm,
+                blocks.get(k),
+            )  # fmt: skip
     return out
 
 
@@ -102,7 +97,7 @@ def _offset_origin(pos: F64, n: F64) -> F64:
 
 def multibounce_returns(
     layout: ChannelLayout,
-    plastic: dict[int, F64],
+    blocks: dict[int, F64],
     wavelength_nm: F64,
     v: VisibleHits,
     s_dir: F64,
@@ -121,9 +116,9 @@ def multibounce_returns(
 
     Parameters
     ----------
-    layout, plastic
-        Channel layout of the target and each plastic material's block factors on the
-        laser's support wavelengths ``wavelength_nm`` (S,) [nm].
+    layout, blocks
+        Channel layout of the target and the block factors of its materials that have a
+        block (plastic, RGL) on the laser's support wavelengths ``wavelength_nm`` (S,) [nm].
     v
         The batch's primary hits (:class:`~speclight.render.shading.VisibleHits`).
     s_dir, lit_ep
@@ -164,7 +159,7 @@ def multibounce_returns(
         through = np.ones((start.size, n_s))
         for _ in range(2, max_depth):
             w = _cosine_hemisphere(n, rng)
-            fc = fcos_spectral(layout, plastic, wl, mat, n, w, view)
+            fc = fcos_spectral(layout, blocks, wl, mat, n, w, view)
             through = through * fc * np.pi / np.maximum(dot_rows(n, w), 1e-12)[:, None]
             hits = caster.intersect(_offset_origin(pos, n), w)
             keep = np.flatnonzero(hits.hit & np.any(through > 0, axis=1))
@@ -185,7 +180,7 @@ def multibounce_returns(
                 blocked = caster.occluded(pos[lit], s[lit], n[lit])
                 lit = lit[~blocked]
             if lit.size:
-                fl = fcos_spectral(layout, plastic, wl, mat[lit], n[lit], s[lit], view[lit])
+                fl = fcos_spectral(layout, blocks, wl, mat[lit], n[lit], s[lit], view[lit])
                 value = through[lit] * fl * irradiance_W_m2_nm[slot[lit]] * (pixel_area_m2 / spp)
                 delta = 0.5 * (path[lit] - dot_rows(pos[lit] - com_body_m, s[lit]))
                 bins = np.clip(((delta - edges[0]) / width).astype(np.int64), 0, nb - 1)

@@ -35,12 +35,17 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.render import material_channels as channels
 from speclight.render.camera import primary_rays
 from speclight.render.laser_multibounce import multibounce_returns
 from speclight.render.material_channels import ChannelLayout, pixel_contributions
 from speclight.render.raycast import Caster, Hits
-from speclight.render.shading import VisibleHits, dot_rows, half_vectors, mirror_in_sun
+from speclight.render.shading import (
+    SUN_COS,
+    VisibleHits,
+    dot_rows,
+    half_vectors,
+    mirror_in_sun,
+)
 from speclight.target.parts import Target
 
 if TYPE_CHECKING:
@@ -109,7 +114,6 @@ class LaserReturnAccumulator:
         samples_per_pixel: int = 1,
         seed: int = 0,
     ) -> None:
-        channels.check_supported(target.materials)
         self.target = target
         self.obs = np.asarray(observer_dir_body, dtype=float)
         self.lights = lights
@@ -136,9 +140,7 @@ class LaserReturnAccumulator:
         self.max_depth = int(max_depth)
         self.samples_per_pixel = int(samples_per_pixel)
         self.seed = int(seed)
-        self._plastic = {
-            k: channels.plastic_factor(self.layout.mats[k], self.wl) for k in self.layout.block
-        }
+        self._blocks = {k: self.layout.bsdfs[k].block_factor(self.wl) for k in self.layout.block}
 
     def __call__(
         self, epochs: I64, origin: F64, direction: F64, hits: Hits, caster: Caster | None = None
@@ -184,7 +186,7 @@ class LaserReturnAccumulator:
             e_idx = v.ep[idx]
             cos_o = v.cos_o[idx]
             cos_i, cos_h, cos_d = cos_o, cos_o, np.ones_like(cos_o)
-            mirror_ok = (2.0 * cos_o**2 - 1.0 >= channels.SUN_COS).astype(float)
+            mirror_ok = (2.0 * cos_o**2 - 1.0 >= SUN_COS).astype(float)
             delta_px = -v.rel_o[idx]
         else:
             cos_all = dot_rows(v.n, s[v.ep])
@@ -220,7 +222,7 @@ class LaserReturnAccumulator:
             sup = light.support
             increments = multibounce_returns(
                 self.layout,
-                {c: f[:, sup] for c, f in self._plastic.items()},
+                {c: f[:, sup] for c, f in self._blocks.items()},
                 self.wl[sup],
                 v,
                 s,
@@ -256,10 +258,10 @@ class LaserReturnAccumulator:
         # spectral factor (b, C, S) on the laser's support, times the irradiance
         cos_half = np.sqrt(np.clip(0.5 * (1.0 + np.einsum("bk,bk->b", s, o)), 0.0, 1.0))
         factor = np.zeros((b, self.layout.n_channels, n_s))
-        for c, m in enumerate(self.layout.mats):
-            factor[:, c, :] = channels.main_factor(m, cos_half, self.wl[sup])
+        for c, bsdf in enumerate(self.layout.bsdfs):
+            factor[:, c, :] = bsdf.main_factor(cos_half, self.wl[sup])
         for c, start in self.layout.block.items():
-            blk = self._plastic[c][:, sup]
+            blk = self._blocks[c][:, sup]
             factor[:, start : start + blk.shape[0], :] = blk[None]
         factor *= light.irradiance_W_m2_nm[epochs][:, None, :]
         value = w[:, None] * factor[e_rows, chans, :]  # (M, S)

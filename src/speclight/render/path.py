@@ -12,7 +12,7 @@ The sample budget is split in ``K`` passes with independent samples; their sprea
 standard error of the mean per bin. All passes of an epoch are sampled in one launch of
 Mitsuba's path integrator over rays and wavelengths drawn here (:mod:`.path_sampling`: the
 radiance of each sample goes to its bins, without a film), whatever the materials: plastic
-coats are the spectral BSDF of :mod:`.path_coat`. Measured lab BRDF tables are not
+coats are the spectral BSDF of :mod:`.bsdfs.path_coat`. Measured lab BRDF tables are not
 available in this mode; RGL ``.bsdf`` measured materials use Mitsuba's ``measured`` plugin
 (:mod:`.rgl`). A smooth mirror (``specular``, smooth plastic coat) lit by the directional
 (point) Sun reflects no light toward a given observer (a delta BSDF meets a delta light);
@@ -37,8 +37,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
+from speclight.render.bsdfs.bsdf_interface import spectrum_grid
+from speclight.render.bsdfs.path_plastic import group_bases, index_groups
 from speclight.render.camera import image_axes, primary_rays
-from speclight.render.path_plastic import group_bases, index_groups
 from speclight.render.path_sampling import FREEZE_MIN_LAUNCHES, PassSampler, launch_count
 from speclight.render.path_scene import build_scene, set_epoch
 from speclight.render.polarization import sky_axes
@@ -78,7 +79,7 @@ def render_path(
 
     ``solar_disk``: light the target with the finite solar disk instead of a point
     (directional) Sun, so that smooth mirrors and smooth plastic coats show their glint.
-    ``coat``: ``'spectral'`` (plastic coats as :mod:`.path_coat`, one launch per epoch) or
+    ``coat``: ``'spectral'`` (plastic coats as :mod:`.bsdfs.path_coat`, one launch per epoch) or
     ``'grouped'`` (the previous model: Mitsuba's plastic with one coat index per group of
     bins, one ``mi.render`` per group, epoch and pass; kept as a reference for the tests).
     Scalar variants (no Dr.Jit kernels to trace a Python BSDF or a sample loop into) always
@@ -93,68 +94,26 @@ def render_path(
     width = hi - lo
     passes = max(1, min(MAX_PASSES, samples_per_pixel))
     spp = max(1, samples_per_pixel // passes)
-    _, radius = target.bounding_sphere()
-    pixel_area = (2.0 * radius / resolution_px) ** 2
     n_ep, n_wl, res = len(sun_dir), len(wavelength_nm), resolution_px
     sums = np.zeros((n_ep, passes, n_wl))
     # kept epochs' images, summed over passes (float64, filled as they are rendered)
     acc = {e: np.zeros((res, res, n_wl)) for e in set(keep)}
-    import drjit as dr
-
     stokes_sums = np.zeros((n_ep, 3, passes, n_wl)) if polarized else None
-    north = None
-    if polarized:
-        if not dr.is_jit_v(mi.Float) or pole is None:
-            raise InputError(
-                f"render.polarization in render.mode 'path' needs an llvm_ad or cuda_ad "
-                f"*_spectral_polarized variant (got '{session.variant}') and the pole",
-                field="render.variant",
-            )
-        north, _ = sky_axes(obs_dir, pole)
-    if coat == "grouped" or not dr.is_jit_v(mi.Float):  # scalar variants: the film loop
+    north = _sky_north(mi, session.variant, obs_dir, pole) if polarized else None
+    if coat == "grouped" or not _jit(mi):  # scalar variants: the film loop
         _render_grouped(
-            mi,
-            target,
-            sun_dir,
-            obs_dir,
-            wavelength_nm,
-            res,
-            spp,
-            seed,
-            solar_disk,
-            sums,
-            acc,
+            mi, target, sun_dir, obs_dir, wavelength_nm, res, spp, seed, solar_disk, sums, acc,
             on_epoch,
-        )
+        )  # fmt: skip
     else:
-        scene, params = build_scene(target, lo, hi, res, spp, solar_disk, groups=[])
-        centre, _ = target.bounding_sphere()
-        freeze = launch_count(passes, res, spp, n_ep) >= FREEZE_MIN_LAUNCHES
-        sampler = PassSampler(mi, scene, centre, radius, lo, hi, res, spp, passes, freeze)
-        for e in range(n_ep):
-            set_epoch(mi, params, target, sun_dir[e], obs_dir[e], solar_disk)
-            basis = None if north is None else north[e]
-            s, img = sampler.epoch(obs_dir[e], seed, e, image=e in acc, north=basis)
-            if stokes_sums is not None:
-                stokes_sums[e] = s[1:] / spp * pixel_area / width
-                s = s[0]
-            sums[e] = s / spp * pixel_area / width
-            if img is not None:
-                acc[e] = img / spp
-            if on_epoch is not None:
-                on_epoch(1)
-        sampler.close()
-    mean = sums.mean(axis=1) * irradiance
-    if passes > 1:
-        err = sums.std(axis=1, ddof=1) / np.sqrt(passes) * irradiance
-    else:
-        err = np.full((n_ep, n_wl), np.nan)
+        _render_launches(
+            mi, target, sun_dir, obs_dir, (lo, hi), res, (spp, passes), seed, solar_disk,
+            (sums, stokes_sums, acc), on_epoch, north,
+        )  # fmt: skip
+    mean, err = _pass_mean_and_error(sums, irradiance)
     stokes = stokes_err = None
     if stokes_sums is not None:
-        e3 = irradiance[:, None, :]
-        stokes = np.moveaxis(stokes_sums.mean(axis=2) * e3, 1, 2)
-        spread = stokes_sums.std(axis=2, ddof=1) / np.sqrt(passes) if passes > 1 else np.nan
-        stokes_err = np.moveaxis(np.broadcast_to(spread, (*stokes_sums.shape[:2], n_wl)) * e3, 1, 2)
+        stokes, stokes_err = _stokes_mean_and_error(stokes_sums, irradiance)
     images = {
         e: _image(
             e,
@@ -167,6 +126,89 @@ def render_path(
         for e, a_e in acc.items()
     }
     return mean, err, images, stokes, stokes_err
+
+
+def _jit(mi: Any) -> bool:
+    """True in a Dr.Jit (llvm_ad, cuda_ad) variant: kernels are traced and launched."""
+    import drjit as dr
+
+    return bool(dr.is_jit_v(mi.Float))
+
+
+def _sky_north(mi: Any, variant: str, obs_dir: F64, pole: F64 | None) -> F64:
+    """The sky's north (N, 3) per epoch, the Stokes reference of a polarised render."""
+    if not _jit(mi) or pole is None:
+        raise InputError(
+            f"render.polarization in render.mode 'path' needs an llvm_ad or cuda_ad "
+            f"*_spectral_polarized variant (got '{variant}') and the pole",
+            field="render.variant",
+        )
+    north, _ = sky_axes(obs_dir, pole)
+    return north
+
+
+def _render_launches(
+    mi: Any,
+    target: Target,
+    sun_dir: F64,
+    obs_dir: F64,
+    bounds_nm: tuple[F64, F64],
+    res: int,
+    samples: tuple[int, int],
+    seed: int,
+    solar_disk: bool,
+    out: tuple[F64, F64 | None, dict[int, F64]],
+    on_epoch: Callable[[int], None] | None,
+    north: F64 | None,
+) -> None:
+    """Path mode's own sample loop, one launch per epoch: fills ``out`` = (pass sums
+    (N, P, L), Stokes pass sums (N, 3, P, L) or None, kept images) per unit irradiance.
+
+    ``bounds_nm``: the bins' edges (lo, hi); ``samples``: (samples per pixel per pass,
+    passes)."""
+    (lo, hi), (spp, passes) = bounds_nm, samples
+    sums, stokes_sums, acc = out
+    width = hi - lo
+    centre, radius = target.bounding_sphere()
+    pixel_area = (2.0 * radius / res) ** 2
+    scene, params = build_scene(target, lo, hi, res, spp, solar_disk, groups=[])
+    freeze = launch_count(passes, res, spp, len(sun_dir)) >= FREEZE_MIN_LAUNCHES
+    sampler = PassSampler(mi, scene, centre, radius, lo, hi, res, spp, passes, freeze)
+    for e in range(len(sun_dir)):
+        set_epoch(mi, params, target, sun_dir[e], obs_dir[e], solar_disk)
+        basis = None if north is None else north[e]
+        s, img = sampler.epoch(obs_dir[e], seed, e, image=e in acc, north=basis)
+        if stokes_sums is not None:
+            stokes_sums[e] = s[1:] / spp * pixel_area / width
+            s = s[0]
+        sums[e] = s / spp * pixel_area / width
+        if img is not None:
+            acc[e] = img / spp
+        if on_epoch is not None:
+            on_epoch(1)
+    sampler.close()
+
+
+def _pass_mean_and_error(sums: F64, irradiance: F64) -> tuple[F64, F64]:
+    """Mean over the passes (N, P, L) times the irradiance, and its standard error (NaN
+    with one pass)."""
+    passes = sums.shape[1]
+    mean = sums.mean(axis=1) * irradiance
+    if passes > 1:
+        err = sums.std(axis=1, ddof=1) / np.sqrt(passes) * irradiance
+    else:
+        err = np.full((sums.shape[0], sums.shape[2]), np.nan)
+    return mean, err
+
+
+def _stokes_mean_and_error(stokes_sums: F64, irradiance: F64) -> tuple[F64, F64]:
+    """Stokes Q, U, V (N, L, 3) from their pass sums (N, 3, P, L), and standard errors."""
+    passes, n_wl = stokes_sums.shape[2], stokes_sums.shape[3]
+    e3 = irradiance[:, None, :]
+    stokes = np.moveaxis(stokes_sums.mean(axis=2) * e3, 1, 2)
+    spread = stokes_sums.std(axis=2, ddof=1) / np.sqrt(passes) if passes > 1 else np.nan
+    stokes_err = np.moveaxis(np.broadcast_to(spread, (*stokes_sums.shape[:2], n_wl)) * e3, 1, 2)
+    return stokes, stokes_err
 
 
 def _render_grouped(
@@ -194,26 +236,45 @@ def _render_grouped(
     # Each group gets its share of the samples (>= 1 spp): the samples per bin, hence the
     # noise per bin, are those of one render over all bins.
     group_spp = [max(1, round(spp * (b - a) / len(wavelength_nm))) for a, b in spans]
-    grid = np.linspace(lo[0], hi[-1], max(2, int((hi[-1] - lo[0]) / 2.0) + 1))
+    grid = spectrum_grid(float(lo[0]), float(hi[-1]))
     sensors = {sen.id(): sen for sen in scene.sensors()}
     bases = group_bases(target, groups, grid)
-    passes = sums.shape[1]
     # Groups outer: Mitsuba recomputes its coat tables (~0.1 s) only once per group.
     for j, (a, b, etas) in enumerate(groups):
         for k, n in etas.items():
             params[f"part{k}.bsdf.brdf_0.eta"] = n
             params[f"part{k}.bsdf.brdf_0.diffuse_reflectance.values"] = bases[j][k]
+        last = on_epoch if j == len(groups) - 1 else None
         for e in range(len(sun_dir)):
             set_epoch(mi, params, target, sun_dir[e], obs_dir[e], solar_disk, f"sensor{j}")
-            for k in range(passes):
-                s = (seed * 1_000_003 + e * MAX_PASSES + k + j * 7_919) % (2**32)
-                img = mi.render(scene, sensor=sensors[f"sensor{j}"], seed=s, spp=group_spp[j])
-                img = np.asarray(img, dtype=float)
-                sums[e, k, a:b] = img.sum(axis=(0, 1)) * pixel_area / width[a:b]
-                if e in acc:
-                    acc[e][:, :, a:b] += img
-            if on_epoch is not None and j == len(groups) - 1:
-                on_epoch(1)
+            kept = acc[e][:, :, a:b] if e in acc else None
+            _group_passes(
+                mi, scene, sensors[f"sensor{j}"], (seed, e, j), group_spp[j],
+                (sums[e, :, a:b], kept), (pixel_area, width[a:b]),
+            )  # fmt: skip
+            if last is not None:
+                last(1)
+
+
+def _group_passes(
+    mi: Any,
+    scene: Any,
+    sensor: Any,
+    ids: tuple[int, int, int],
+    spp: int,
+    out: tuple[F64, F64 | None],
+    area_width: tuple[float, F64],
+) -> None:
+    """The passes of one epoch and group of bins: each pass's sums (P, B) into ``out[0]``
+    (times the pixel area over the bins' widths ``area_width``), its image added to
+    ``out[1]`` if kept; ``ids``: (seed, epoch, group)."""
+    (seed, e, j), (sums, image), (pixel_area, width) = ids, out, area_width
+    for k in range(len(sums)):
+        s = (seed * 1_000_003 + e * MAX_PASSES + k + j * 7_919) % (2**32)
+        img = np.asarray(mi.render(scene, sensor=sensor, seed=s, spp=spp), dtype=float)
+        sums[k] = img.sum(axis=(0, 1)) * pixel_area / width
+        if image is not None:
+            image += img
 
 
 def _image(

@@ -1,12 +1,13 @@
 """The Mitsuba scene of path mode: parts, BSDFs, the Sun and the sensors (see :mod:`.path`).
 
-BSDFs are two-sided, like the single-scattering mode: ``diffuse``; ``roughconductor`` with
-the Beckmann or GGX distribution, Fresnel from n,k, or a reflectance with
+BSDFs are two-sided, like the single-scattering mode; each model gives its own
+(:meth:`speclight.render.bsdfs.MaterialBsdf.path_bsdf`): ``diffuse``; ``roughconductor``
+with the Beckmann or GGX distribution, Fresnel from n,k, or a reflectance with
 ``material='none'`` (F = 1 scaled by the reflectance); smooth ``conductor``; ``plastic``
-materials as the coated diffuse BSDF of :mod:`.path_coat` (coat index varying with
+materials as the coated diffuse BSDF of :mod:`.bsdfs.path_coat` (coat index varying with
 wavelength: the whole spectrum in one render), or, with ``coat='grouped'``, as Mitsuba's
-``plastic`` / ``roughplastic`` with one index per group of bins (:mod:`.path_plastic`, the
-previous model, kept as a reference); RGL measured materials through Mitsuba's
+``plastic`` / ``roughplastic`` with one index per group of bins (:mod:`.bsdfs.path_plastic`,
+the previous model, kept as a reference); RGL measured materials through Mitsuba's
 ``measured`` plugin. The Sun is a ``directional`` emitter of unit spectral irradiance or,
 with ``solar_disk``, a far sphere emitter subtending the solar disk. The sensor is
 orthographic along the line of sight, its ``specfilm`` holding one box response per
@@ -25,15 +26,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.errors import InputError
-from speclight.render import material_channels as channels
+from speclight.render.bsdfs import material_bsdf
 from speclight.render.camera import image_axes
-from speclight.render.path_coat import coat_tables, coated_diffuse
-from speclight.render.path_plastic import base_for_mitsuba
-from speclight.render.rgl import is_rgl, path_bsdf
+from speclight.render.shading import sun_disk_sin2
 from speclight.target.materials import Material
 from speclight.target.parts import Target
-from speclight.target.reflectance import Reflectance
 
 F64 = NDArray[np.float64]
 #: Longest path (number of bounces + 1) followed; Russian roulette starts after 5.
@@ -44,85 +41,9 @@ MAX_DEPTH = 16
 SUN_DISTANCE_FACTOR = 1.0e5
 
 
-def _spectrum(wl: F64, values: F64) -> dict[str, Any]:
-    return {
-        "type": "irregular",
-        "wavelengths": ", ".join(f"{w:.6g}" for w in wl),
-        "values": ", ".join(f"{v:.8g}" for v in values),
-    }
-
-
-def _refl_spectrum(refl: Reflectance, lo: float, hi: float) -> dict[str, Any]:
-    if refl.kind == "constant":
-        return {"type": "uniform", "value": refl.value}
-    grid = np.linspace(lo, hi, max(2, int((hi - lo) / 2.0) + 1))
-    return _spectrum(grid, refl.evaluate(grid))
-
-
 def _bsdf(m: Material, lo: float, hi: float, coat: str = "spectral") -> Any:
     """Mitsuba BSDF dict of a material (two-sided, like the single-scattering mode)."""
-    refl = m.reflectance
-    grid = np.linspace(lo, hi, max(2, int((hi - lo) / 2.0) + 1))
-    if m.bsdf == "lambertian":
-        inner: Any = {"type": "diffuse", "reflectance": _refl_spectrum(refl, lo, hi)}
-    elif m.bsdf in ("beckmann", "ggx", "specular"):
-        inner = (
-            {"type": "conductor"}
-            if m.bsdf == "specular"
-            else {
-                "type": "roughconductor",
-                "distribution": m.bsdf,
-                "alpha": float(m.roughness or 0.0),
-            }
-        )
-        if refl.is_fresnel:
-            eta = refl.eta(grid)
-            inner["eta"] = _spectrum(grid, eta.real)
-            # an all-zero irregular spectrum is refused by Mitsuba ("no probability mass"):
-            # a dielectric without absorption (k = 0) gets the constant 0
-            inner["k"] = _spectrum(grid, eta.imag) if np.any(eta.imag != 0) else 0.0
-        else:
-            inner["material"] = "none"
-            inner["specular_reflectance"] = _refl_spectrum(refl, lo, hi)
-    elif m.bsdf == "plastic" and coat == "spectral":
-        import mitsuba as mi
-
-        inner = coated_diffuse(mi, coat_tables(m, lo, hi))
-    elif m.bsdf == "plastic":
-        inner = _plastic(m, float(np.mean(refl.eta(grid).real)), lo, hi)  # set per group
-        if m.roughness is not None:
-            inner.update(distribution="beckmann", alpha=float(m.roughness))
-    elif is_rgl(m):
-        inner = path_bsdf(m)  # Mitsuba's 'measured' plugin on the RGL .bsdf file
-    else:
-        raise InputError(
-            f"material '{m.name}': bsdf '{m.bsdf}' is not supported in render.mode 'path' yet "
-            "(path supports lambertian, beckmann, ggx, specular, plastic and measured RGL "
-            ".bsdf files); use render.mode "
-            "'single'",
-            field="render.mode",
-        )
-    return {"type": "twosided", "material": inner}
-
-
-def _plastic(m: Material, eta: float, lo: float, hi: float) -> dict[str, Any]:
-    """Mitsuba ``plastic`` / ``roughplastic`` (linear) carrying the single mode's model.
-
-    Both use ``f_d = rho T(theta_i) T(theta_o) / (eta^2 pi (1 - F_dr,int))``; Mitsuba's
-    F_dr,int estimate (:func:`.path_plastic.mitsuba_internal_reflectance`) differs from the
-    exact integral the single mode uses, so the base reflectance handed to Mitsuba is rescaled
-    by ``(1 - F_dr,int[Mitsuba]) / (1 - F_dr,int[exact])``, which makes the two equal. The
-    coat index is set per group of bins while rendering (:func:`.path_plastic.index_groups`).
-    """
-    grid = np.linspace(lo, hi, max(2, int((hi - lo) / 2.0) + 1))
-    inner: dict[str, Any] = {
-        "type": "plastic" if m.roughness is None else "roughplastic",
-        "int_ior": eta,
-        "ext_ior": 1.0,
-        "diffuse_reflectance": _spectrum(grid, base_for_mitsuba(m, eta, grid)),
-        "nonlinear": False,
-    }
-    return inner
+    return {"type": "twosided", "material": material_bsdf(m, "path").path_bsdf(lo, hi, coat)}
 
 
 def _sun(lo: float, hi: float, solar_disk: bool) -> dict[str, Any]:
@@ -143,7 +64,7 @@ def _sun(lo: float, hi: float, solar_disk: bool) -> dict[str, Any]:
             "direction": [0.0, 0.0, -1.0],
             "irradiance": {**unit, "values": "1, 1"},
         }
-    radiance = 1.0 / (np.pi * channels.sun_disk_sin2())
+    radiance = 1.0 / (np.pi * sun_disk_sin2())
     return {
         "type": "sphere",
         "to_world": _sun_sphere_transform(np.zeros(3), 1.0, np.array([0.0, 0.0, 1.0])),
@@ -160,7 +81,7 @@ def _sun_sphere_transform(centre: F64, radius: float, sun: F64) -> Any:
 
     dist = SUN_DISTANCE_FACTOR * radius
     pos = centre + dist * np.asarray(sun, float)
-    r = dist * np.sqrt(channels.sun_disk_sin2())
+    r = dist * np.sqrt(sun_disk_sin2())
     return mi.ScalarTransform4f().translate(pos.tolist()) @ mi.ScalarTransform4f().scale([r, r, r])
 
 

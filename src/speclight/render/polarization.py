@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError
+from speclight.target.bsdf_models import BSDF_FORMS
 from speclight.target.materials import Material
 
 F64 = NDArray[np.float64]
@@ -133,44 +134,21 @@ def dolp_aolp(i: ArrayLike, q: ArrayLike, u: ArrayLike) -> tuple[F64, F64]:
     return np.asarray(dolp), np.asarray(aolp)
 
 
-#: Materials whose polarisation the renders model (``measured`` BRDF tables and RGL files
-#: hold intensity only).
-POLARIZABLE = ("lambertian", "beckmann", "ggx", "specular", "plastic")
-
-
 def check_polarizable(materials: Iterable[Material], mode: str = "single") -> None:
-    """Raise an InputError naming the first material whose polarisation is not modelled.
+    """Raise an InputError naming the first material whose polarisation is not modelled in
+    render mode ``mode`` (the models' ``polarized_modes``, :mod:`speclight.target.bsdf_models`).
 
     Measured BRDFs (lab tables and RGL ``.bsdf`` files) are unpolarised measurements of
     intensity: treating them as unpolarising would claim a DoLP of 0 for surfaces that can
     polarise strongly (glass, paint), so ``render.polarization`` refuses them. Path mode
     also refuses ``plastic`` (its coat is a Python BSDF without a Mueller matrix).
     """
-    accepted = POLARIZABLE if mode == "single" else tuple(b for b in POLARIZABLE if b != "plastic")
+    accepted = ", ".join(dict.fromkeys(f.name for f in BSDF_FORMS if mode in f.polarized_modes))
     for m in materials:
-        if m.bsdf not in accepted:
+        if mode not in m.model.polarized_modes:
             raise InputError(
                 f"material '{m.name}': bsdf '{m.bsdf}' has no polarisation model in "
                 f"render.mode '{mode}' (render.polarization: true accepts "
-                f"{', '.join(accepted)}); set render.polarization: false or change the bsdf",
+                f"{accepted}); set render.polarization: false or change the bsdf",
                 field=f"target.materials.{m.name}.bsdf",
             )
-
-
-def main_linear_factor(m: Material, cos_half_phase: F64, wavelength_nm: F64) -> F64:
-    """Q factor (N, L) of a material's main channel, referenced to the scattering plane's
-    normal: the counterpart of :func:`speclight.render.material_channels.main_factor`.
-
-    Mirror, microfacet and plastic-coat reflection: ``(R_s - R_p) / 2`` at the half-phase
-    angle for the material's n, k (the coat's real index for ``plastic``). Lambertian and
-    reflectances given as numbers (no n, k: Fresnel F = 1 scaled by the reflectance, as
-    Mitsuba's ``material='none'``, so R_s = R_p) are unpolarising: 0.
-    """
-    n = len(cos_half_phase)
-    refl = m.reflectance
-    if m.bsdf == "lambertian" or not refl.is_fresnel:
-        return np.zeros((n, len(wavelength_nm)))
-    c = np.where(np.isfinite(cos_half_phase), cos_half_phase, 1.0)
-    eta = refl.eta(wavelength_nm)
-    coat = eta.real if m.bsdf == "plastic" else eta  # a plastic's coat: its real index
-    return linear_factor(c[:, None], coat[None, :])

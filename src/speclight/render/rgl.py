@@ -35,8 +35,9 @@ from numpy.typing import NDArray
 
 from speclight.errors import InputError
 from speclight.render.variant import activate
+from speclight.target.bsdf_models import MEASURED_RGL
 from speclight.target.materials import Material
-from speclight.target.rgl_file import is_rgl_path, load_rgl_info
+from speclight.target.rgl_file import load_rgl_info
 
 F64 = NDArray[np.float64]
 #: Lanes per ``eval`` call (bounds the Dr.Jit memory use).
@@ -45,7 +46,7 @@ EVAL_BATCH = 1 << 20
 
 def is_rgl(m: Material) -> bool:
     """True for a ``measured`` material whose ``brdf_table`` is an RGL ``.bsdf`` file."""
-    return m.bsdf == "measured" and is_rgl_path(m.brdf_table)
+    return m.model is MEASURED_RGL
 
 
 def scale(m: Material) -> float:

@@ -3,7 +3,7 @@
 For each epoch an orthographic grid of rays (one per pixel centre) is cast along the line of
 sight; each hit is tested for shadow by a ray towards the Sun, and the BRDF is evaluated for
 the Sun and observer directions. Every model factorises into geometric weights times spectral
-factors (see :mod:`speclight.render.material_channels`), so one ray cast per epoch gives all
+factors (see :mod:`speclight.render.bsdfs`), so one ray cast per epoch gives all
 wavelengths, without noise in wavelength:
 
     I(lambda) = E(lambda) * sum_c w_c * R_c(lambda)      [W sr-1 nm-1]
@@ -35,7 +35,7 @@ from numpy.typing import NDArray
 from speclight.render import material_channels as channels
 from speclight.render.camera import image_axes, primary_rays
 from speclight.render.material_channels import ChannelLayout, pixel_contributions
-from speclight.render.polarization import check_polarizable, main_linear_factor
+from speclight.render.polarization import check_polarizable
 from speclight.render.raycast import Caster
 from speclight.render.result import RenderImage
 from speclight.render.shading import dot_rows, half_vectors, mirror_in_sun
@@ -165,8 +165,8 @@ def channel_sum(
     """
     cos_half = np.sqrt(np.clip(0.5 * (1.0 + np.einsum("nk,nk->n", sun_dir, obs_dir)), 0.0, 1.0))
     n_mat = len(layout.mats)
-    main = [channels.main_factor(m, cos_half, wavelength_nm) for m in layout.mats]
-    blocks = {k: channels.block_factor(layout.mats[k], wavelength_nm) for k in layout.block}
+    main = [bsdf.main_factor(cos_half, wavelength_nm) for bsdf in layout.bsdfs]
+    blocks = {k: layout.bsdfs[k].block_factor(wavelength_nm) for k in layout.block}
     total = sum(w[:, k, None] * main[k] for k in range(n_mat))
     for k, start in layout.block.items():
         total = total + w[:, start : start + blocks[k].shape[0]] @ blocks[k]
@@ -198,7 +198,6 @@ def render_single_polarized(
     """
     if polarization:
         check_polarizable(target.materials)
-    channels.check_supported(target.materials)
     keep = list(keep)
     w, kept, pitch, layout = geometric_weights(
         target,
@@ -216,7 +215,7 @@ def render_single_polarized(
     intensity = irradiance * total
     linear = None
     if polarization:  # the block channels (diffuse bases) are unpolarised
-        q = [main_linear_factor(m, cos_half, wavelength_nm) for m in layout.mats]
+        q = [bsdf.linear_factor(cos_half, wavelength_nm) for bsdf in layout.bsdfs]
         linear = irradiance * sum(w[:, k, None] * q[k] for k in range(n_mat))
     images: dict[int, RenderImage] = {}
     for e, kp in kept.items():
@@ -267,7 +266,6 @@ def material_contributions(
     the pixels that see material k (``target.materials`` order); the sum over k is the
     intensity of :func:`render_single` (to rounding).
     """
-    channels.check_supported(target.materials)
     w, _, _, layout = geometric_weights(
         target,
         sun_dir,
@@ -278,10 +276,10 @@ def material_contributions(
     )
     cos_half = np.sqrt(np.clip(0.5 * (1.0 + np.einsum("nk,nk->n", sun_dir, obs_dir)), 0.0, 1.0))
     out = np.zeros((len(sun_dir), len(layout.mats), len(wavelength_nm)))
-    for k, m in enumerate(layout.mats):
-        out[:, k] = w[:, k, None] * channels.main_factor(m, cos_half, wavelength_nm)
+    for k, bsdf in enumerate(layout.bsdfs):
+        out[:, k] = w[:, k, None] * bsdf.main_factor(cos_half, wavelength_nm)
         if k in layout.block:
-            block = channels.block_factor(m, wavelength_nm)
+            block = bsdf.block_factor(wavelength_nm)
             start = layout.block[k]
             out[:, k] += w[:, start : start + block.shape[0]] @ block
     return out * irradiance[:, None, :]

@@ -13,9 +13,11 @@ pass as the intensity: one extra channel per differentiated material, accumulate
 others (:func:`~speclight.render.single.geometric_weights`), so that it costs a fraction of
 a render, not the two renders of a central difference.
 
-Materials: ``beckmann`` and ``ggx``. ``plastic`` is refused: the transmittance of its rough
-coat, which weights its diffuse base, depends on alpha through a quadrature table
-(:func:`~speclight.render.material_channels.rough_coat_tables`) that has no derivative here.
+Materials: those whose model gives the derivative
+(:meth:`~speclight.render.bsdfs.MaterialBsdf.roughness_derivative`: ``beckmann``, ``ggx``).
+``plastic`` is refused: the transmittance of its rough coat, which weights its diffuse base,
+depends on alpha through a quadrature table
+(:func:`~speclight.render.bsdfs.coat_optics.rough_coat_tables`) without a derivative here.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from numpy.typing import NDArray
 
 from speclight.errors import InputError
 from speclight.render import material_channels as channels
-from speclight.render.brdf_gradient import microfacet_weight_dalpha
+from speclight.render.bsdfs import material_bsdf
 from speclight.render.material_channels import ChannelLayout, pixel_contributions
 from speclight.render.raycast import Caster
 from speclight.render.single import channel_sum, geometric_weights
@@ -35,21 +37,10 @@ from speclight.target.parts import Target
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
 
-#: BSDFs whose roughness derivative this module computes.
-DIFFERENTIABLE = ("beckmann", "ggx")
-
 
 def gradient_problem(m: Material) -> str:
     """Why the roughness derivative of material ``m`` is not available ("" when it is)."""
-    if m.bsdf == "plastic":
-        return (
-            f"material '{m.name}' (plastic): the roughness of a plastic's coat also sets the "
-            "transmittance to its diffuse base, a quadrature table without an analytic "
-            "derivative here"
-        )
-    if m.bsdf not in DIFFERENTIABLE or not m.roughness:
-        return f"material '{m.name}' has no microfacet roughness (bsdf '{m.bsdf}')"
-    return ""
+    return material_bsdf(m, "single").gradient_problem()
 
 
 class _GradientLayout(ChannelLayout):
@@ -75,14 +66,12 @@ def _contributions(
     rows, chans, weights = pixel_contributions(layout, mat, cos_i, cos_o, cos_h, cos_d, mirror_ok)
     extra_rows, extra_chans, extra_w = [rows], [chans], [weights]
     for k, channel in layout.grad.items():
-        m = layout.mats[k]
         sel = np.flatnonzero(mat == k)
-        alpha = float(m.roughness or 0.0)
+        dw = layout.bsdfs[k].roughness_derivative(cos_i[sel], cos_o[sel], cos_h[sel])
+        assert dw is not None  # gradient_problem() was checked
         extra_rows.append(sel)
         extra_chans.append(np.full(sel.size, channel))
-        extra_w.append(
-            microfacet_weight_dalpha(cos_i[sel], cos_o[sel], cos_h[sel], alpha, m.bsdf)  # type: ignore[arg-type]
-        )
+        extra_w.append(dw)
     return np.concatenate(extra_rows), np.concatenate(extra_chans), np.concatenate(extra_w)
 
 
@@ -111,7 +100,6 @@ def render_single_gradient(
         The intensity, equal to :func:`~speclight.render.single.render_single`'s (the same
         sums in the same order), and ``d intensity / d alpha_k`` (module doc).
     """
-    channels.check_supported(target.materials)
     names = [m.name for m in target.materials]
     index = []
     for name in rough:
@@ -142,4 +130,4 @@ def render_single_gradient(
     return np.asarray(intensity, dtype=float), grad.reshape(len(index), *intensity.shape)
 
 
-__all__ = ["DIFFERENTIABLE", "gradient_problem", "render_single_gradient"]
+__all__ = ["gradient_problem", "render_single_gradient"]

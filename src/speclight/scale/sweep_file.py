@@ -103,7 +103,8 @@ class _Checker:
         shown = f" = {value!r}" if value is not None else ""
         return InputError(f"line {line}: {what}{shown}: {message}", source=self.source)
 
-    def check(self, data: Any, root: yaml.Node | None) -> SweepSpec:
+    def _top_keys(self, data: Any, root: yaml.Node | None) -> None:
+        """A mapping of known keys, with base and vary."""
         if not isinstance(data, dict):
             raise InputError(
                 "a sweep file is a YAML mapping with base, vary (and set, draws, seed, "
@@ -126,6 +127,31 @@ class _Checker:
                     "scenario file; vary: the fields to vary)",
                     source=self.source,
                 )
+
+    def _check_draws(
+        self, root: yaml.Node | None, random: bool, seed: int | None, draws: int
+    ) -> None:
+        """Random distributions need a seed; several draws need a random distribution."""
+        if random and seed is None:
+            raise self.error(
+                _line(root, "vary"),
+                "seed",
+                None,
+                "vary has random distributions: give seed: N (an integer >= 0) so that the "
+                "same file gives the same cases",
+            )
+        if not random and draws > 1:
+            raise self.error(
+                _line(root, "draws"),
+                "draws",
+                draws,
+                "without a random distribution in vary every draw is the same case; "
+                "remove draws or vary a field with {uniform: [a, b]} (or normal, loguniform, "
+                "choice)",
+            )
+
+    def check(self, data: Any, root: yaml.Node | None) -> SweepSpec:
+        self._top_keys(data, root)
         base = data["base"]
         if not isinstance(base, str) or not base.strip():
             raise self.error(
@@ -141,23 +167,7 @@ class _Checker:
             raise self.error(_line(root, "spectra"), "spectra", spectra, "accepted: true, false")
         fixed = self._set(data.get("set", {}), _child(root, "set"), _line(root, "set"))
         axes, dists = self._vary(data["vary"], _child(root, "vary"), _line(root, "vary"))
-        if dists and seed is None:
-            raise self.error(
-                _line(root, "vary"),
-                "seed",
-                None,
-                "vary has random distributions: give seed: N (an integer >= 0) so that the "
-                "same file gives the same cases",
-            )
-        if not dists and draws > 1:
-            raise self.error(
-                _line(root, "draws"),
-                "draws",
-                draws,
-                "without a random distribution in vary every draw is the same case; "
-                "remove draws or vary a field with {uniform: [a, b]} (or normal, loguniform, "
-                "choice)",
-            )
+        self._check_draws(root, bool(dists), seed, draws)
         spec = SweepSpec(
             self.source,
             self.folder,
@@ -298,18 +308,23 @@ class _Checker:
             lists.append(value)
         return Axis(tuple(fields), tuple(zip(*lists, strict=True)))
 
+    def _one_distribution(self, f: Field, value: dict[str, Any]) -> None:
+        """The mapping names exactly one known distribution."""
+        if len(value) == 1 and next(iter(value)) in DISTRIBUTIONS:
+            return
+        name = str(next(iter(value))) if len(value) == 1 else None
+        hint = did_you_mean(name, DISTRIBUTIONS) if name else ""
+        raise self.error(
+            f.line,
+            f"vary.{f.name}",
+            value,
+            f"one distribution{hint}: {{uniform: [a, b]}}, {{normal: [mu, sigma]}}, "
+            "{loguniform: [a, b]} or {choice: [v1, v2, ...]} (or a list of values)",
+        )
+
     def _distribution(self, f: Field, value: dict[str, Any]) -> Distribution:
         where = f"vary.{f.name}"
-        if len(value) != 1 or next(iter(value)) not in DISTRIBUTIONS:
-            name = str(next(iter(value))) if len(value) == 1 else None
-            hint = did_you_mean(name, DISTRIBUTIONS) if name else ""
-            raise self.error(
-                f.line,
-                where,
-                value,
-                f"one distribution{hint}: {{uniform: [a, b]}}, {{normal: [mu, sigma]}}, "
-                "{loguniform: [a, b]} or {choice: [v1, v2, ...]} (or a list of values)",
-            )
+        self._one_distribution(f, value)
         name, args = next(iter(value.items()))
         if name == "choice":
             if not isinstance(args, list) or not args:

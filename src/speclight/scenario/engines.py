@@ -29,7 +29,6 @@ from speclight.engine_packages import (
 )
 from speclight.errors import InputError
 from speclight.scenario.scenario_model import Scenario
-from speclight.target.rgl_file import is_rgl_path
 
 
 def needed_engines(scenario: Scenario) -> list[Need]:
@@ -50,15 +49,25 @@ def needed_engines(scenario: Scenario) -> list[Need]:
             field = f"instrument.bands.{i}.filter"
             needs.append(Need(SPECLITE, field, f"the filter {band.filter!r}"))
     if scenario.target is not None:
-        render = scenario.render
-        if render.mode == "path":
-            needs.append(Need(MITSUBA, "render.mode", "'path' (spectral path tracing)"))
-        if render.variant not in (None, "auto", "numpy"):
-            needs.append(Need(MITSUBA, "render.variant", f"the Mitsuba variant {render.variant!r}"))
-        for part, material in scenario.target.materials.items():
-            if material.bsdf == "measured" and is_rgl_path(material.brdf_table):
-                field = f"target.materials.{part}.brdf_table"
-                needs.append(Need(MITSUBA, field, f"the RGL file {material.brdf_table!r}"))
+        needs += _render_engines(scenario)
+    return needs
+
+
+def _render_engines(scenario: Scenario) -> list[Need]:
+    """The engines the render of a target needs: path mode, a Mitsuba variant, the
+    materials' models (:mod:`speclight.target.bsdf_models`)."""
+    assert scenario.target is not None
+    needs: list[Need] = []
+    render = scenario.render
+    if render.mode == "path":
+        needs.append(Need(MITSUBA, "render.mode", "'path' (spectral path tracing)"))
+    if render.variant not in (None, "auto", "numpy"):
+        needs.append(Need(MITSUBA, "render.variant", f"the Mitsuba variant {render.variant!r}"))
+    for part, material in scenario.target.materials.items():
+        bsdf = material.model
+        for engine, key in bsdf.engines:
+            reason = f"bsdf '{bsdf.label}' with {key} {getattr(material, key)!r}"
+            needs.append(Need(ENGINES[engine], f"target.materials.{part}.{key}", reason))
     return needs
 
 
@@ -72,6 +81,29 @@ def _sixs_problem() -> str | None:
     except SixSUnavailable as exc:
         return str(exc)
     return None
+
+
+def _sixs_problems(scenario: Scenario, need: Need, modules: list[str]) -> list[tuple[str, str]]:
+    """``(field, message)`` of 6S when it cannot run: none when SPECTRL2 may stand in and
+    pvlib is there."""
+    problem = missing_message(need, modules) if modules else _sixs_problem()
+    if problem is None:
+        return []
+    if scenario.atmosphere.fallback_to_spectrl2:  # SPECTRL2 then needs pvlib
+        pvlib = Need(
+            PVLIB,
+            "atmosphere.fallback_to_spectrl2",
+            "true (6S cannot run here, so SPECTRL2)",
+        )
+        if missing_modules(PVLIB):
+            return [(pvlib.field, missing_message(pvlib, missing_modules(PVLIB)))]
+        return []
+    return [
+        (
+            need.field,
+            f"{problem}. Or set atmosphere.fallback_to_spectrl2: true to use SPECTRL2 instead",
+        )
+    ]
 
 
 def check_engines(scenario: Scenario, source: str | None = None) -> None:
@@ -94,25 +126,7 @@ def check_engines(scenario: Scenario, source: str | None = None) -> None:
     for need in needed_engines(scenario):
         modules = missing_modules(need.engine)
         if need.engine is SIXS:
-            problem = missing_message(need, modules) if modules else _sixs_problem()
-            if problem is None:
-                continue
-            if scenario.atmosphere.fallback_to_spectrl2:  # SPECTRL2 then needs pvlib
-                pvlib = Need(
-                    PVLIB,
-                    "atmosphere.fallback_to_spectrl2",
-                    "true (6S cannot run here, so SPECTRL2)",
-                )
-                if missing_modules(PVLIB):
-                    problems.append((pvlib.field, missing_message(pvlib, missing_modules(PVLIB))))
-                continue
-            problems.append(
-                (
-                    need.field,
-                    f"{problem}. Or set atmosphere.fallback_to_spectrl2: true to use "
-                    "SPECTRL2 instead",
-                )
-            )
+            problems += _sixs_problems(scenario, need, modules)
         elif modules:
             problems.append((need.field, missing_message(need, modules)))
     if problems:

@@ -22,8 +22,15 @@ from pydantic import (
 from speclight.instrument.bands import MAX_GAUSSIAN_NM
 from speclight.scenario.sections_geometry import Strict, Vector3
 from speclight.scenario.sections_imaging import Imaging
+from speclight.target.bsdf_models import (
+    MAX_ROUGHNESS,
+    PARAMETERS,
+    BsdfModel,
+    BsdfName,
+    bsdf_model,
+    parameter_problems,
+)
 
-BsdfName = Literal["lambertian", "beckmann", "ggx", "plastic", "specular", "measured"]
 ConductorName = Literal["Al", "Ag", "Au"]
 DielectricName = Literal["SiO2", "Si", "GaAs", "Kapton"]
 #: Shipped reflectance tables (``data/materials``, :mod:`speclight.target.material_tables`).
@@ -130,7 +137,10 @@ class Material(Strict):
         "specular); for plastic the coat's dielectric",
     )
     roughness: float | None = Field(
-        default=None, gt=0, le=1, description="Microfacet alpha (beckmann, ggx; plastic coat)"
+        default=None,
+        gt=0,
+        le=MAX_ROUGHNESS,
+        description="Microfacet alpha (beckmann, ggx; plastic coat)",
     )
     diffuse_reflectance: Reflectance | None = Field(
         default=None, description="Diffuse base of a plastic/coated layer"
@@ -145,17 +155,29 @@ class Material(Strict):
     def _params(self) -> Material:
         if isinstance(self.reflectance, float) and not 0.0 <= self.reflectance <= 1.0:
             raise ValueError(f"reflectance = {self.reflectance} must lie in [0, 1]")
-        if self.bsdf in ("beckmann", "ggx") and self.roughness is None:
-            raise ValueError(f"bsdf '{self.bsdf}' needs roughness (microfacet alpha, 0 < a <= 1)")
-        if self.bsdf in ("lambertian", "specular", "measured") and self.roughness is not None:
-            raise ValueError(f"bsdf '{self.bsdf}' takes no roughness")
-        if self.bsdf == "plastic" and self.diffuse_reflectance is None:
-            raise ValueError("bsdf 'plastic' needs diffuse_reflectance (the base under the coat)")
-        if self.bsdf == "measured" and not self.brdf_table:
-            raise ValueError("bsdf 'measured' needs brdf_table: a shipped table name or a CSV file")
-        if self.bsdf != "measured" and self.brdf_table:
-            raise ValueError(f"brdf_table is only used by bsdf 'measured', not '{self.bsdf}'")
+        kind = _reflectance_kind(self.reflectance)
+        problems = parameter_problems(self.bsdf, self.parameters(), kind)
+        if problems:
+            raise ValueError(problems[0][1])
         return self
+
+    def parameters(self) -> dict[str, Any]:
+        """The model parameters given (:data:`speclight.target.bsdf_models.PARAMETERS`)."""
+        given = {name: getattr(self, name) for name in PARAMETERS}
+        given["brdf_table"] = self.brdf_table or None  # an empty name is none
+        return given
+
+    @property
+    def model(self) -> BsdfModel:
+        """The material's entry (its form) in the table of BSDF models."""
+        return bsdf_model(self.bsdf, self.parameters())
+
+
+def _reflectance_kind(value: Any) -> str:
+    """The :class:`~speclight.target.Reflectance` kind a validated reflectance becomes."""
+    if isinstance(value, Conductor | Dielectric):
+        return "conductor" if isinstance(value, Conductor) else "dielectric"
+    return "constant" if isinstance(value, float) else "table"
 
 
 _SHAPE_SIZES: dict[str, tuple[str, ...]] = {
@@ -219,19 +241,28 @@ class Shape(Strict):
             if sizes:
                 raise ValueError(f"{', '.join(sizes)} apply to builtin shapes, not mesh_file")
             return self
-        missing = [k for k in _SHAPE_REQUIRED[self.builtin] if getattr(self, k) is None]
-        if missing:
-            raise ValueError(f"builtin '{self.builtin}' needs {', '.join(missing)}")
-        extra = [k for k in sizes if k not in _SHAPE_SIZES[self.builtin]]
-        if extra:
-            raise ValueError(
-                f"builtin '{self.builtin}' takes {', '.join(_SHAPE_SIZES[self.builtin])}, "
-                f"not {', '.join(extra)}"
-            )
-        if self.dish is False and (self.dish_radius_m or self.dish_depth_m):
-            raise ValueError("dish: false leaves out the dish; drop dish_radius_m, dish_depth_m")
+        _check_sizes(self.builtin, sizes, [k for k in _SHAPE_FIELDS if getattr(self, k) is None])
+        _check_dish(self.dish, self.dish_radius_m, self.dish_depth_m)
         _check_scale(self.builtin, {k: getattr(self, k) for k in sizes})
         return self
+
+
+def _check_dish(dish: bool | None, radius_m: float | None, depth_m: float | None) -> None:
+    """No dish sizes for a box-wing without its dish."""
+    if dish is False and (radius_m or depth_m):
+        raise ValueError("dish: false leaves out the dish; drop dish_radius_m, dish_depth_m")
+
+
+def _check_sizes(builtin: str, given: list[str], left_out: list[str]) -> None:
+    """A built-in shape's sizes: every one it needs, none it does not take."""
+    missing = [k for k in _SHAPE_REQUIRED[builtin] if k in left_out]
+    if missing:
+        raise ValueError(f"builtin '{builtin}' needs {', '.join(missing)}")
+    extra = [k for k in given if k not in _SHAPE_SIZES[builtin]]
+    if extra:
+        raise ValueError(
+            f"builtin '{builtin}' takes {', '.join(_SHAPE_SIZES[builtin])}, not {', '.join(extra)}"
+        )
 
 
 def _check_scale(builtin: str, sizes: dict[str, Any]) -> None:

@@ -28,10 +28,13 @@ from pydantic import BaseModel
 from speclight.orbit.iers_files import finals_path
 from speclight.orbit.orbit_sources import file_keys
 from speclight.scenario import LoadedScenario
+from speclight.target.bsdf_models import bsdf_file_parameters
 
 #: Scenario fields (by their last name) whose string values may name a file or folder: the
 #: orbit sources that read a file come from their registry
-#: (:data:`speclight.orbit.orbit_sources.ORBIT_SOURCES`), so a new source is hashed too.
+#: (:data:`speclight.orbit.orbit_sources.ORBIT_SOURCES`), so a new source is hashed too, and
+#: the material parameters that name a file from the table of BSDF models
+#: (:func:`speclight.target.bsdf_models.bsdf_file_parameters`).
 FILE_FIELDS = frozenset(
     {
         "file",
@@ -39,11 +42,11 @@ FILE_FIELDS = frozenset(
         "spectrum_file",
         "table_file",
         "map_file",
-        "brdf_table",
         "detector_qe",
         "optics_transmission",
     }
     | file_keys()
+    | bsdf_file_parameters()
 )
 _CHUNK = 1 << 20
 

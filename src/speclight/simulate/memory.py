@@ -45,7 +45,6 @@ import os
 import resource
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 
 from speclight.errors import InputError
@@ -121,33 +120,16 @@ def _bins(scenario: Scenario) -> int:
 
 
 def channel_count(scenario: Scenario, resolve: Callable[[str], Path] | None = None) -> int:
-    """Render channels of the scenario's target in single mode: one per material, plus
-    ``PLASTIC_NODES**2`` per ``plastic`` and the wavelength nodes of each RGL file (read
-    through ``resolve``, a relative path to a file; 0 where it cannot be read: the run
-    reports that file itself). 0 without a target."""
-    from speclight.render.material_channels import PLASTIC_NODES
-    from speclight.target.rgl_file import is_rgl_path
+    """Render channels of the scenario's target in single mode: one per material, plus its
+    block (:func:`speclight.render.bsdfs.planned_channels`: ``PLASTIC_NODES**2`` per
+    ``plastic`` and the wavelength nodes of each RGL file, read through ``resolve``, a
+    relative path to a file; 0 where it cannot be read: the run reports that file itself).
+    0 without a target."""
+    from speclight.render.bsdfs import planned_channels
 
     if scenario.target is None:
         return 0
-    count = 0
-    for m in scenario.target.materials.values():
-        count += 1
-        if m.bsdf == "plastic":
-            count += PLASTIC_NODES**2
-        elif m.bsdf == "measured" and is_rgl_path(m.brdf_table) and resolve is not None:
-            count += _rgl_nodes(str(resolve(str(m.brdf_table))))
-    return count
-
-
-@lru_cache(maxsize=16)
-def _rgl_nodes(path: str) -> int:
-    from speclight.target.rgl_file import load_rgl_info
-
-    try:
-        return len(load_rgl_info(path).wavelength_nm)
-    except (InputError, OSError, ValueError, KeyError):
-        return 0
+    return sum(planned_channels(m, resolve) for m in scenario.target.materials.values())
 
 
 def estimate_memory(

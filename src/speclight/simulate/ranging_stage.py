@@ -44,6 +44,7 @@ from speclight.instrument.photometry import photon_kernel
 from speclight.orbit.timescale import time_from_utc
 from speclight.ranging import link, transmitter_geometry
 from speclight.ranging.bins import RANGE_BINS, range_bin_edges_m
+from speclight.render.bsdfs import material_bsdf
 from speclight.render.laser_returns import LaserLight, LaserReturnAccumulator, LaserReturns
 from speclight.render.path_scene import MAX_DEPTH as PATH_MAX_DEPTH
 from speclight.render.session import RenderSession
@@ -194,9 +195,24 @@ def prepare_ranging(
 
         return RangingSetup(lasers, None, None, flags, wavelength_nm, from_map)
     assert target is not None and session is not None
+    acc = _accumulator(loaded, target, obs, lasers, wavelength_nm, range_bins)
+    return RangingSetup(lasers, acc, session, flags, wavelength_nm)
+
+
+def _accumulator(
+    loaded: LoadedScenario,
+    target: Target,
+    obs: F64,
+    lasers: list[LaserSetup],
+    wavelength_nm: F64,
+    range_bins: int,
+) -> LaserReturnAccumulator:
+    """The render of the lasers' light at the target, resolved in range (centre of mass at
+    the body origin; multi-bounce paths in path mode)."""
+    sc = loaded.scenario
     com = np.zeros(3)
     path = sc.render.mode == "path"
-    acc = LaserReturnAccumulator(
+    return LaserReturnAccumulator(
         target,
         obs,
         [la.light for la in lasers],
@@ -207,7 +223,6 @@ def prepare_ranging(
         samples_per_pixel=sc.render.samples_per_pixel,
         seed=sc.render.seed,
     )
-    return RangingSetup(lasers, acc, session, flags, wavelength_nm)
 
 
 def laser_irradiance_W_m2_nm(setup: RangingSetup, n_wavelengths: int) -> F64:
@@ -241,92 +256,25 @@ def laser_ranging(
         The instrument curves (band response, optics, QE); ``None``: no band outputs.
     """
     sc = loaded.scenario
-    acc = setup.accumulator
     wavelength_nm = setup.wavelength_nm
-    if setup.map_returns is not None:  # render.mode map: the returns from the map
-        rr = setup.map_returns()
-    else:
-        assert acc is not None and setup.session is not None
-        if np.any(acc.active & ~acc.rendered):
-            acc.finish(setup.session.caster(acc.target), sc.render.resolution_px)
-        rr = acc.result()
-    n, n_wl, k_las = geo.t_s.size, wavelength_nm.size, len(setup.lasers)
+    rr = _target_returns(setup, sc.render.resolution_px)
+    n, n_wl = geo.t_s.size, wavelength_nm.size
     obs = geo.observable
     intensity = np.zeros((n, n_wl))
     for k, laser in enumerate(setup.lasers):
         intensity[:, laser.light.support] += rr.intensity_W_sr_nm(k)
     bands = radiometry.band_names if radiometry is not None else []
-    n_bins = len(rr.bin_edges_m) - 1
     if radiometry is not None:
-        area = instrument.aperture_area_m2(
-            sc.telescope.aperture_diameter_m, sc.telescope.obstruction_diameter_m
-        )
-        # electrons per joule per bin x width (B, L); each band's own detector QE is folded
-        # into its response, as for the Sun's count rates (simulate/radiometry.py)
-        kernel = photon_kernel(
-            wavelength_nm,
-            radiometry.optics,
-            np.ones(n_wl),
-            radiometry.band_response * radiometry.qe,
-        )
-        conversions = [
-            link.downlink_conversion(
-                transmission[:, la.light.support],
-                obs,
-                geo.range_m,
-                area,
-                kernel[:, la.light.support],
-            )
-            for la in setup.lasers
-        ]
-        returns = link.receiver_returns(
-            rr.histogram, rr.moment_m, conversions, [la.repetition_rate_hz for la in setup.lasers]
-        )
-        per_pulse, total = returns.per_pulse, returns.rate_per_s
-        hist, offset = returns.histogram_per_s, returns.offset_m
-        # eq. 5 with the lasers' line instead of the Sun (docs/upsample-unmix.md): the same
-        # reflectance factor as the Sun's, from the return rates and the lasers' irradiance
-        illumination = laser_irradiance_W_m2_nm(setup, n_wl) * np.nan_to_num(transmission)
-        factor = instrument.reflectance_factor_m2_sr(
-            total,
-            geo.range_m,
-            area,
-            illumination,
-            wavelength_nm,
-            radiometry.optics,
-            np.ones(n_wl),
-            radiometry.band_response * radiometry.qe,
-        )
+        received = _received(loaded, geo, setup, rr, transmission, radiometry)
     else:
-        per_pulse, total = np.zeros((n, k_las, 0)), np.zeros((n, 0))
-        hist, offset = np.zeros((n, 0, n_bins)), np.zeros((n, 0))
-        factor = np.zeros((n, 0))
-    nan_rows = ~obs
-    intensity[nan_rows] = np.nan
-    per_pulse[nan_rows] = np.nan
-    hist[nan_rows] = np.nan
-    total[nan_rows] = np.nan
-    offset[nan_rows] = np.nan
-    factor[nan_rows] = np.nan
-    notes = []
-    below = [la.name for la in setup.lasers if np.any(obs & geo.orbit_ok & ~la.above_horizon)]
-    if below:
-        notes.append(
-            f"laser(s) {', '.join(below)} below the transmitter's horizon at some observable "
-            "epochs (flag laser_below_horizon): no return from them there"
-        )
-    if (
-        acc is not None
-        and sc.render.mode == "path"
-        and any(
-            m.bsdf == "specular" or (m.bsdf == "plastic" and m.roughness is None)
-            for m in acc.target.materials
-        )
-    ):
-        notes.append(
-            "laser ranging in render.mode 'path' does not follow the mirror reflection of "
-            "smooth (specular, smooth plastic) surfaces between bounces"
-        )
+        n_bins, k_las = len(rr.bin_edges_m) - 1, len(setup.lasers)
+        received = (
+            np.zeros((n, k_las, 0)), np.zeros((n, 0)), np.zeros((n, 0, n_bins)),
+            np.zeros((n, 0)), np.zeros((n, 0)),
+        )  # fmt: skip
+    for a in (intensity, *received):
+        a[~obs] = np.nan
+    per_pulse, total, hist, offset, factor = received
     return RangingResult(
         laser_names=[la.name for la in setup.lasers],
         band_names=list(bands),
@@ -340,5 +288,99 @@ def laser_ranging(
         range_histogram_per_s=hist,
         range_offset_m=offset,
         reflectance_factor_m2_sr=factor,
-        notes=notes,
+        notes=_ranging_notes(loaded, geo, setup),
     )
+
+
+def _target_returns(setup: RangingSetup, resolution_px: int) -> LaserReturns:
+    """The returns at the target: from the map, or the accumulator's (finished here for
+    the epochs the Sun's render did not share its rays with)."""
+    if setup.map_returns is not None:  # render.mode map: the returns from the map
+        return setup.map_returns()
+    acc = setup.accumulator
+    assert acc is not None and setup.session is not None
+    if np.any(acc.active & ~acc.rendered):
+        acc.finish(setup.session.caster(acc.target), resolution_px)
+    return acc.result()
+
+
+def _received(
+    loaded: LoadedScenario,
+    geo: Geometry,
+    setup: RangingSetup,
+    rr: LaserReturns,
+    transmission: F64,
+    radiometry: Radiometry,
+) -> tuple[F64, F64, F64, F64, F64]:
+    """Per band: returns per pulse (N, K, B), rate (N, B), range histogram (N, B, bins),
+    centre-of-mass offset (N, B) and reflectance factor (N, B) at the receiver."""
+    sc = loaded.scenario
+    wavelength_nm = setup.wavelength_nm
+    n_wl = wavelength_nm.size
+    area = instrument.aperture_area_m2(
+        sc.telescope.aperture_diameter_m, sc.telescope.obstruction_diameter_m
+    )
+    # electrons per joule per bin x width (B, L); each band's own detector QE is folded
+    # into its response, as for the Sun's count rates (simulate/radiometry.py)
+    kernel = photon_kernel(
+        wavelength_nm,
+        radiometry.optics,
+        np.ones(n_wl),
+        radiometry.band_response * radiometry.qe,
+    )
+    conversions = [
+        link.downlink_conversion(
+            transmission[:, la.light.support],
+            geo.observable,
+            geo.range_m,
+            area,
+            kernel[:, la.light.support],
+        )
+        for la in setup.lasers
+    ]
+    returns = link.receiver_returns(
+        rr.histogram, rr.moment_m, conversions, [la.repetition_rate_hz for la in setup.lasers]
+    )
+    # eq. 5 with the lasers' line instead of the Sun (docs/upsample-unmix.md): the same
+    # reflectance factor as the Sun's, from the return rates and the lasers' irradiance
+    illumination = laser_irradiance_W_m2_nm(setup, n_wl) * np.nan_to_num(transmission)
+    factor = instrument.reflectance_factor_m2_sr(
+        returns.rate_per_s,
+        geo.range_m,
+        area,
+        illumination,
+        wavelength_nm,
+        radiometry.optics,
+        np.ones(n_wl),
+        radiometry.band_response * radiometry.qe,
+    )
+    return (
+        returns.per_pulse,
+        returns.rate_per_s,
+        returns.histogram_per_s,
+        returns.offset_m,
+        factor,
+    )
+
+
+def _ranging_notes(loaded: LoadedScenario, geo: Geometry, setup: RangingSetup) -> list[str]:
+    """What the run should say about its laser returns (lasers below the horizon, mirrors)."""
+    notes = []
+    obs = geo.observable
+    below = [la.name for la in setup.lasers if np.any(obs & geo.orbit_ok & ~la.above_horizon)]
+    if below:
+        notes.append(
+            f"laser(s) {', '.join(below)} below the transmitter's horizon at some observable "
+            "epochs (flag laser_below_horizon): no return from them there"
+        )
+    acc = setup.accumulator
+    if (
+        acc is not None
+        and loaded.scenario.render.mode == "path"
+        and any(material_bsdf(m).mirror_lobe() for m in acc.target.materials)
+    ):
+        notes.append(
+            "laser ranging in render.mode 'path' does not follow the mirror reflection of "
+            "smooth (specular, smooth plastic) surfaces between bounces"
+        )
+    return notes

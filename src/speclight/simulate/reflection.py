@@ -14,9 +14,8 @@ from numpy.typing import NDArray
 
 from speclight import schema
 from speclight.constants import AU_M
-from speclight.errors import InputError
 from speclight.illumination import solar_irradiance_W_m2_nm
-from speclight.render.result import RenderImage
+from speclight.render.result import RenderImage, RenderResult
 from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
 from speclight.scenario.sections_light import (
@@ -24,6 +23,7 @@ from speclight.scenario.sections_light import (
     Dielectric,
     ReflectanceFile,
     ReflectancePairs,
+    Shape,
     ShippedTable,
 )
 from speclight.scenario.sections_light import Material as MaterialModel
@@ -36,11 +36,10 @@ from speclight.target.articulation import (
     joint_angles_rad,
     read_angle_table,
 )
-from speclight.target.brdf_table import load_brdf_table
+from speclight.target.bsdf_models import bsdf_file_parameters
 from speclight.target.from_values import BUILTIN_SHAPES
 from speclight.target.material_tables import material_table_path
 from speclight.target.mesh_io import load_mesh
-from speclight.target.rgl_file import is_rgl_path
 
 F64 = NDArray[np.float64]
 
@@ -59,6 +58,11 @@ def build_target(loaded: LoadedScenario) -> Target:
         files = [shape.mesh_file] if isinstance(shape.mesh_file, str) else shape.mesh_file
         paths = [loaded.resolve(f) for f in files]
         return load_mesh(paths, mats, scale_m_per_unit=float(shape.scale_m_per_unit))
+    return _builtin_target(shape, mats)
+
+
+def _builtin_target(shape: Shape, mats: dict[str, Material]) -> Target:
+    """A built-in shape with the sizes the scenario gives (the others: its defaults)."""
     assert shape.builtin is not None
     builder, sizes = BUILTIN_SHAPES[shape.builtin]
     kwargs = {k: getattr(shape, k) for k in sizes if getattr(shape, k) is not None}
@@ -107,15 +111,13 @@ def _reflectance(loaded: LoadedScenario, spec: Any, field: str) -> Reflectance:
 
 
 def _material(loaded: LoadedScenario, name: str, m: MaterialModel) -> Material:
+    """A scenario material as a :class:`Material` (files named relative to the scenario)."""
     field = f"target.materials.{name}"
-    table = m.brdf_table
-    if table is not None and Path(table).suffix:  # a file, not a shipped table name
-        table = str(loaded.resolve(table))
-    if m.bsdf == "measured" and table is not None and not is_rgl_path(table):
-        try:  # read the lab table now (it is cached), not halfway through the run
-            load_brdf_table(table)
-        except InputError as exc:
-            raise InputError(exc.message, source=exc.source, field=f"{field}.brdf_table") from None
+    files = {
+        key: str(loaded.resolve(value)) if Path(value).suffix else value  # not a shipped name
+        for key in bsdf_file_parameters()
+        if (value := getattr(m, key))
+    }
     diffuse = m.diffuse_reflectance
     return Material(
         name=name,
@@ -125,7 +127,7 @@ def _material(loaded: LoadedScenario, name: str, m: MaterialModel) -> Material:
         diffuse_reflectance=None
         if diffuse is None
         else _reflectance(loaded, diffuse, f"{field}.diffuse_reflectance"),
-        brdf_table=table,
+        **files,
     )
 
 
@@ -173,112 +175,162 @@ def render_reflection(
             intensity_W_sr_nm=None,
             flags=np.zeros(geo.t_s.size, dtype=np.uint8),
         )
-    n, n_wl = geo.t_s.size, wavelength_nm.size
-    intensity = np.full((n, n_wl), np.nan)
-    std = np.full((n, n_wl), np.nan)
-    polarized = sc.render.polarization
-    stokes = np.full((n, n_wl, 3), np.nan) if polarized else None
-    stokes_std = np.full((n, n_wl, 3), np.nan) if polarized else None
-    observable = geo.observable
-    sunlit = geo.sunlit_fraction if sc.illumination.sun else np.zeros(n)
-    lit = observable & (sunlit > 0)
-    intensity[observable & ~lit] = 0.0
-    std[observable & ~lit] = 0.0
-    if stokes is not None and stokes_std is not None:
-        stokes[observable & ~lit] = 0.0
-        stokes_std[observable & ~lit] = 0.0
+    sunlit = _sunlit_fraction(loaded, geo)
+    lit = geo.observable & (sunlit > 0)
+    out = _unrendered(solar, geo.observable & ~lit, wavelength_nm.size, sc.render.polarization)
     idx = np.flatnonzero(lit)
-    flags = np.zeros(n, dtype=np.uint8)
-    variant = ""
-    images: dict[int, RenderImage] = {}
-    part_names: list[str] = []
-    earthshine_on = sc.illumination.earthshine is not None and bool(np.any(observable))
-    if idx.size or earthshine_on:
-        if target is None:
-            target = build_target(loaded)
-        if session is None:
-            session = RenderSession.create(
-                sc.render.mode, sc.render.variant, target.materials, sc.render.polarization
-            )
+    earthshine_on = _earthshine_on(loaded, geo)
+    if not (idx.size or earthshine_on):
+        return out
+    target = build_target(loaded) if target is None else target
+    session = _session(loaded, target) if session is None else session
     if idx.size:
-        from speclight.render import render_intensity
-
-        assert target is not None and session is not None
-
-        keep = [int(np.searchsorted(idx, i)) for i in sc.render.save_images_at if i in set(idx)]
-        part_names = [part.name for part in target.parts]
-        if progress and sc.render.mode == "path":
-            from speclight.simulate.memory import path_render_note
-
-            print(path_render_note(sc, idx.size), file=sys.stderr)  # the bar follows
-        common: dict[str, Any] = dict(
-            resolution_px=sc.render.resolution_px,
-            samples_per_pixel=sc.render.samples_per_pixel,
-            seed=sc.render.seed,
-            workers=os.cpu_count(),  # used by the numpy fallback; Dr.Jit uses all cores itself
-            on_hits=None if on_hits is None else on_hits(idx),
-            solar_disk=sc.illumination.solar_disk,
+        result = _render_lit(
+            loaded, geo, wavelength_nm, solar, idx, progress, on_hits, target, session
         )
-        if polarized:
-            common.update(polarization=True, pole_body=pole_body(geo)[idx])
-        sun_b, obs_b = geo.sun_direction_body[idx], geo.observer_direction_body[idx]
-        joints = build_joints(loaded, target) if sc.target.articulation else ()
-        if joints:
-            from speclight.render.articulated import render_articulated
-
-            angles = joint_angles_rad(joints, sun_b, geo.time_utc[idx])
-            result = render_articulated(
-                target,
-                joints,
-                angles,
-                sun_b,
-                obs_b,
-                solar[idx],
-                wavelength_nm,
-                session=session,
-                angle_step_deg=sc.target.articulation_step_deg,
-                keep_images_for=keep or None,
-                **common,
-            )
-        else:
-            result = render_intensity(
-                target,
-                sun_b,
-                obs_b,
-                solar[idx],
-                wavelength_nm,
-                mode=session.mode,
-                variant=sc.render.variant,
-                progress=progress,
-                keep_images_for=keep or None,
-                session=session,
-                **common,
-            )
-        scale = sunlit[idx, None]
-        intensity[idx] = result.intensity_W_sr_nm * scale
-        if result.intensity_std_W_sr_nm is not None:
-            std[idx] = result.intensity_std_W_sr_nm * scale
-        else:
-            std[idx] = 0.0
-        failed = idx[~(result.ok & np.all(np.isfinite(result.intensity_W_sr_nm), axis=1))]
-        flags[failed] |= schema.FLAG_RENDER_FAILED
-        if stokes is not None and stokes_std is not None:
-            assert result.stokes_W_sr_nm is not None and result.stokes_std_W_sr_nm is not None
-            stokes[idx] = result.stokes_W_sr_nm * scale[:, :, None]
-            stokes_std[idx] = result.stokes_std_W_sr_nm * scale[:, :, None]
-        variant = result.variant
-        images = {int(idx[k]): image for k, image in result.images.items()}
-        for epoch, image in images.items():  # penumbra: as the intensity
-            image.radiance_W_m2_sr_nm = image.radiance_W_m2_sr_nm * sunlit[epoch]
-    earthshine = None
+        _store_lit(out, result, idx, sunlit)
+        out.part_names = [part.name for part in target.parts]
     if earthshine_on:
-        assert target is not None and session is not None
-        earthshine, es_stokes = earthshine_intensity(
-            loaded, geo, solar, wavelength_nm, target, session
-        )
-        intensity = intensity + np.nan_to_num(earthshine)  # NaN rows stay NaN (failed, unseen)
-        if stokes is not None and es_stokes is not None:
-            stokes = stokes + np.nan_to_num(es_stokes)
+        _add_earthshine(out, loaded, geo, wavelength_nm, target, session)
+    return out
+
+
+def _sunlit_fraction(loaded: LoadedScenario, geo: Geometry) -> F64:
+    """The visible fraction of the solar disk per epoch (0 with ``illumination.sun`` off)."""
+    return geo.sunlit_fraction if loaded.scenario.illumination.sun else np.zeros(geo.t_s.size)
+
+
+def _earthshine_on(loaded: LoadedScenario, geo: Geometry) -> bool:
+    """Whether Earthshine is rendered: asked for, and some epoch is observable."""
+    return loaded.scenario.illumination.earthshine is not None and bool(np.any(geo.observable))
+
+
+def _session(loaded: LoadedScenario, target: Target) -> RenderSession:
+    """The run's render session (its one Mitsuba variant) for the scenario's target."""
+    r = loaded.scenario.render
+    return RenderSession.create(r.mode, r.variant, target.materials, r.polarization)
+
+
+def _unrendered(
+    solar: F64, observable_unlit: NDArray[np.bool_], n_wl: int, polarized: bool
+) -> Reflection:
+    """NaN everywhere (not rendered), 0 at the observable epochs the Sun does not light."""
+    n = observable_unlit.size
+    shape = (n, n_wl, 3) if polarized else (0,)
+    arrays = [np.full((n, n_wl), np.nan), np.full((n, n_wl), np.nan)]
+    stokes = [np.full(shape, np.nan), np.full(shape, np.nan)] if polarized else [None, None]
+    for a in [*arrays, *stokes]:
+        if a is not None:
+            a[observable_unlit] = 0.0
     return Reflection(
-        solar, intensity, std, variant, images, part_names, flags, earthshine, stokes, stokes_std
+        solar_irradiance_W_m2_nm=solar,
+        intensity_W_sr_nm=arrays[0],
+        intensity_std_W_sr_nm=arrays[1],
+        flags=np.zeros(n, dtype=np.uint8),
+        stokes_W_sr_nm=stokes[0],
+        stokes_std_W_sr_nm=stokes[1],
     )
+
+
+def _render_lit(
+    loaded: LoadedScenario,
+    geo: Geometry,
+    wavelength_nm: F64,
+    solar: F64,
+    idx: NDArray[np.int64],
+    progress: bool,
+    on_hits: Callable[[NDArray[np.int64]], Callable[..., None]] | None,
+    target: Target,
+    session: RenderSession,
+) -> RenderResult:
+    """The render of the lit epochs ``idx`` (articulated parts posed per group of epochs)."""
+    sc = loaded.scenario
+    assert sc.target is not None
+    if progress and sc.render.mode == "path":
+        from speclight.simulate.memory import path_render_note
+
+        print(path_render_note(sc, idx.size), file=sys.stderr)  # the bar follows
+    common = _render_options(loaded, geo, idx, on_hits, session)
+    sun_b, obs_b = geo.sun_direction_body[idx], geo.observer_direction_body[idx]
+    joints = build_joints(loaded, target) if sc.target.articulation else ()
+    if joints:
+        from speclight.render.articulated import render_articulated
+
+        angles = joint_angles_rad(joints, sun_b, geo.time_utc[idx])
+        return render_articulated(
+            target, joints, angles, sun_b, obs_b, solar[idx], wavelength_nm,
+            angle_step_deg=sc.target.articulation_step_deg, **common,
+        )  # fmt: skip
+    from speclight.render import render_intensity
+
+    return render_intensity(
+        target, sun_b, obs_b, solar[idx], wavelength_nm, mode=session.mode,
+        variant=sc.render.variant, progress=progress, **common,
+    )  # fmt: skip
+
+
+def _render_options(
+    loaded: LoadedScenario,
+    geo: Geometry,
+    idx: NDArray[np.int64],
+    on_hits: Callable[[NDArray[np.int64]], Callable[..., None]] | None,
+    session: RenderSession,
+) -> dict[str, Any]:
+    """The keywords every render of the lit epochs ``idx`` takes from the scenario."""
+    sc = loaded.scenario
+    keep = [int(np.searchsorted(idx, i)) for i in sc.render.save_images_at if i in set(idx)]
+    common: dict[str, Any] = dict(
+        resolution_px=sc.render.resolution_px,
+        samples_per_pixel=sc.render.samples_per_pixel,
+        seed=sc.render.seed,
+        workers=os.cpu_count(),  # used by the numpy fallback; Dr.Jit uses all cores itself
+        on_hits=None if on_hits is None else on_hits(idx),
+        solar_disk=sc.illumination.solar_disk,
+        keep_images_for=keep or None,
+        session=session,
+    )
+    if sc.render.polarization:
+        common.update(polarization=True, pole_body=pole_body(geo)[idx])
+    return common
+
+
+def _store_lit(out: Reflection, result: RenderResult, idx: NDArray[np.int64], sunlit: F64) -> None:
+    """Put the lit epochs' render in ``out``, scaled by the visible fraction of the Sun."""
+    assert out.intensity_W_sr_nm is not None and out.intensity_std_W_sr_nm is not None
+    scale = sunlit[idx, None]
+    out.intensity_W_sr_nm[idx] = result.intensity_W_sr_nm * scale
+    if result.intensity_std_W_sr_nm is not None:
+        out.intensity_std_W_sr_nm[idx] = result.intensity_std_W_sr_nm * scale
+    else:
+        out.intensity_std_W_sr_nm[idx] = 0.0
+    failed = idx[~(result.ok & np.all(np.isfinite(result.intensity_W_sr_nm), axis=1))]
+    assert out.flags is not None
+    out.flags[failed] |= schema.FLAG_RENDER_FAILED
+    if out.stokes_W_sr_nm is not None and out.stokes_std_W_sr_nm is not None:
+        assert result.stokes_W_sr_nm is not None and result.stokes_std_W_sr_nm is not None
+        out.stokes_W_sr_nm[idx] = result.stokes_W_sr_nm * scale[:, :, None]
+        out.stokes_std_W_sr_nm[idx] = result.stokes_std_W_sr_nm * scale[:, :, None]
+    out.variant = result.variant
+    out.images = {int(idx[k]): image for k, image in result.images.items()}
+    for epoch, image in out.images.items():  # penumbra: as the intensity
+        image.radiance_W_m2_sr_nm = image.radiance_W_m2_sr_nm * sunlit[epoch]
+
+
+def _add_earthshine(
+    out: Reflection,
+    loaded: LoadedScenario,
+    geo: Geometry,
+    wavelength_nm: F64,
+    target: Target,
+    session: RenderSession,
+) -> None:
+    """Add the light of the sunlit Earth (``illumination.earthshine``) to ``out``."""
+    earthshine, es_stokes = earthshine_intensity(
+        loaded, geo, out.solar_irradiance_W_m2_nm, wavelength_nm, target, session
+    )
+    out.earthshine_W_sr_nm = earthshine
+    assert out.intensity_W_sr_nm is not None
+    # NaN rows stay NaN (failed, unseen)
+    out.intensity_W_sr_nm = out.intensity_W_sr_nm + np.nan_to_num(earthshine)
+    if out.stokes_W_sr_nm is not None and es_stokes is not None:
+        out.stokes_W_sr_nm = out.stokes_W_sr_nm + np.nan_to_num(es_stokes)

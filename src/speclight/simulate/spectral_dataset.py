@@ -78,22 +78,35 @@ def add_images(ds: xr.Dataset, images: dict[int, RenderImage], part_names: list[
     ds = ds.assign_coords(image_time=("image_time", ds["time"].values[epochs]))
     ds["image_time"].attrs.update(schema.COORDINATES["image_time"])
     ds["image_radiance"] = schema.variable("image_radiance", radiance)
-    stokes = [images[e].stokes_qu_W_m2_sr_nm for e in epochs]
-    if all(s is not None for s in stokes):  # single mode with render.polarization
+    _add_image_stokes(ds, [images[e] for e in epochs])
+    return _add_image_geometry(ds, [images[e] for e in epochs], part_names)
+
+
+def _add_image_stokes(ds: xr.Dataset, images: list[RenderImage]) -> None:
+    """The kept images' per-pixel Stokes Q, U, where every image has them (single mode with
+    ``render.polarization``)."""
+    stokes = [image.stokes_qu_W_m2_sr_nm for image in images]
+    if all(s is not None for s in stokes):
         qu = np.stack([s for s in stokes if s is not None]).astype(np.float32)
         ds["image_radiance_q"] = schema.variable("image_radiance_q", qu[..., 0])
         ds["image_radiance_u"] = schema.variable("image_radiance_u", qu[..., 1])
-    depth = np.stack([images[e].depth_m for e in epochs]).astype(np.float32)
+
+
+def _add_image_geometry(
+    ds: xr.Dataset, kept: list[RenderImage], part_names: list[str]
+) -> xr.Dataset:
+    """The kept images' depth maps, part maps, pixel sizes and image axes."""
+    depth = np.stack([image.depth_m for image in kept]).astype(np.float32)
     ds["image_depth"] = schema.variable("image_depth", depth)
     ds["image_part"] = schema.variable(
         "image_part",
-        np.stack([images[e].part_index for e in epochs]).astype(np.int16),
+        np.stack([image.part_index for image in kept]).astype(np.int16),
         flag_values=np.arange(len(part_names), dtype=np.int16),
         flag_meanings=" ".join(name.replace(" ", "_") for name in part_names),
     )
-    pitch = np.array([images[e].pixel_size_m for e in epochs])
+    pitch = np.array([image.pixel_size_m for image in kept])
     ds["image_pixel_size"] = schema.variable("image_pixel_size", pitch)
     for name in ("right", "up"):
-        axis = np.stack([getattr(images[e], f"{name}_body") for e in epochs])
+        axis = np.stack([getattr(image, f"{name}_body") for image in kept])
         ds[f"image_{name}_body"] = schema.variable(f"image_{name}_body", axis)
     return ds

@@ -144,6 +144,18 @@ def check_joint_parts(target: Target, joints: tuple[Joint, ...]) -> None:
             )
 
 
+def _angle_row(line: str) -> tuple[np.datetime64, float]:
+    """The time and angle of a row ``time_utc,angle_deg``; ValueError if it is not one."""
+    cells = [c.strip() for c in line.split(",")]
+    if len(cells) != 2:
+        raise ValueError("not 2 cells")
+    t = np.datetime64(cells[0][:-1] if cells[0].upper().endswith("Z") else cells[0])
+    a = float(cells[1])
+    if not np.isfinite(a) or np.isnat(t):
+        raise ValueError("not finite")
+    return t, a
+
+
 def read_angle_table(path: str | Path, field: str) -> tuple[NDArray[np.datetime64], F64]:
     """Read a CSV ``time_utc,angle_deg`` (header row, ISO UTC times, strictly increasing)."""
     text = read_user_text(Path(path), field)
@@ -153,14 +165,8 @@ def read_angle_table(path: str | Path, field: str) -> tuple[NDArray[np.datetime6
         s = line.split("#", 1)[0].strip()
         if not s or s.replace(" ", "").lower() == "time_utc,angle_deg":
             continue
-        cells = [c.strip() for c in s.split(",")]
         try:
-            if len(cells) != 2:
-                raise ValueError("not 2 cells")
-            t = np.datetime64(cells[0][:-1] if cells[0].upper().endswith("Z") else cells[0])
-            a = float(cells[1])
-            if not np.isfinite(a) or np.isnat(t):
-                raise ValueError("not finite")
+            t, a = _angle_row(s)
         except ValueError:
             raise InputError(
                 f"line {lineno} {s[:60]!r}: expected 'time_utc,angle_deg' (ISO UTC time, degrees)",

@@ -15,6 +15,7 @@ from typing import Any
 
 from speclight.errors import InputError, did_you_mean
 from speclight.target import shapes
+from speclight.target.bsdf_models import BSDF_MODELS, PARAMETERS
 from speclight.target.material_tables import material_table_path
 from speclight.target.materials import Material
 from speclight.target.mesh_io import load_mesh
@@ -34,7 +35,7 @@ BUILTIN_SHAPES = {
     ),
     "bus_array": (shapes.bus_array, ("bus_size_m", "array_size_m", "array_gap_m")),
 }  # fmt: skip
-_MATERIAL_KEYS = ("bsdf", "reflectance", "roughness", "diffuse_reflectance", "brdf_table")
+_MATERIAL_KEYS = ("bsdf", "reflectance", *PARAMETERS)
 
 
 def _check_keys(d: Mapping[str, Any], allowed: tuple[str, ...], field: str) -> None:
@@ -89,11 +90,12 @@ def material_from_spec(
     table = spec.get("brdf_table")
     if table is not None and Path(str(table)).suffix:
         table = str(_resolve(str(table), base_dir))
+    model = BSDF_MODELS.get(str(spec["bsdf"]))  # an unknown name: Material says so
     return Material(
         name=name,
         bsdf=spec["bsdf"],
         reflectance=reflectance_from_spec(
-            spec.get("reflectance", 1.0 if spec["bsdf"] == "measured" else None),
+            spec.get("reflectance", None if model is None else model.reflectance_default),
             field=f"{field}.reflectance",
             base_dir=base_dir,
         ),

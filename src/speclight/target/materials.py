@@ -3,16 +3,21 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal, get_args
 
-from speclight.errors import InputError, did_you_mean
+from speclight.errors import InputError
+from speclight.target.bsdf_models import (
+    BSDF_NAMES,
+    MAX_ROUGHNESS,
+    PARAMETERS,
+    BsdfModel,
+    BsdfName,
+    bsdf_model,
+    check_bsdf_name,
+    parameter_problems,
+)
 from speclight.target.reflectance import Reflectance
-from speclight.target.rgl_file import check_rgl_material, is_rgl_path
 
-BsdfName = Literal["lambertian", "beckmann", "ggx", "plastic", "specular", "measured"]
-BSDF_NAMES: tuple[str, ...] = get_args(BsdfName)
-#: Largest accepted microfacet roughness alpha (RMS slope); beyond ~1 the models lose meaning.
-MAX_ROUGHNESS = 1.0
+__all__ = ["BSDF_NAMES", "MAX_ROUGHNESS", "BsdfName", "Material"]
 
 
 @dataclass(frozen=True)
@@ -24,8 +29,10 @@ class Material:
     name
         Label used in messages and outputs.
     bsdf
-        ``lambertian`` (ideal diffuse), ``beckmann`` / ``ggx`` (rough surface, Cook-Torrance
-        microfacet model with that normal distribution, Walter et al. 2007,
+        A name of :data:`~speclight.target.bsdf_models.BSDF_MODELS` (the table that also says
+        which parameters each takes): ``lambertian`` (ideal diffuse), ``beckmann`` / ``ggx``
+        (rough surface, Cook-Torrance microfacet model with that normal distribution,
+        Walter et al. 2007,
         doi:10.2312/EGWR/EGSR07/195-206), ``specular`` (smooth mirror), ``plastic`` (diffuse
         base under a dielectric coat: smooth, or Beckmann-rough when ``roughness`` is given) or
         ``measured`` (tabulated BRDF, see :mod:`speclight.target.brdf_table`).
@@ -52,53 +59,26 @@ class Material:
     brdf_table: str | None = None
 
     def __post_init__(self) -> None:
-        field = f"materials.{self.name}"
-        if self.bsdf not in BSDF_NAMES:
-            raise InputError(
-                f"unknown bsdf '{self.bsdf}'{did_you_mean(self.bsdf, BSDF_NAMES)} "
-                f"(choices: {', '.join(BSDF_NAMES)})",
-                field=f"{field}.bsdf",
-            )
+        field = f"target.materials.{self.name}"
+        check_bsdf_name(self.bsdf, f"{field}.bsdf")
         if not isinstance(self.reflectance, Reflectance):
             raise InputError(
                 "reflectance must be a speclight.target.Reflectance", field=f"{field}.reflectance"
             )
-        if self.bsdf in ("beckmann", "ggx"):
-            r = self.roughness
-            if r is None or not 0.0 < float(r) <= MAX_ROUGHNESS:
-                raise InputError(
-                    f"roughness = {r!r} must be given for bsdf '{self.bsdf}' and lie in "
-                    f"(0, {MAX_ROUGHNESS:g}] (microfacet alpha; use 'specular' for a mirror)",
-                    field=f"{field}.roughness",
-                )
-        elif self.roughness is not None and self.bsdf != "plastic":
-            raise InputError(
-                f"roughness is not used by bsdf '{self.bsdf}'; remove it or use beckmann/ggx",
-                field=f"{field}.roughness",
-            )
-        if self.bsdf == "plastic":
-            if self.diffuse_reflectance is None:
-                raise InputError(
-                    "bsdf 'plastic' needs diffuse_reflectance (the base under the coat)",
-                    field=f"{field}.diffuse_reflectance",
-                )
-            if self.reflectance.kind != "dielectric":
-                raise InputError(
-                    "bsdf 'plastic' needs reflectance: {dielectric: NAME} (the coat's n, k), "
-                    f"got a {self.reflectance.kind} reflectance",
-                    field=f"{field}.reflectance",
-                )
-            r = self.roughness
-            if r is not None and not 0.0 < float(r) <= MAX_ROUGHNESS:
-                raise InputError(
-                    f"roughness = {r!r} must lie in (0, {MAX_ROUGHNESS:g}] (coat microfacet "
-                    "alpha) or be omitted for a smooth coat",
-                    field=f"{field}.roughness",
-                )
-        if self.bsdf == "measured" and not self.brdf_table:
-            raise InputError(
-                "bsdf 'measured' needs brdf_table (a BRDF table file)",
-                field=f"{field}.brdf_table",
-            )
-        if self.bsdf == "measured" and is_rgl_path(self.brdf_table):
-            check_rgl_material(str(self.brdf_table), self.reflectance, field)
+        given = self.parameters()
+        problems = parameter_problems(self.bsdf, given, self.reflectance.kind)
+        if problems:
+            key, message = problems[0]
+            raise InputError(message, field=f"{field}.{key}")
+        check = self.model.check
+        if check is not None:  # reads the material's file (an RGL .bsdf)
+            check(self, field)
+
+    @property
+    def model(self) -> BsdfModel:
+        """The material's entry (its form) in the table of BSDF models."""
+        return bsdf_model(self.bsdf, self.parameters())
+
+    def parameters(self) -> dict[str, object]:
+        """The model parameters given (:data:`speclight.target.bsdf_models.PARAMETERS`)."""
+        return {name: getattr(self, name) for name in PARAMETERS}

@@ -51,23 +51,8 @@ def read_obj(path: Path) -> dict[str, Mesh]:
     text = read_user_bytes(path, FIELD).decode("utf-8", errors="replace")
     for lineno, raw in enumerate(text.splitlines(), 1):
         tok = raw.split("#", 1)[0].split()
-        if not tok:
-            continue
         try:
-            if tok[0] == "v":
-                verts.append([float(x) for x in tok[1:4]])
-                if len(verts[-1]) != 3:
-                    raise ValueError("a vertex needs x y z")
-            elif tok[0] in ("g", "o", "usemtl"):
-                current = " ".join(tok[1:]) or path.stem
-            elif tok[0] == "f":
-                idx = []
-                for t in tok[1:]:
-                    i = int(t.split("/")[0])
-                    idx.append(i - 1 if i > 0 else len(verts) + i)
-                if len(idx) < 3:
-                    raise ValueError("a face needs at least 3 vertices")
-                faces.setdefault(current, []).extend(fan(idx))
+            current = _obj_line(tok, verts, faces, current, path.stem)
         except ValueError as exc:
             raise _fail(path, f"line {lineno} {raw.strip()!r}: {exc}") from None
     if not faces:
@@ -81,6 +66,40 @@ def read_obj(path: Path) -> dict[str, Mesh]:
         used, inverse = np.unique(fa, return_inverse=True)
         out[name] = (v[used], inverse.reshape(-1, 3))
     return out
+
+
+def _obj_line(
+    tok: list[str],
+    verts: list[list[float]],
+    faces: dict[str, list[list[int]]],
+    current: str,
+    stem: str,
+) -> str:
+    """Read one OBJ line's fields ``tok`` into ``verts`` / ``faces``; the part that
+    follows (``g``, ``o``, ``usemtl`` start one; ``stem``: the file's, for a nameless one)."""
+    if not tok:
+        return current
+    if tok[0] == "v":
+        verts.append([float(x) for x in tok[1:4]])
+        if len(verts[-1]) != 3:
+            raise ValueError("a vertex needs x y z")
+    elif tok[0] in ("g", "o", "usemtl"):
+        return " ".join(tok[1:]) or stem
+    elif tok[0] == "f":
+        faces.setdefault(current, []).extend(fan(_face_indices(tok[1:], len(verts))))
+    return current
+
+
+def _face_indices(fields: list[str], n_verts: int) -> list[int]:
+    """0-based vertex indices of an ``f`` line's fields (``v``, ``v/vt``, ``v/vt/vn``;
+    negative: counted back from the last vertex read)."""
+    idx = []
+    for t in fields:
+        i = int(t.split("/")[0])
+        idx.append(i - 1 if i > 0 else n_verts + i)
+    if len(idx) < 3:
+        raise ValueError("a face needs at least 3 vertices")
+    return idx
 
 
 def _out_of_scale(what: str, radius: float, reach: float, scale: float, src: str) -> InputError:
@@ -169,28 +188,36 @@ def load_mesh(
     paths = [Path(path)] if isinstance(path, str | Path) else [Path(p) for p in path]
     meshes: dict[str, Mesh] = {}
     for p in paths:
-        ext = p.suffix.lower()
-        if not p.exists():
-            raise _fail(p, "mesh file not found")
-        if ext == ".obj":
-            found = read_obj(p)
-        elif ext == ".ply":
-            found = {p.stem: read_ply(p)}
-        elif ext in TRIMESH_SUFFIXES:
-            found = read_trimesh(p)
-        else:
-            accepted = ", ".join((".obj", ".ply", *TRIMESH_SUFFIXES))
-            raise _fail(p, f"unsupported mesh format '{ext}' (accepted: {accepted})")
-        for name, (v, f) in found.items():
+        for name, (v, f) in _read_parts(p).items():
             with np.errstate(over="ignore"):  # a coordinate overflowing to inf is refused
                 meshes[name] = _checked_part(name, v * scale_m_per_unit, f, p, scale_m_per_unit)
     source = ", ".join(str(p) for p in paths)
     mats = assign_materials(list(meshes), part_materials, source=source)
     target = Target(tuple(Part(n, v, f, mats[n]) for n, (v, f) in meshes.items()))
+    _check_size(target, scale_m_per_unit, source)
+    return target
+
+
+def _read_parts(p: Path) -> dict[str, Mesh]:
+    """The parts of one mesh file, read by its format (the file's suffix)."""
+    ext = p.suffix.lower()
+    if not p.exists():
+        raise _fail(p, "mesh file not found")
+    if ext == ".obj":
+        return read_obj(p)
+    if ext == ".ply":
+        return {p.stem: read_ply(p)}
+    if ext in TRIMESH_SUFFIXES:
+        return read_trimesh(p)
+    accepted = ", ".join((".obj", ".ply", *TRIMESH_SUFFIXES))
+    raise _fail(p, f"unsupported mesh format '{ext}' (accepted: {accepted})")
+
+
+def _check_size(target: Target, scale_m_per_unit: float, source: str) -> None:
+    """Refuse a target below :data:`MIN_BOUNDING_RADIUS_M`; warn about an implausible one."""
     _, radius = target.bounding_sphere()
     if radius < MIN_BOUNDING_RADIUS_M:
         reach = max(float(np.linalg.norm(p.vertices_m, axis=1).max()) for p in target.parts)
         raise _out_of_scale("the mesh", radius, reach, scale_m_per_unit, source)
     size = f"{FIELD} (its bounding diameter with scale_m_per_unit = {scale_m_per_unit:g})"
     warn_implausible(size, 2.0 * radius, TARGET_SIZE_M)
-    return target

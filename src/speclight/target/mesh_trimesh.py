@@ -57,11 +57,13 @@ def read_trimesh(path: Path) -> dict[str, Mesh]:
         pieces.setdefault(name, []).append((v, np.asarray(faces, dtype=np.int64)))
     if not pieces:
         raise _fail(path, "no triangle faces found")
-    out: dict[str, Mesh] = {}
-    for name, parts in pieces.items():
-        offsets = np.cumsum([0] + [len(v) for v, _ in parts[:-1]])
-        v = np.concatenate([v for v, _ in parts])
-        f = np.concatenate([f + o for (_, f), o in zip(parts, offsets, strict=True)])
-        used, inverse = np.unique(f, return_inverse=True)
-        out[name] = (v[used], inverse.reshape(-1, 3))
-    return out
+    return {name: _joined(parts) for name, parts in pieces.items()}
+
+
+def _joined(parts: list[Mesh]) -> Mesh:
+    """One mesh of several (vertices renumbered), keeping only the vertices faces use."""
+    offsets = np.cumsum([0] + [len(v) for v, _ in parts[:-1]])
+    v = np.concatenate([v for v, _ in parts])
+    f = np.concatenate([f + o for (_, f), o in zip(parts, offsets, strict=True)])
+    used, inverse = np.unique(f, return_inverse=True)
+    return v[used], inverse.reshape(-1, 3)

@@ -44,16 +44,9 @@ class Part:
         v = np.ascontiguousarray(self.vertices_m, dtype=float)
         f = np.ascontiguousarray(self.faces, dtype=np.int64)
         where = f"target.parts.{self.name}"
-        if v.ndim != 2 or v.shape[1] != 3 or not np.all(np.isfinite(v)):
-            raise InputError(
-                f"vertices_m must be a finite (V, 3) array, got {v.shape}", field=where
-            )
-        if f.ndim != 2 or f.shape[1] != 3 or f.size == 0:
-            raise InputError(f"faces must be a non-empty (F, 3) array, got {f.shape}", field=where)
-        if f.min() < 0 or f.max() >= len(v):
-            raise InputError(
-                f"face indices must lie in 0..{len(v) - 1}, got {f.min()}..{f.max()}", field=where
-            )
+        problem = _mesh_problem(v, f)
+        if problem is not None:
+            raise InputError(problem, field=where)
         if self.sphere_radius_m is not None and not self.sphere_radius_m > 0:
             raise InputError(f"radius_m = {self.sphere_radius_m} must be > 0", field=where)
         object.__setattr__(self, "vertices_m", v)
@@ -68,6 +61,17 @@ class Part:
         return float(
             0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1).sum()
         )
+
+
+def _mesh_problem(v: NDArray[np.float64], f: NDArray[np.int64]) -> str | None:
+    """What is wrong with a part's vertices (V, 3) and faces (F, 3), or None."""
+    if v.ndim != 2 or v.shape[1] != 3 or not np.all(np.isfinite(v)):
+        return f"vertices_m must be a finite (V, 3) array, got {v.shape}"
+    if f.ndim != 2 or f.shape[1] != 3 or f.size == 0:
+        return f"faces must be a non-empty (F, 3) array, got {f.shape}"
+    if f.min() < 0 or f.max() >= len(v):
+        return f"face indices must lie in 0..{len(v) - 1}, got {f.min()}..{f.max()}"
+    return None
 
 
 @dataclass(frozen=True, eq=False)

@@ -62,32 +62,51 @@ def _ply_header(path: Path, data: bytes) -> tuple[str, list[_PlyElement], bytes,
     fmt = ""
     elements: list[_PlyElement] = []
     for lineno, line in enumerate(lines, 1):
-        tok = line.split()
-        where = f"line {lineno} {line.strip()!r}"
-        if not tok or tok[0] in ("ply", "comment", "obj_info"):
-            continue
-        if tok[0] == "format" and len(tok) >= 2:
-            fmt = tok[1]
-        elif tok[0] == "element" and len(tok) == 3:
-            if not tok[2].isdigit():
-                raise _fail(path, f"{where}: the count '{tok[2]}' is not an integer >= 0")
-            elements.append(_PlyElement(tok[1], int(tok[2])))
-        elif tok[0] == "property" and not elements:
-            raise _fail(path, f"{where}: a property before any element")
-        elif tok[0] == "property" and len(tok) == 5 and tok[1] == "list":
-            count_dt, item_dt = _ply_type(path, tok[2], where), _ply_type(path, tok[3], where)
-            if count_dt[0] not in "iu" or (elements[-1].name == "face" and item_dt[0] not in "iu"):
-                raise _fail(path, f"{where}: list counts and vertex indices must be integer types")
-            elements[-1].props.append(_PlyProperty(tok[4], item_dt, count_dt))
-        elif tok[0] == "property" and len(tok) == 3:
-            elements[-1].props.append(_PlyProperty(tok[2], _ply_type(path, tok[1], where)))
-        else:
-            raise _fail(path, f"{where} is not a PLY header line (format, element, property)")
+        fmt = _header_line(path, line.split(), f"line {lineno} {line.strip()!r}", elements) or fmt
     if fmt not in _PLY_FORMATS:
         raise _fail(
             path, f"PLY format '{fmt}' is not supported (accepted: {', '.join(_PLY_FORMATS)})"
         )
     return fmt, elements, body, len(lines) + 2
+
+
+def _header_line(path: Path, tok: list[str], where: str, elements: list[_PlyElement]) -> str:
+    """Read one header line (its fields ``tok``): an element or a property is added to
+    ``elements``; the format is returned ("" for any other line)."""
+    if not tok or tok[0] in ("ply", "comment", "obj_info"):
+        return ""
+    if tok[0] == "format" and len(tok) >= 2:
+        return tok[1]
+    if tok[0] == "element" and len(tok) == 3:
+        elements.append(_element(path, tok, where))
+    elif tok[0] == "property":
+        _add_property(path, tok, where, elements)
+    else:
+        raise _fail(path, f"{where} is not a PLY header line (format, element, property)")
+    return ""
+
+
+def _element(path: Path, tok: list[str], where: str) -> _PlyElement:
+    """An ``element NAME COUNT`` header line."""
+    if not tok[2].isdigit():
+        raise _fail(path, f"{where}: the count '{tok[2]}' is not an integer >= 0")
+    return _PlyElement(tok[1], int(tok[2]))
+
+
+def _add_property(path: Path, tok: list[str], where: str, elements: list[_PlyElement]) -> None:
+    """A ``property TYPE NAME`` or ``property list COUNT_TYPE ITEM_TYPE NAME`` header line,
+    added to the last element."""
+    if not elements:
+        raise _fail(path, f"{where}: a property before any element")
+    if len(tok) == 5 and tok[1] == "list":
+        count_dt, item_dt = _ply_type(path, tok[2], where), _ply_type(path, tok[3], where)
+        if count_dt[0] not in "iu" or (elements[-1].name == "face" and item_dt[0] not in "iu"):
+            raise _fail(path, f"{where}: list counts and vertex indices must be integer types")
+        elements[-1].props.append(_PlyProperty(tok[4], item_dt, count_dt))
+    elif len(tok) == 3:
+        elements[-1].props.append(_PlyProperty(tok[2], _ply_type(path, tok[1], where)))
+    else:
+        raise _fail(path, f"{where} is not a PLY header line (format, element, property)")
 
 
 def _ascii_row(props: list[_PlyProperty], tok: list[str]) -> list[Any] | None:
@@ -150,6 +169,13 @@ def _binary_rows(
             raise truncated
         arr = np.frombuffer(body, dt, el.count, off)
         return {p.name: arr[f"p{k}"] for k, p in enumerate(el.props)}, off + dt.itemsize * el.count
+    return _binary_list_rows(el, body, off, order, truncated)
+
+
+def _binary_list_rows(
+    el: _PlyElement, body: bytes, off: int, order: str, truncated: Exception
+) -> tuple[dict[str, Any], int]:
+    """:func:`_binary_rows` of an element with list properties: row by row."""
     columns: dict[str, list[Any]] = {p.name: [] for p in el.props}
     for _ in range(el.count):
         for p in el.props:
@@ -180,38 +206,57 @@ def read_ply(path: Path) -> Mesh:
         than 3 vertices or refers to a vertex that does not exist.
     """
     fmt, elements, body, first_line = _ply_header(path, read_user_bytes(path, FIELD))
-    columns: dict[str, dict[str, Any]] = {}
     if fmt == "ascii":
-        text = body.decode("ascii", errors="replace").splitlines()
-        rows = [(first_line + k, r) for k, r in enumerate(text) if r.strip()]
-        pos = 0
-        for el in elements:
-            if len(rows) - pos < el.count:
-                raise _fail(
-                    path,
-                    f"the header announces {el.count} {el.name} rows but {len(rows) - pos} "
-                    "data lines are left",
-                )
-            values = _ascii_rows(path, el, rows[pos : pos + el.count])
-            columns[el.name] = {p.name: [r[k] for r in values] for k, p in enumerate(el.props)}
-            pos += el.count
-        if pos < len(rows):
-            raise _fail(
-                path,
-                f"{len(rows) - pos} line(s) after the last element (from line {rows[pos][0]}): "
-                "the header's element counts do not match the data",
-            )
+        columns = _ascii_columns(path, elements, body, first_line)
     else:
-        order, off = ("<" if fmt == "binary_little_endian" else ">"), 0
-        for el in elements:
-            columns[el.name], off = _binary_rows(path, el, body, off, order)
-        if body[off:].strip():
+        columns = _binary_columns(
+            path, elements, body, "<" if fmt == "binary_little_endian" else ">"
+        )
+    return _ply_mesh(path, elements, columns)
+
+
+def _ascii_columns(
+    path: Path, elements: list[_PlyElement], body: bytes, first_line: int
+) -> dict[str, dict[str, Any]]:
+    """Each element's columns of an ASCII body (its lines counted from ``first_line``)."""
+    columns: dict[str, dict[str, Any]] = {}
+    text = body.decode("ascii", errors="replace").splitlines()
+    rows = [(first_line + k, r) for k, r in enumerate(text) if r.strip()]
+    pos = 0
+    for el in elements:
+        if len(rows) - pos < el.count:
             raise _fail(
                 path,
-                f"{len(body) - off} bytes after the last element: the header's element counts "
-                "do not match the data",
+                f"the header announces {el.count} {el.name} rows but {len(rows) - pos} "
+                "data lines are left",
             )
-    return _ply_mesh(path, elements, columns)
+        values = _ascii_rows(path, el, rows[pos : pos + el.count])
+        columns[el.name] = {p.name: [r[k] for r in values] for k, p in enumerate(el.props)}
+        pos += el.count
+    if pos < len(rows):
+        raise _fail(
+            path,
+            f"{len(rows) - pos} line(s) after the last element (from line {rows[pos][0]}): "
+            "the header's element counts do not match the data",
+        )
+    return columns
+
+
+def _binary_columns(
+    path: Path, elements: list[_PlyElement], body: bytes, order: str
+) -> dict[str, dict[str, Any]]:
+    """Each element's columns of a binary body of byte order ``order`` (``<`` or ``>``)."""
+    columns: dict[str, dict[str, Any]] = {}
+    off = 0
+    for el in elements:
+        columns[el.name], off = _binary_rows(path, el, body, off, order)
+    if body[off:].strip():
+        raise _fail(
+            path,
+            f"{len(body) - off} bytes after the last element: the header's element counts "
+            "do not match the data",
+        )
+    return columns
 
 
 def _ply_mesh(path: Path, elements: list[_PlyElement], columns: dict[str, dict[str, Any]]) -> Mesh:
@@ -219,30 +264,39 @@ def _ply_mesh(path: Path, elements: list[_PlyElement], columns: dict[str, dict[s
     names = [el.name for el in elements]
     if "vertex" not in names or "face" not in names:
         raise _fail(path, "a PLY mesh needs a 'vertex' and a 'face' element")
-    vertex = elements[names.index("vertex")]
-    scalar = {p.name for p in vertex.props if p.count_dtype is None}
-    for axis in "xyz":
-        if axis not in scalar:
-            raise _fail(path, f"the vertex element has no '{axis}' property (it needs x, y, z)")
-    verts = np.stack([np.asarray(columns["vertex"][c], dtype=float) for c in "xyz"], axis=1)
+    verts = _vertices(path, elements[names.index("vertex")], columns["vertex"])
     face = elements[names.index("face")]
     lists = [p.name for p in face.props if p.count_dtype is not None]
     if not lists:
         raise _fail(path, "the face element has no list property (vertex_indices)")
     key = next((n for n in ("vertex_indices", "vertex_index") if n in lists), lists[0])
+    return verts, _triangles(path, columns["face"][key], len(verts))
+
+
+def _vertices(path: Path, vertex: _PlyElement, columns: dict[str, Any]) -> np.ndarray:
+    """The vertices (V, 3) of the vertex element's x, y, z columns."""
+    scalar = {p.name for p in vertex.props if p.count_dtype is None}
+    for axis in "xyz":
+        if axis not in scalar:
+            raise _fail(path, f"the vertex element has no '{axis}' property (it needs x, y, z)")
+    return np.stack([np.asarray(columns[c], dtype=float) for c in "xyz"], axis=1)
+
+
+def _triangles(path: Path, polygons: list[Any], n_verts: int) -> np.ndarray:
+    """Triangle fans (T, 3) of the faces' vertex lists, each checked."""
     triangles: list[list[int]] = []
-    for k, poly in enumerate(columns["face"][key]):
+    for k, poly in enumerate(polygons):
         idx = [int(i) for i in poly]
         if len(idx) < 3:
             raise _fail(path, f"face {k} has {len(idx)} vertices; a face needs at least 3")
-        bad = [i for i in idx if not 0 <= i < len(verts)]
+        bad = [i for i in idx if not 0 <= i < n_verts]
         if bad:
             raise _fail(
                 path,
-                f"face {k} refers to vertex {bad[0]}, but the file has {len(verts)} vertices "
+                f"face {k} refers to vertex {bad[0]}, but the file has {n_verts} vertices "
                 "(numbered from 0)",
             )
         triangles.extend(fan(idx))
     if not triangles:
         raise _fail(path, "PLY file has no faces")
-    return verts, np.asarray(triangles, dtype=np.int64)
+    return np.asarray(triangles, dtype=np.int64)

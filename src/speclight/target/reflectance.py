@@ -57,33 +57,9 @@ class Reflectance:
         """Tabulated reflectance, linearly interpolated between strictly increasing nodes."""
         wl = np.asarray(wavelength_nm, dtype=float).ravel()
         v = np.asarray(value, dtype=float).ravel()
-        if wl.size != v.size or wl.size < 2:
-            raise InputError(
-                f"reflectance table needs >= 2 (wavelength_nm, value) pairs of equal length, "
-                f"got {wl.size} and {v.size}",
-                source=source or None,
-                field=field,
-            )
-        if np.any(np.diff(wl) <= 0) or not np.all(np.isfinite(wl)):
-            raise InputError(
-                "reflectance table wavelength_nm must be finite and strictly increasing",
-                source=source or None,
-                field=field,
-            )
-        if not np.all(np.isfinite(v)):
-            raise InputError(
-                f"reflectance table values must be finite numbers in [0, 1], got "
-                f"{np.count_nonzero(~np.isfinite(v))} NaN or inf",
-                source=source or None,
-                field=field,
-            )
-        if np.any(~((v >= 0) & (v <= 1))):
-            raise InputError(
-                f"reflectance table values must be in [0, 1] (got {v.min():g}..{v.max():g}); "
-                "give fractions, not percent",
-                source=source or None,
-                field=field,
-            )
+        problem = _pairs_problem(wl, v)
+        if problem is not None:
+            raise InputError(problem, source=source or None, field=field)
         return cls(kind="table", wavelength_nm=tuple(wl), values=tuple(v), source=source)
 
     @classmethod
@@ -182,3 +158,25 @@ class Reflectance:
         if self.is_fresnel:
             return fresnel_reflectance(c, self.eta(wl)[None, :])
         return np.broadcast_to(self.evaluate(wl)[None, :], (c.shape[0], wl.size)).copy()
+
+
+def _pairs_problem(wl: NDArray[np.float64], v: NDArray[np.float64]) -> str | None:
+    """What is wrong with a reflectance table's wavelengths [nm] and values, or None."""
+    if wl.size != v.size or wl.size < 2:
+        return (
+            f"reflectance table needs >= 2 (wavelength_nm, value) pairs of equal length, "
+            f"got {wl.size} and {v.size}"
+        )
+    if np.any(np.diff(wl) <= 0) or not np.all(np.isfinite(wl)):
+        return "reflectance table wavelength_nm must be finite and strictly increasing"
+    if not np.all(np.isfinite(v)):
+        return (
+            f"reflectance table values must be finite numbers in [0, 1], got "
+            f"{np.count_nonzero(~np.isfinite(v))} NaN or inf"
+        )
+    if np.any(~((v >= 0) & (v <= 1))):
+        return (
+            f"reflectance table values must be in [0, 1] (got {v.min():g}..{v.max():g}); "
+            "give fractions, not percent"
+        )
+    return None

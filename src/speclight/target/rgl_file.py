@@ -184,20 +184,25 @@ def load_rgl_info(path: str) -> RGLInfo:
             field="brdf_table",
         )
     f = read_tensor_file(path)
-    missing = [k for k in RGL_FIELDS if k not in f]
-    if missing and "rgb" in f:
-        raise _fail(
-            path,
-            f"is an RGB material file (field 'rgb', no {', '.join(missing)}); Mitsuba's "
-            "spectral 'measured' plugin needs the spectral version of the material",
-        )
-    if missing:
-        raise _fail(path, f"lacks the field(s) {', '.join(missing)}")
-    for k, (dt, ndim) in RGL_FIELDS.items():
-        if f[k].dtype != np.dtype(dt):
-            raise _fail(path, f"has field '{k}' of dtype {f[k].dtype}, not {np.dtype(dt)}")
-        if f[k].ndim != ndim:
-            raise _fail(path, f"has field '{k}' with {f[k].ndim} dimensions, not {ndim}")
+    _check_fields(path, f)
+    what = _shape_problem(f)
+    if what is not None:
+        raise _fail(path, f"is malformed: {what}")
+    n_w, spec = len(f["wavelengths"]), f["spectra"].shape
+    wl = f["wavelengths"].astype(float)
+    if n_w < 1 or not np.all(np.diff(wl) > 0):
+        raise _fail(path, "has wavelengths that are not increasing")
+    return RGLInfo(
+        path=path,
+        description=bytes(f["description"]).decode("utf-8", "replace"),
+        isotropic=len(f["phi_i"]) <= 2,
+        wavelength_nm=wl,
+        resolution=tuple(int(s) for s in spec),
+    )
+
+
+def _shape_problem(f: dict[str, NDArray[np.generic]]) -> str | None:
+    """Which array shapes do not fit together as the plugin needs (None: they do)."""
     n_p, n_t, n_w = len(f["phi_i"]), len(f["theta_i"]), len(f["wavelengths"])
     spec, lum, vndf = f["spectra"].shape, f["luminance"].shape, f["vndf"].shape
     checks = [
@@ -212,19 +217,25 @@ def load_rgl_info(path: str) -> RGLInfo:
              f["sigma"].shape[1], vndf[2], vndf[3]) >= 2 or n_t == 1,
          "its grids need at least 2 nodes per axis"),
     ]  # fmt: skip
-    for ok, what in checks:
-        if not ok:
-            raise _fail(path, f"is malformed: {what}")
-    wl = f["wavelengths"].astype(float)
-    if n_w < 1 or not np.all(np.diff(wl) > 0):
-        raise _fail(path, "has wavelengths that are not increasing")
-    return RGLInfo(
-        path=path,
-        description=bytes(f["description"]).decode("utf-8", "replace"),
-        isotropic=n_p <= 2,
-        wavelength_nm=wl,
-        resolution=tuple(int(s) for s in spec),
-    )
+    return next((what for ok, what in checks if not ok), None)
+
+
+def _check_fields(path: str, f: dict[str, NDArray[np.generic]]) -> None:
+    """Every field the plugin reads is there, with its dtype and number of dimensions."""
+    missing = [k for k in RGL_FIELDS if k not in f]
+    if missing and "rgb" in f:
+        raise _fail(
+            path,
+            f"is an RGB material file (field 'rgb', no {', '.join(missing)}); Mitsuba's "
+            "spectral 'measured' plugin needs the spectral version of the material",
+        )
+    if missing:
+        raise _fail(path, f"lacks the field(s) {', '.join(missing)}")
+    for k, (dt, ndim) in RGL_FIELDS.items():
+        if f[k].dtype != np.dtype(dt):
+            raise _fail(path, f"has field '{k}' of dtype {f[k].dtype}, not {np.dtype(dt)}")
+        if f[k].ndim != ndim:
+            raise _fail(path, f"has field '{k}' with {f[k].ndim} dimensions, not {ndim}")
 
 
 def check_rgl_material(path: str, reflectance: Reflectance, field: str) -> RGLInfo:

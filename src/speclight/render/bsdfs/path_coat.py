@@ -3,7 +3,7 @@
 Mitsuba's ``plastic`` / ``roughplastic`` take one real coat index, so path mode used to
 render plastic materials in ~26 groups of bins, each with its own index (~200 renders per
 epoch on the box-wing). This BSDF carries the single mode's plastic model
-(:mod:`speclight.render.material_channels`) at every sampled wavelength, so the whole
+(:mod:`.bsdf_plastic`) at every sampled wavelength, so the whole
 spectrum renders in one pass:
 
 * coat reflection F(theta; n(lambda)): a mirror (smooth coat) or the Beckmann microfacet lobe
@@ -12,7 +12,7 @@ spectrum renders in one pass:
 * the diffuse base rho_d T(theta_i) T(theta_o) / (n^2 pi (1 - F_dr,int)) (Weidlich & Wilkie
   2007, doi:10.1145/1321261.1321292; Mitsuba's linear ``plastic`` model), with the exact
   F_dr,int and, for a rough coat, the transmittance tables of
-  :func:`~speclight.render.material_channels.coat_transmittance` (cached on disk).
+  :func:`~speclight.render.bsdfs.coat_optics.coat_transmittance` (cached on disk).
 
 The spectral quantities are tabulated on a uniform wavelength grid (:data:`TABLE_STEP_NM`)
 and interpolated linearly at the sampled wavelengths; the rough-coat transmittance also
@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.render import material_channels as channels
+from speclight.render.bsdfs import coat_optics
 from speclight.target.materials import Material
 
 F64 = NDArray[np.float64]
@@ -44,13 +44,13 @@ def coat_tables(m: Material, lo_nm: float, hi_nm: float) -> dict[str, Any]:
 
     Returns the grid start and step [nm], the coat index ``eta`` (L,), the base factor
     ``base`` (L,) = rho_d / (n^2 pi (1 - F_dr,int)) [sr-1], and for a rough coat the
-    transmittance ``t`` (COAT_TABLE_NODES, L) at :func:`~.material_channels.coat_table_nodes`.
+    transmittance ``t`` (COAT_TABLE_NODES, L) at :func:`~.coat_optics.coat_table_nodes`.
     """
     assert m.diffuse_reflectance is not None
     n = max(2, int(np.ceil((hi_nm - lo_nm) / TABLE_STEP_NM)) + 1)
     grid = np.linspace(lo_nm, hi_nm, n)
     eta = m.reflectance.eta(grid).real
-    t, f_dr = channels.coat_transmittance(channels.coat_table_nodes(), eta, m.roughness)
+    t, f_dr = coat_optics.coat_transmittance(coat_optics.coat_table_nodes(), eta, m.roughness)
     base = m.diffuse_reflectance.evaluate(grid) / (eta**2 * np.pi * (1.0 - f_dr))
     out: dict[str, Any] = {
         "start_nm": float(grid[0]),
@@ -79,7 +79,7 @@ def _define(mi: Any) -> Any:
     import drjit as dr
 
     n_spec = dr.size_v(mi.Spectrum)
-    n_nodes = channels.COAT_TABLE_NODES
+    n_nodes = coat_optics.COAT_TABLE_NODES
 
     def per_wavelength(fn: Any, lam: Any) -> Any:
         return mi.Spectrum(*[fn(lam[k]) for k in range(n_spec)])

@@ -1,5 +1,5 @@
 """The previous path-mode plastic: Mitsuba's ``plastic`` / ``roughplastic`` set up to carry
-the single-scattering mode's model (:mod:`speclight.render.material_channels`).
+the single-scattering mode's model (:mod:`.bsdf_plastic`).
 
 Path mode now renders plastic coats with the spectral BSDF of :mod:`.path_coat` (the whole
 spectrum in one render). This grouped model is kept for the scalar variants (no Dr.Jit
@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.render import material_channels as channels
+from speclight.render.bsdfs import coat_optics
 from speclight.target.materials import Material
 from speclight.target.parts import Target
 
@@ -37,13 +37,13 @@ def mitsuba_internal_reflectance(eta: float, roughness: float | None) -> float:
     ``roughplastic``: ``2 * mean(R(mu_j; 1/eta) mu_j)`` over its 64 uniform cosine nodes,
     j / 63, which is 1.6-2 % below the integral 2 int R mu dmu (the mean divides by 64 nodes
     where a quadrature would weight 63 intervals). R is computed here independently
-    (:func:`speclight.render.material_channels.rough_coat_albedo`).
+    (:func:`speclight.render.bsdfs.coat_optics.rough_coat_albedo`).
     """
     if roughness is None:
         e = 1.0 / eta
         return float(0.0636 / e + e * (e * -1.4399 + 0.7099) + 0.6681)
-    mu = channels.coat_table_nodes()
-    r = channels.rough_coat_albedo(mu, np.array([1.0 / eta]), float(roughness), transmit=False)
+    mu = coat_optics.coat_table_nodes()
+    r = coat_optics.rough_coat_albedo(mu, np.array([1.0 / eta]), float(roughness), transmit=False)
     return float(2.0 * np.mean(r[:, 0] * mu))
 
 
@@ -56,7 +56,7 @@ def group_bases(
         m = target.parts[k].material
         assert m.diffuse_reflectance is not None
         etas = np.array([g[2][k] for g in groups])
-        exact = channels.coat_transmittance(np.ones(1), etas, m.roughness)[1]
+        exact = coat_optics.coat_transmittance(np.ones(1), etas, m.roughness)[1]
         nodes = np.linspace(etas.min(), etas.max(), max(2, int(np.ptp(etas) / 0.01) + 2))
         mits = np.interp(etas, nodes, [mitsuba_internal_reflectance(n, m.roughness) for n in nodes])
         rho = m.diffuse_reflectance.evaluate(grid)
@@ -68,7 +68,7 @@ def group_bases(
 def base_for_mitsuba(m: Material, eta: float, grid: F64) -> F64:
     """Base reflectance handed to Mitsuba for coat index ``eta`` (see :func:`group_bases`)."""
     assert m.diffuse_reflectance is not None
-    exact = float(channels.coat_transmittance(np.ones(1), np.array([eta]), m.roughness)[1][0])
+    exact = float(coat_optics.coat_transmittance(np.ones(1), np.array([eta]), m.roughness)[1][0])
     scale = (1.0 - mitsuba_internal_reflectance(eta, m.roughness)) / (1.0 - exact)
     return scale * m.diffuse_reflectance.evaluate(grid)
 
