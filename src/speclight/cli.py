@@ -351,8 +351,8 @@ def fit(
     """
 
     def run() -> None:
-        from speclight.estimate.measured import read_measured
-        from speclight.estimate.scenario_fit import fit_scenario, parse_free, parse_method
+        from speclight.estimate.fitting.fit_run import fit_scenario, parse_free, parse_method
+        from speclight.estimate.inputs.measured import read_measured
         from speclight.plot.figure_output import claim_outputs, write_outputs
         from speclight.scenario import load_scenario
 
@@ -410,8 +410,8 @@ def upsample(
     """
 
     def run() -> None:
-        from speclight.estimate.upsample_io import read_fit_albedos, spectrum_csv
-        from speclight.estimate.upsample_io import upsample_scenario as upsample_from
+        from speclight.estimate.spectra.upsample_run import read_fit_albedos, spectrum_csv
+        from speclight.estimate.spectra.upsample_run import upsample_scenario as upsample_from
         from speclight.plot.figure_output import claim_outputs, write_outputs
         from speclight.scenario import load_scenario
 
@@ -516,7 +516,7 @@ def unmix(
     """
 
     def run() -> None:
-        from speclight.estimate.unmix_io import check_unmix_options, unmix_measured
+        from speclight.estimate.spectra.unmix_run import check_unmix_options, unmix_measured
         from speclight.io.netcdf import dataset_bytes
         from speclight.plot.figure_output import claim_outputs, write_outputs
 
@@ -621,9 +621,9 @@ def reflection_map_cmd(
     """
 
     def run() -> None:
-        from speclight.estimate.reflection_map import check_nside
-        from speclight.estimate.reflection_map_io import reflection_map_measured
-        from speclight.estimate.source_spectrum import check_light
+        from speclight.estimate.inputs.source_spectrum import check_light
+        from speclight.estimate.reflection_maps.reflection_map_core import check_nside
+        from speclight.estimate.reflection_maps.reflection_map_run import reflection_map_measured
         from speclight.io.netcdf import dataset_bytes
         from speclight.plot.figure_output import claim_outputs, write_outputs
 
@@ -843,10 +843,10 @@ def spin_axis(
     """
 
     def run() -> None:
-        from speclight.estimate.source_spectrum import check_light
-        from speclight.estimate.spin_axis import check_search_options
-        from speclight.estimate.spin_axis_io import axis_dataset, spin_axis_measured
-        from speclight.estimate.spin_axis_refine import check_refine_options
+        from speclight.estimate.inputs.source_spectrum import check_light
+        from speclight.estimate.spin_axis.spin_axis_core import check_search_options
+        from speclight.estimate.spin_axis.spin_axis_refine import check_refine_options
+        from speclight.estimate.spin_axis.spin_axis_run import axis_dataset, spin_axis_measured
         from speclight.io.netcdf import dataset_bytes
         from speclight.plot.figure_output import claim_outputs, write_outputs
         from speclight.scenario import load_scenario
@@ -996,8 +996,8 @@ def period(
     def run() -> None:
         import json
 
-        from speclight.estimate.period_decision import IfSymmetric
-        from speclight.estimate.period_io import estimate_period
+        from speclight.estimate.period.period_decision import IfSymmetric
+        from speclight.estimate.period.period_run import estimate_period
         from speclight.plot.figure_output import claim_outputs, write_outputs
 
         if if_symmetric not in ("auto", "double", "keep"):
@@ -1168,9 +1168,9 @@ def compare(
     """
 
     def run() -> None:
-        from speclight.estimate.compare import compare as run_compare
-        from speclight.estimate.compare_stats import summary_lines
-        from speclight.estimate.observations import read_observations
+        from speclight.estimate.comparison.compare_run import compare as run_compare
+        from speclight.estimate.comparison.compare_stats import summary_lines
+        from speclight.estimate.inputs.observations import read_observations
         from speclight.io.netcdf import dataset_bytes
         from speclight.plot.figure_output import claim_outputs, write_outputs
         from speclight.scenario import load_scenario

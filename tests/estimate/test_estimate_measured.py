@@ -10,7 +10,7 @@ import xarray as xr
 import yaml
 
 from speclight.errors import InputError
-from speclight.estimate.measured import bin_light_curve, measured_from_dataset, read_measured
+from speclight.estimate.inputs.measured import bin_light_curve, measured_from_dataset, read_measured
 from speclight.io.netcdf import write_dataset
 from speclight.scenario import example_text, parse_scenario
 from speclight.simulate import simulate

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from speclight.errors import InputError
-from speclight.estimate.period_io import estimate_period
+from speclight.estimate.period.period_run import estimate_period
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
 from speclight.simulate.pipeline import simulate

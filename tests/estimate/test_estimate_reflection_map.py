@@ -17,7 +17,7 @@ import pytest
 from astropy_healpix import healpix_to_xyz
 
 from speclight.errors import InputError
-from speclight.estimate.reflection_map import (
+from speclight.estimate.reflection_maps.reflection_map_core import (
     check_nside,
     pixel_centres_deg,
     pixel_of,

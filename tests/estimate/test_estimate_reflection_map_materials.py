@@ -18,10 +18,10 @@ import numpy as np
 import yaml
 from astropy_healpix import xyz_to_healpix
 
-from speclight.estimate.endmember_spectra import endmembers_from_scenario
-from speclight.estimate.ground_truth import fractions
-from speclight.estimate.reflection_map_io import reflection_map_measured
-from speclight.estimate.unmix_inputs import read_reflectance_factors
+from speclight.estimate.inputs.reflectance_factors import read_reflectance_factors
+from speclight.estimate.reflection_maps.reflection_map_run import reflection_map_measured
+from speclight.estimate.spectra.endmember_spectra import endmembers_from_scenario
+from speclight.estimate.spectra.ground_truth import fractions
 from speclight.io.netcdf import dataset_bytes
 from speclight.scenario import example_text, parse_scenario
 from speclight.simulate import simulate

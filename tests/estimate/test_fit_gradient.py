@@ -21,9 +21,9 @@ import yaml
 
 from speclight.errors import InputError
 from speclight.estimate import fit_scenario
-from speclight.estimate.gradient_fit import fit_roughness_gradient, projected_residuals
-from speclight.estimate.measured import MeasuredLightCurve
-from speclight.estimate.roughness_gradient import RoughnessRates
+from speclight.estimate.fitting.gradient_fit import fit_roughness_gradient, projected_residuals
+from speclight.estimate.fitting.roughness_gradient import RoughnessRates
+from speclight.estimate.inputs.measured import MeasuredLightCurve
 from speclight.render.brdf import microfacet_d, microfacet_weight, smith_g1
 from speclight.render.brdf_gradient import (
     microfacet_d_dalpha,

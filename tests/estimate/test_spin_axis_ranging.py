@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from speclight.estimate.spin_axis import angular_distance_deg, spin_axis_search
-from speclight.estimate.spin_axis_lookup import EpochGeometry, spin_frame_map
-from speclight.estimate.spin_axis_ranging import (
+from speclight.estimate.spin_axis.spin_axis_core import angular_distance_deg, spin_axis_search
+from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, spin_frame_map
+from speclight.estimate.spin_axis.spin_axis_ranging import (
     RangingTerm,
     offsets_from_channels,
     resolve_weight,
