@@ -34,11 +34,11 @@ import time
 from pathlib import Path
 
 from speclight.estimate.inputs.reflectance_factors import read_reflectance_factors
-from speclight.estimate.reflectivity_map import reflectivity_map
 from speclight.estimate.spin_axis.spin_axis_core import grid_errors, radec_grid, spin_axis_search
 from speclight.estimate.spin_axis.spin_axis_lookup import load_band_map, spin_frame_map
 from speclight.estimate.spin_axis.spin_axis_run import inertial_epochs, spin_axis_measured
 from speclight.io.netcdf import dataset_bytes
+from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.scenario import example_text, load_scenario
 from speclight.simulate import simulate
 from speclight.simulate.geometry_stage import scenario_geometry

@@ -719,8 +719,8 @@ def reflectivity_map(
     """
 
     def run() -> None:
-        from speclight.estimate.reflectivity_map import check_map_options
-        from speclight.estimate.reflectivity_map import reflectivity_map as build
+        from speclight.maps.writer.reflectivity_map_run import check_map_options
+        from speclight.maps.writer.reflectivity_map_run import reflectivity_map as build
         from speclight.scenario import load_scenario
 
         angles = _phase_angles(phase_angles_deg)

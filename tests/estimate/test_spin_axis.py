@@ -24,8 +24,8 @@ from speclight.estimate.spin_axis.spin_axis_core import (
     spin_axis_search,
 )
 from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, spin_frame_map
-from speclight.render.map_geometry import healpix_directions
-from speclight.render.map_lookup import MapHeader, ReflectivityMap
+from speclight.maps.map_geometry import healpix_directions
+from speclight.maps.map_lookup import MapHeader, ReflectivityMap
 
 
 def _misfit(p: np.ndarray, y: np.ndarray) -> float:

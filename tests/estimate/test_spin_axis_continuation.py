@@ -34,7 +34,7 @@ from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
 from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, spin_frame_map
 from speclight.estimate.spin_axis.spin_axis_ranging import RangingTerm
 from speclight.estimate.spin_axis.spin_axis_refine import refine_candidate, refine_staged
-from speclight.render.map_geometry import healpix_directions
+from speclight.maps.map_geometry import healpix_directions
 
 
 def test_coarsened_map_averages_the_children() -> None:

@@ -3,7 +3,7 @@ float64 computation, one candidate at a time, on tiny grids.
 
 The reference does not share the fast path's machinery: each candidate's attitude comes from
 the spin model (:func:`speclight.attitude.spin.spin_attitude`, quaternions), each epoch's
-phase vector, phase angle and roll from :func:`speclight.render.map_geometry.map_coordinates`
+phase vector, phase angle and roll from :func:`speclight.maps.map_geometry.map_coordinates`
 in the spin frame, the cell from the layout documented on
 :class:`speclight.estimate.spin_axis.spin_axis_lookup.SpinFrameMap` (nearest polar and azimuth cell,
 linear in phase angle and roll), and the misfit from its definition (mean over epochs and
@@ -36,8 +36,8 @@ from speclight.estimate.spin_axis.spin_axis_lookup import (
     spin_frame_map,
 )
 from speclight.estimate.spin_axis.spin_axis_ranging import RangingTerm
-from speclight.render.map_geometry import healpix_directions, map_coordinates
-from speclight.render.map_lookup import MapHeader, ReflectivityMap, phase_angle_weights
+from speclight.maps.map_geometry import healpix_directions, map_coordinates
+from speclight.maps.map_lookup import MapHeader, ReflectivityMap, phase_angle_weights
 
 EPS32 = float(np.finfo(np.float32).eps)
 N_T, N_PHASES, GRID_DEG, PERIOD_S = 40, 12, 45.0, 47.0

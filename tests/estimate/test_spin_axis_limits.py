@@ -24,8 +24,8 @@ from speclight.estimate.spin_axis.spin_axis_lookup import (
 )
 from speclight.estimate.spin_axis.spin_axis_ranging import check_ranging_weight
 from speclight.estimate.spin_axis.spin_axis_refine import Refined
-from speclight.render.map_geometry import healpix_directions
-from speclight.render.map_lookup import MapHeader, ReflectivityMap
+from speclight.maps.map_geometry import healpix_directions
+from speclight.maps.map_lookup import MapHeader, ReflectivityMap
 
 
 def _map(zero_band: bool = False) -> ReflectivityMap:

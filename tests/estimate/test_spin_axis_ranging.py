@@ -25,8 +25,8 @@ from speclight.estimate.spin_axis.spin_axis_ranging import (
     resolve_weight,
     term_from_offsets,
 )
-from speclight.render.map_geometry import healpix_directions
-from speclight.render.map_lookup import MapHeader, ReflectivityMap
+from speclight.maps.map_geometry import healpix_directions
+from speclight.maps.map_lookup import MapHeader, ReflectivityMap
 
 RA, DEC = 70.0, 25.0  # the truth; its reverse is RA 250, Dec -25
 

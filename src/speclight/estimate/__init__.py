@@ -44,7 +44,6 @@ from speclight.estimate.reflection_maps import (
     reflection_map,
     reflection_map_measured,
 )
-from speclight.estimate.reflectivity_map import MapRun, reflectivity_map
 from speclight.estimate.spectra import (
     UNMIX_METHODS,
     EndmemberResult,
@@ -75,7 +74,6 @@ __all__ = [
     "CompareResult",
     "EndmemberResult",
     "FitResult",
-    "MapRun",
     "MeasuredLightCurve",
     "Observations",
     "PeriodResult",
@@ -103,7 +101,6 @@ __all__ = [
     "read_reflectance_factors",
     "reflection_map",
     "reflection_map_measured",
-    "reflectivity_map",
     "scenario_band_responses",
     "shot_noise_sigma",
     "spectral_angle_rad",

@@ -24,10 +24,10 @@ from typing import Any
 import numpy as np
 
 from speclight.errors import InputError
+from speclight.io.store_io import check_free_space, store_lock, store_writes
 from speclight.orbit.orbit_sources import file_keys
 from speclight.scale import sweep_store as store
 from speclight.scale.executor import open_executor
-from speclight.scale.store_io import check_free_space, store_lock, store_writes
 from speclight.scale.sweep_cases import CaseTask, SweepPlan
 from speclight.scale.worker_cache import worker_cached
 from speclight.scenario import LoadedScenario, parse_scenario

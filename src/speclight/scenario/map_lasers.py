@@ -17,7 +17,7 @@ import numpy as np
 from speclight.errors import InputError
 
 if TYPE_CHECKING:
-    from speclight.render.map_lookup import MapHeader
+    from speclight.maps.map_lookup import MapHeader
     from speclight.scenario.scenario_model import Scenario
 
 #: A laser within this distance of the observer is coaxial for a map: its phase angle is

@@ -1,6 +1,6 @@
 """Laser returns from a reflectivity map (``render.mode: map``): no rendering.
 
-The map (:mod:`speclight.render.map_lookup`) stores, at phase angle 0, the intensity under
+The map (:mod:`speclight.maps.map_lookup`) stores, at phase angle 0, the intensity under
 the Sun at 1 AU ``I(d, l)`` per body-frame direction ``d`` and wavelength bin ``l``, a coaxial
 laser's mean one-way range offset ``o(d, l)`` [m] and its range histogram per band
 ``H(d, b, bin)`` for 1 W m-2 nm-1 on every bin (single scattering; range 1 m, aperture
@@ -47,9 +47,9 @@ from numpy.typing import NDArray
 from speclight.errors import InputError
 from speclight.illumination import solar_irradiance_W_m2_nm
 from speclight.instrument.photometry import photon_kernel
+from speclight.maps.map_lookup import FIELD, ReflectivityMap, healpix_weights, load_map
 from speclight.ranging.bins import range_bin_edges_m
 from speclight.render.laser_returns import COAXIAL_RAD, LaserLight, LaserReturns
-from speclight.render.map_lookup import FIELD, ReflectivityMap, healpix_weights, load_map
 from speclight.scenario import LoadedScenario
 from speclight.simulate.radiometry import instrument_response
 from speclight.simulate.reflection import build_target

@@ -9,7 +9,7 @@ from numpy.typing import NDArray
 
 from speclight.constants import AU_M
 from speclight.illumination import solar_irradiance_W_m2_nm
-from speclight.render.map_lookup import load_map
+from speclight.maps.map_lookup import load_map
 from speclight.scenario import LoadedScenario
 from speclight.simulate.geometry_stage import Geometry
 from speclight.simulate.reflection import Reflection
@@ -18,7 +18,7 @@ F64 = NDArray[np.float64]
 
 
 def map_reflection(loaded: LoadedScenario, geo: Geometry, wavelength_nm: F64) -> Reflection:
-    """Intensity interpolated from the scenario's map (see :mod:`speclight.render.map_lookup`).
+    """Intensity interpolated from the scenario's map (see :mod:`speclight.maps.map_lookup`).
 
     The map holds the intensity under the Sun at 1 AU; each epoch's is scaled by the solar
     spectrum at its Sun distance over the one at 1 AU (``1 / d^2``) and by the sunlit

@@ -8,7 +8,7 @@ the real misfit. Two ways of smoothing, measured in ``bench/bench_spin_continuat
   ``nside`` (each coarse pixel the mean of its children; the map is RING-ordered, the
   children of NESTED pixel ``k`` are ``4k .. 4k + 3``) and the rolls to fewer (a circular
   ``[1/4, 1/2, 1/4]`` filter, then every other roll, so that roll ``k`` of the coarse map
-  is at ``k`` times its step, as :func:`speclight.render.map_lookup.roll_weights` wants);
+  is at ``k`` times its step, as :func:`speclight.maps.map_lookup.roll_weights` wants);
   With ranging returns the offsets' map is coarsened in the same way.
 * **light curves smoothed in time** (:class:`SmoothedMisfit`): a Gaussian of ``sigma_s``
   seconds over the epochs applied to the residuals (the normalised measured and predicted
@@ -24,8 +24,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
-from speclight.render.map_geometry import healpix_directions
-from speclight.render.map_lookup import ReflectivityMap
+from speclight.maps.map_geometry import healpix_directions
+from speclight.maps.map_lookup import ReflectivityMap
 
 F64 = NDArray[np.float64]
 

@@ -41,7 +41,7 @@ from speclight.estimate.spin_axis.spin_axis_lookup import (
     SpinFrameMap,
 )
 from speclight.estimate.spin_axis.spin_axis_misfit import exact_misfit as exact_misfit
-from speclight.render.map_lookup import ReflectivityMap
+from speclight.maps.map_lookup import ReflectivityMap
 
 if TYPE_CHECKING:
     from speclight.estimate.spin_axis.spin_axis_ranging import RangingTerm

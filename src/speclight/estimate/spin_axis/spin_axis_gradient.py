@@ -21,7 +21,7 @@ turn of the spin body axis onto z), so an inertial direction ``g`` is, in the bo
 ``d exp(-[w]x) h / dw_k = g x [J_r(w)]_k`` (column ``k``) ``k`` (``g = exp(-[w]x) h``, ``J_r``
 the right Jacobian of SO(3): ``I - (1 - cos t) / t^2 [w]x + (t - sin t) / t^3 [w]x^2``,
 ``t = |w|``). Then the map's interpolation and its derivative
-(:func:`speclight.render.map_lookup_grad.intensity_jacobian`), then the misfit of
+(:func:`speclight.maps.map_lookup_grad.intensity_jacobian`), then the misfit of
 :mod:`.spin_axis_core`: residuals ``r_tb = (p_tb / m_b - y_tb / mean y_b) / sqrt(T B)`` with
 ``m_b`` the mean of ``p_b`` over the epochs, ``dr = (dp / m - p dm / m^2) / sqrt(T B)``, and
 with ranging returns the offsets' residuals ``sqrt(W / (n mean(o_meas^2))) (M / R - o_meas)``.
@@ -39,8 +39,8 @@ from numpy.typing import ArrayLike, NDArray
 from speclight.attitude.quaternion import quat_to_matrix
 from speclight.attitude.spin import body_axis_to_z
 from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, axis_frames
-from speclight.render.map_lookup import ReflectivityMap
-from speclight.render.map_lookup_grad import intensity_jacobian
+from speclight.maps.map_lookup import ReflectivityMap
+from speclight.maps.map_lookup_grad import intensity_jacobian
 
 if TYPE_CHECKING:
     from speclight.estimate.spin_axis.spin_axis_ranging import RangingTerm

@@ -43,8 +43,8 @@ from numpy.typing import NDArray
 
 from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, SpinFrameMap, axis_frames
 from speclight.estimate.spin_axis.spin_axis_ranging import RangingTerm, coaxial
-from speclight.render.map_geometry import map_coordinates
-from speclight.render.map_lookup import phase_angle_weights
+from speclight.maps.map_geometry import map_coordinates
+from speclight.maps.map_lookup import phase_angle_weights
 
 F64 = NDArray[np.float64]
 F32 = NDArray[np.float32]
@@ -109,7 +109,7 @@ def epoch_frames(geo: EpochGeometry, phase_angle_deg: F64) -> EpochFrames:
 
     A rotation keeps lengths and angles, so the phase vector, the plane's unit vector and the
     phase angle are computed once per epoch in GCRS (as
-    :func:`speclight.render.map_geometry.map_coordinates` does in the body frame) and only
+    :func:`speclight.maps.map_geometry.map_coordinates` does in the body frame) and only
     turned into each candidate's spin frame.
     """
     p, a, _ = map_coordinates(geo.sun_gcrs, geo.observer_gcrs)
@@ -126,7 +126,7 @@ def epoch_frames(geo: EpochGeometry, phase_angle_deg: F64) -> EpochFrames:
 
 def _roll(p: F64, u: F64) -> F64:
     """Roll [rad, 0..2 pi) of ``u`` about ``p`` (..., 3) in the spin frame (the convention of
-    :mod:`speclight.render.map_geometry`: ``e_lon = normalize(z x p)``, ``e_lat = p x e_lon``,
+    :mod:`speclight.maps.map_geometry`: ``e_lon = normalize(z x p)``, ``e_lat = p x e_lon``,
     ``e_lon = y`` within 1e-9 of the poles), from the components without normalising:
     ``rho (u . e_lon) = u_y p_x - u_x p_y``, ``rho (u . e_lat) = u_z rho^2 - p_z (u_x p_x +
     u_y p_y)`` with ``rho = |z x p|``."""

@@ -6,7 +6,7 @@ A spin about the body axis ``b`` turns the body frame about ``b``; in the **spin
 of the azimuth about z and nothing else. So the map is resampled once onto a regular grid
 of the spin frame (polar angle x azimuth x the map's phase angles x rolls, the roll measured
 from the spin frame's own east/north axes, which a turn about z leaves unchanged) with the
-map's own interpolation (:meth:`speclight.render.map_lookup.ReflectivityMap.intensity_1au`,
+map's own interpolation (:meth:`speclight.maps.map_lookup.ReflectivityMap.intensity_1au`,
 HEALPix bilinear, linear in phase angle and roll). The azimuth step divides the phase step
 ``360 / n_phases`` by an integer ``m``, so the ``n_phases`` candidate phases of one
 (axis, epoch) read one contiguous run of the grid: a window of a sliding-window view, no
@@ -27,8 +27,8 @@ from numpy.typing import ArrayLike, NDArray
 from speclight.attitude.quaternion import quat_to_matrix
 from speclight.attitude.spin import body_axis_to_z
 from speclight.errors import InputError
-from speclight.render.map_geometry import sun_observer
-from speclight.render.map_lookup import ReflectivityMap, read_header
+from speclight.maps.map_geometry import sun_observer
+from speclight.maps.map_lookup import ReflectivityMap, read_header
 
 F64 = NDArray[np.float64]
 F32 = NDArray[np.float32]

@@ -13,7 +13,7 @@ from speclight.attitude.quaternion import quat_to_matrix
 from speclight.attitude.spin import spin_attitude
 from speclight.estimate.spin_axis.spin_axis_grid import misfit_from_sums
 from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry
-from speclight.render.map_lookup import ReflectivityMap
+from speclight.maps.map_lookup import ReflectivityMap
 
 if TYPE_CHECKING:
     from speclight.estimate.spin_axis.spin_axis_ranging import RangingTerm

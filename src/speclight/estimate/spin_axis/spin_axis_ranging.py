@@ -40,7 +40,7 @@ from numpy.typing import NDArray
 
 from speclight.errors import InputError
 from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, SpinFrameMap
-from speclight.render.map_lookup import ReflectivityMap, read_header
+from speclight.maps.map_lookup import ReflectivityMap, read_header
 
 F64 = NDArray[np.float64]
 FIELD = "--map"

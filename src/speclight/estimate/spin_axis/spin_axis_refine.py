@@ -41,7 +41,7 @@ from speclight.estimate.spin_axis.spin_axis_continuation import (
 )
 from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
 from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry
-from speclight.render.map_lookup import ReflectivityMap
+from speclight.maps.map_lookup import ReflectivityMap
 
 if TYPE_CHECKING:
     from speclight.estimate.spin_axis.spin_axis_ranging import RangingTerm

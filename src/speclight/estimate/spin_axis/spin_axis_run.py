@@ -81,7 +81,7 @@ def phase_vector_track(
     spin axis and phase (the observation track of the reference's Figure 18)."""
     from speclight.attitude.quaternion import quat_to_matrix
     from speclight.attitude.spin import spin_attitude
-    from speclight.render.map_geometry import lonlat_deg, map_coordinates
+    from speclight.maps.map_geometry import lonlat_deg, map_coordinates
 
     if not (np.isfinite(ra_deg) and np.isfinite(dec_deg) and np.isfinite(phase_deg)):
         nan = np.full(epochs.t_s.size, np.nan)
@@ -164,7 +164,7 @@ def spin_axis_measured(
     from speclight.estimate.inputs.reflectance_factors import read_reflectance_factors
     from speclight.estimate.spin_axis.spin_axis_limits import check_search_cost
     from speclight.estimate.spin_axis.spin_axis_refine import check_refine_options
-    from speclight.render.map_lookup import check_map_matches
+    from speclight.maps.map_lookup import check_map_matches
     from speclight.simulate.geometry_stage import scenario_geometry
     from speclight.simulate.radiometry import wavelength_grid_nm
 

@@ -6,7 +6,7 @@ many epochs (:func:`speclight.simulate.memory.estimate_memory`: render batch, ch
 weights, spectra). A chunk that cannot fit under the memory limit is refused before any
 work, with the largest chunk that fits; the workers of a local cluster, each rendering one
 chunk, are as many as fit (:func:`speclight.scale.executor.local_workers`). The store's
-data, uncompressed, must fit on its disk (:func:`speclight.scale.store_io.check_free_space`).
+data, uncompressed, must fit on its disk (:func:`speclight.io.store_io.check_free_space`).
 """
 
 from __future__ import annotations
@@ -61,7 +61,7 @@ def check_chunk_memory(
 
 
 def store_bytes(shapes: dict[str, int]) -> int:
-    """The store's data arrays, uncompressed [bytes] (layout: :mod:`.reflectivity_map_store`)."""
+    """The store's data arrays, uncompressed [bytes] (layout: :mod:`speclight.maps.map_format`)."""
     d, p, r = shapes["direction"], shapes["phase"], shapes["roll"]
     n_wl, n_band = shapes["wavelength"], shapes["band"]
     values = d * p * r * (n_wl + n_band)

@@ -1,7 +1,7 @@
 """Intensity from a reflectivity map instead of a render (``render.mode: map``).
 
 The map (a Zarr store written by ``speclight reflectivity-map``, layout in
-:mod:`speclight.estimate.reflectivity_map_store`) holds the intensity at 1 AU on HEALPix
+:mod:`speclight.maps.map_format`) holds the intensity at 1 AU on HEALPix
 phase-vector directions x phase angles x rolls (conventions: :mod:`.map_geometry`). An
 epoch's intensity is interpolated:
 
@@ -27,11 +27,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError
-from speclight.render.map_geometry import lonlat_deg, map_coordinates, roll_reference
+from speclight.maps.map_format import FORMAT_NAME
+from speclight.maps.map_geometry import lonlat_deg, map_coordinates, roll_reference
 
 F64 = NDArray[np.float64]
 FIELD = "render.map_file"
-FORMAT_NAME = "speclight reflectivity map"
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """Rendering one chunk of a reflectivity map: Sun intensity, unit count rates, laser offsets.
 
-Used by :func:`speclight.estimate.reflectivity_map.reflectivity_map`; conventions in
-:mod:`speclight.render.map_geometry`.
+Used by :func:`speclight.maps.writer.reflectivity_map_run.reflectivity_map`; conventions in
+:mod:`speclight.maps.map_geometry`.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight import instrument
-from speclight.render.map_geometry import sun_observer
+from speclight.maps.map_geometry import sun_observer
 from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
@@ -102,7 +102,7 @@ def coaxial_returns(
     """
     from speclight.instrument.photometry import photon_kernel
     from speclight.ranging import link
-    from speclight.render.laser_returns import LaserLight, render_laser_returns
+    from speclight.render import LaserLight, render_laser_returns
 
     n = len(dirs)
     light = LaserLight(dirs, np.arange(wl.size), np.ones((n, wl.size)))

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.estimate.reflectivity_map_render import coaxial_returns, render_chunk
+from speclight.maps.writer.map_render import coaxial_returns, render_chunk
 from speclight.scale import worker_cached
 from speclight.scenario import LoadedScenario
 

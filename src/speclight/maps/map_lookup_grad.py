@@ -1,6 +1,6 @@
 """Derivatives of a reflectivity map's interpolation with respect to the body-frame directions.
 
-:meth:`speclight.render.map_lookup.ReflectivityMap.intensity_1au` interpolates the map
+:meth:`speclight.maps.map_lookup.ReflectivityMap.intensity_1au` interpolates the map
 bilinearly on the HEALPix sphere (astropy-healpix), linearly in phase angle and periodically
 linearly in roll (the roll measured in each of the 4 pixel centres' own reference frame).
 For a fixed set of 4 pixels every piece is a smooth function of the Sun and observer
@@ -36,8 +36,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from speclight.render.map_geometry import lonlat_deg, roll_reference
-from speclight.render.map_lookup import (
+from speclight.maps.map_geometry import lonlat_deg, roll_reference
+from speclight.maps.map_lookup import (
     ReflectivityMap,
     phase_angle_weights,
     plane_axis,

@@ -2,12 +2,12 @@
 
 :func:`reflectivity_map` renders the scenario's target (its materials, spectrum, render
 settings and bands) for every HEALPix phase-vector direction x phase angle x roll
-(conventions: :mod:`speclight.render.map_geometry`) and streams the results, chunk by chunk
-of directions, into a resumable store (layout: :mod:`.reflectivity_map_store`). Each chunk is
+(conventions: :mod:`speclight.maps.map_geometry`) and streams the results, chunk by chunk
+of directions, into a resumable store (layout: :mod:`speclight.maps.map_format`). Each chunk is
 a task of :mod:`speclight.scale` (in this process, or on a Dask cluster:
-:mod:`.reflectivity_map_task`); this process alone writes the store, as chunks finish.
+:mod:`.map_task`); this process alone writes the store, as chunks finish.
 ``render: {mode: map, map_file: MAP.zarr}`` then interpolates the map instead of rendering
-(:mod:`speclight.render.map_lookup`).
+(:mod:`speclight.maps.map_lookup`).
 """
 
 from __future__ import annotations
@@ -25,13 +25,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
-from speclight.estimate import reflectivity_map_store as store
-from speclight.estimate.reflectivity_map_limits import check_chunk_memory, check_rolls, store_bytes
-from speclight.estimate.reflectivity_map_task import MapChunk, MapJob, map_engine, render_map_chunk
+from speclight.io.store_io import check_free_space, store_lock, store_writes
+from speclight.maps.map_geometry import healpix_directions, nside_for
+from speclight.maps.writer import map_store as store
+from speclight.maps.writer.map_limits import check_chunk_memory, check_rolls, store_bytes
+from speclight.maps.writer.map_task import MapChunk, MapJob, map_engine, render_map_chunk
 from speclight.ranging.bins import range_bin_edges_m
-from speclight.render.map_geometry import healpix_directions, nside_for
 from speclight.scale import Outcome, open_executor
-from speclight.scale.store_io import check_free_space, store_lock, store_writes
 from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
