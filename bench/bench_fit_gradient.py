@@ -39,7 +39,7 @@ import numpy as np
 
 from speclight.estimate import MeasuredLightCurve, fit_scenario
 from speclight.scenario import parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 CUBE = Path(__file__).parent.parent / "tests" / "estimate" / "data" / "spinning_cube.yaml"
 ONE = '"*": {bsdf: beckmann, roughness: 0.12, reflectance: 0.6}'

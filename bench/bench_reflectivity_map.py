@@ -52,10 +52,10 @@ from speclight.maps.map_lookup import load_map
 from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.render import render_intensity
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
-from speclight.simulate.radiometry import wavelength_grid_nm
-from speclight.simulate.ranging_stage import prepare_ranging
-from speclight.simulate.reflection import build_target
+from speclight.simulation import simulate
+from speclight.simulation.radiometry import wavelength_grid_nm
+from speclight.simulation.ranging_stage import prepare_ranging
+from speclight.simulation.reflection import build_target
 
 
 def _scenario(

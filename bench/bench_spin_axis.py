@@ -40,8 +40,8 @@ from speclight.estimate.spin_axis.spin_axis_run import inertial_epochs, spin_axi
 from speclight.io.netcdf import dataset_bytes
 from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.scenario import example_text, load_scenario
-from speclight.simulate import simulate
-from speclight.simulate.geometry_stage import scenario_geometry
+from speclight.simulation import simulate
+from speclight.simulation.geometry_stage import scenario_geometry
 
 
 def _text(px: int, render: str | None = None, example: str = "box-wing") -> str:

@@ -190,7 +190,7 @@ def simulate(
         with OutputClaim(output, force=force, inputs=inputs) as claim:
             from speclight.io.netcdf import dataset_bytes
             from speclight.scenario import load_example, load_scenario
-            from speclight.simulate import simulate as run_simulation
+            from speclight.simulation import simulate as run_simulation
 
             loaded = load_example(example) if example else load_scenario(scenario)  # type: ignore[arg-type]
             result = run_simulation(loaded, progress=sys.stderr.isatty() and not quiet)
@@ -1221,9 +1221,13 @@ def passes(
 
     def run() -> None:
         from speclight.io.output import OutputClaim
-        from speclight.io.pass_table import check_passes_output, passes_file_bytes, print_passes
         from speclight.scenario import load_scenario
-        from speclight.simulate.pass_search import parse_utc, scenario_passes
+        from speclight.simulation.pass_search import parse_utc, scenario_passes
+        from speclight.simulation.pass_table import (
+            check_passes_output,
+            passes_file_bytes,
+            print_passes,
+        )
 
         start_utc = parse_utc(start, "--start") if start is not None else None
         end_utc = parse_utc(end, "--end") if end is not None else None

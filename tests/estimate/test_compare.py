@@ -19,7 +19,7 @@ from speclight.estimate.inputs.observations import read_observations
 from speclight.illumination.solar import solar_table
 from speclight.orbit.timescale import load_ephemeris, load_timescale
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 STUTTGART = (48.7822, 9.1967, 355.0)
 ZIMMERWALD = (46.8772, 7.4652, 951.0)  # ILRS station 7810 (a second site ~250 km away)

@@ -34,8 +34,8 @@ from speclight.estimate.spectra.ground_truth import (
 )
 from speclight.illumination.laser import gaussian_line_per_nm
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
-from speclight.simulate.ranging_stage import SUPPORT_THRESHOLD
+from speclight.simulation import simulate
+from speclight.simulation.ranging_stage import SUPPORT_THRESHOLD
 from speclight.target import Reflectance
 from speclight.target.material_tables import MATERIAL_TABLES, material_table_path
 
@@ -68,7 +68,7 @@ def _case(name: str):
                 for la in loaded.scenario.illumination.lasers
             ]
         )
-        # the pipeline keeps each line on its support (simulate/ranging_stage.py)
+        # the pipeline keeps each line on its support (simulation/ranging_stage.py)
         lines = np.where(lines > SUPPORT_THRESHOLD * lines.max(axis=1, keepdims=True), lines, 0)
         # lasers at the observer's site: the uplink has the downlink's transmission T, so
         # each line at the target is beam x shape x T with laser_irradiance its sum over

@@ -18,7 +18,7 @@ from speclight.estimate import fit_scenario, read_measured
 from speclight.estimate.inputs.measured import MeasuredLightCurve
 from speclight.io.netcdf import write_dataset
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 DATA = Path(__file__).parent / "data"
 

@@ -13,7 +13,7 @@ from speclight.errors import InputError
 from speclight.estimate.inputs.measured import bin_light_curve, measured_from_dataset, read_measured
 from speclight.io.netcdf import write_dataset
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 CSV = """# a camera and a SPAD
 time,B,R,R_sigma

@@ -15,7 +15,7 @@ from speclight.errors import InputError
 from speclight.estimate.period.period_run import estimate_period
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
-from speclight.simulate.pipeline import simulate
+from speclight.simulation.pipeline import simulate
 
 TRUE_PERIOD_S = 120.0
 

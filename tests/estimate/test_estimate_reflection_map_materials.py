@@ -24,7 +24,7 @@ from speclight.estimate.spectra.endmember_spectra import endmembers_from_scenari
 from speclight.estimate.spectra.ground_truth import fractions
 from speclight.io.netcdf import dataset_bytes
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 NSIDE = 2  # 48 pixels: several epochs in most, so that the covariance term is not zero
 #: Float64 rounding through the render, band sums and small least-squares systems.

@@ -17,7 +17,7 @@ from speclight.estimate import fit_scenario
 from speclight.estimate.fitting.fit_bins import EpochBins
 from speclight.estimate.inputs.measured import MeasuredLightCurve
 from speclight.scenario import parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 DATA = Path(__file__).parent / "data"
 T0 = np.datetime64("2020-01-01T00:00:00", "ns")

@@ -32,7 +32,7 @@ from speclight.render.brdf_gradient import (
 )
 from speclight.scenario import example_text, parse_scenario
 from speclight.scenario.overrides import replace_fields
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 DATA = Path(__file__).parent / "data"
 ONE = '"*": {bsdf: beckmann, roughness: 0.12, reflectance: 0.6}'

@@ -27,7 +27,7 @@ from speclight.estimate.inputs.measured import MeasuredLightCurve
 from speclight.render.articulated import pose_groups
 from speclight.scenario import example_text, parse_scenario
 from speclight.scenario.overrides import replace_fields
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 DATA = Path(__file__).parent / "data"
 ARRAY = {"bsdf": "ggx", "roughness": 0.1, "reflectance": 0.3}

@@ -16,8 +16,8 @@ from speclight.maps.map_geometry import sun_observer
 from speclight.maps.map_lookup import load_map, read_header
 from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.render import available_variants
-from speclight.simulate import simulate
-from speclight.simulate.radiometry import instrument_response, wavelength_grid_nm
+from speclight.simulation import simulate
+from speclight.simulation.radiometry import instrument_response, wavelength_grid_nm
 
 RHO, RADIUS_M = 0.6, 1.7
 #: 256 px: the single-mode sphere test's accuracy (0.5 %, pixel sampling < 0.2 %).

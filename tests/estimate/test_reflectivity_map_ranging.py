@@ -20,7 +20,7 @@ from speclight.illumination import solar_irradiance_W_m2_nm
 from speclight.instrument.photometry import photon_kernel
 from speclight.maps.map_lookup import load_map
 from speclight.maps.writer.reflectivity_map_run import reflectivity_map
-from speclight.simulate.radiometry import instrument_response, wavelength_grid_nm
+from speclight.simulation.radiometry import instrument_response, wavelength_grid_nm
 
 RHO, RADIUS_M = 0.6, 1.7
 

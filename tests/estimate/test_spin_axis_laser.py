@@ -25,7 +25,7 @@ from speclight.estimate.spin_axis.spin_axis_run import spin_axis_measured
 from speclight.io.netcdf import dataset_bytes
 from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.scenario import load_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 GRID_DEG, PHASES = 10.0, 36
 runner = CliRunner()

@@ -53,7 +53,7 @@ from speclight.io.netcdf import dataset_bytes
 from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.orbit import iers_files, timescale
 from speclight.scenario import example_text, load_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 runner = CliRunner()
 EXAMPLES = int(os.environ.get("SPECLIGHT_FUZZ_EXAMPLES", "0"))

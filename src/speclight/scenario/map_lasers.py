@@ -1,4 +1,4 @@
-"""Load-time checks of lasers in ``render: {mode: map}`` (``speclight.simulate.map_ranging``).
+"""Load-time checks of lasers in ``render: {mode: map}`` (``speclight.simulation.map_ranging``).
 
 A map-mode scenario with lasers needs a map that holds the coaxial returns: phase angle 0,
 ``range_offset`` and ``range_histogram`` (made by ``speclight reflectivity-map`` with

@@ -137,8 +137,8 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
     CompareResult
         ``dataset`` with dimension ``obs`` (one per row, file order): see docs/compare.md.
     """
-    from speclight.simulate.geometry_stage import scenario_geometry
-    from speclight.simulate.pipeline import simulate
+    from speclight.simulation.geometry_stage import scenario_geometry
+    from speclight.simulation.pipeline import simulate
 
     sc = loaded.scenario
     if sc.target is None and sc.render.mode != "map":

@@ -175,7 +175,7 @@ def fit_scenario(
         ``slsqp`` with one roughness: scan the bounds before SLSQP (``False`` starts SLSQP
         at the scenario's roughness).
     """
-    from speclight.simulate import simulate
+    from speclight.simulation import simulate
 
     for p in free:
         parse_free(p)
@@ -300,7 +300,7 @@ def _scale_problems(names: list[str], scale: F64, std: F64, n_used: NDArray) -> 
 
 def _band_reflectance(loaded: LoadedScenario, ds: Any) -> F64:
     """The scenario's target reflectance per band (module doc: Albedo) [1] (B,)."""
-    from speclight.simulate.reflection import build_target
+    from speclight.simulation.reflection import build_target
 
     target = build_target(loaded)
     wl = ds["wavelength"].values.astype(float)

@@ -42,7 +42,7 @@ def fit_rough_slsqp(
 ) -> Any:
     """SLSQP over the roughness (:mod:`.roughness_fit`) of the measurements ``m`` (N, B) and
     ``sigma``, simulated at their epochs; ``bins``: both averaged over them (:mod:`.fit_bins`)."""
-    from speclight.simulate import simulate
+    from speclight.simulation import simulate
 
     usable, start = _usable_and_start(base, m, rough)
 

@@ -9,7 +9,7 @@ count rate is the same chain applied to the derivative of the intensity,
     dC_tj/dalpha_k = A / r_t^2 * sum_lambda T_t(lambda) dI_t/dalpha_k(lambda) ... (band j)
 
 with the penumbra's sunlit fraction, the articulated parts' poses and the Earthshine cells
-as in the pipeline (:class:`speclight.simulate.reflection_gradient.ReflectionGradient`). The
+as in the pipeline (:class:`speclight.simulation.reflection_gradient.ReflectionGradient`). The
 rates equal ``simulate``'s ``count_rate`` at those epochs (the same sums;
 tests/estimate/test_fit_gradient.py, tests/estimate/test_fit_gradient_scenes.py).
 
@@ -25,14 +25,14 @@ from numpy.typing import NDArray
 from speclight import instrument
 from speclight.render.single_gradient import gradient_problem
 from speclight.scenario import LoadedScenario
-from speclight.simulate.geometry_stage import Geometry
-from speclight.simulate.radiometry import (
+from speclight.simulation.geometry_stage import Geometry
+from speclight.simulation.radiometry import (
     atmosphere_transmission,
     instrument_response,
     wavelength_grid_nm,
 )
-from speclight.simulate.reflection import build_target
-from speclight.simulate.reflection_gradient import ReflectionGradient
+from speclight.simulation.reflection import build_target
+from speclight.simulation.reflection_gradient import ReflectionGradient
 
 F64 = NDArray[np.float64]
 

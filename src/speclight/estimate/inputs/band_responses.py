@@ -3,7 +3,7 @@
 Upsampling (eq. 3) and the band signatures of endmember spectra weight a spectrum with the
 same responses that produced the counts: the band curve times the optics transmission times
 the band's detector quantum efficiency, on the wavelength grid. They are taken from where
-``speclight simulate`` computes them (:func:`speclight.simulate.radiometry.instrument_response`)
+``speclight simulate`` computes them (:func:`speclight.simulation.radiometry.instrument_response`)
 or read back from its dataset (``band_response``, ``optics_transmission``, ``detector_qe``),
 never rebuilt here.
 """
@@ -52,7 +52,7 @@ def scenario_band_responses(loaded: LoadedScenario) -> BandResponses:
     InputError
         If the scenario has no bands, or a band, optics or QE table cannot be read.
     """
-    from speclight.simulate.radiometry import instrument_response, wavelength_grid_nm
+    from speclight.simulation.radiometry import instrument_response, wavelength_grid_nm
 
     wl = wavelength_grid_nm(loaded.scenario.spectrum)
     if not loaded.scenario.instrument.bands:

@@ -1,13 +1,13 @@
 """Up-front limits of the estimation commands: sizes a user controls, checked before any work.
 
-``speclight simulate`` refuses a run that cannot fit in memory (:mod:`speclight.simulate.
+``speclight simulate`` refuses a run that cannot fit in memory (:mod:`speclight.simulation.
 memory`); the estimators do the same for what their options and inputs make large: the
 period's frequency grid and bootstrap draws, the spin-axis grid, phases and map resampling,
 the bins of ``--bin-s``. Each check raises an :class:`~speclight.errors.InputError` naming
 the **Python parameter** (``n_phases``, ``draws``...; the command line says its flag) with
 the estimate, the limit and what to reduce.
 
-* **Memory**: the estimate against :func:`speclight.simulate.memory.memory_limit_bytes`
+* **Memory**: the estimate against :func:`speclight.simulation.memory.memory_limit_bytes`
   (half the physical memory, or the process limit).
 * **Time**: the estimate against :data:`MAX_SECONDS`, one day, the limit ``simulate`` puts
   on a path-mode render: the output is written only at the end, so a longer run risks
@@ -64,7 +64,7 @@ def check_cost(
     reduce
         What to reduce, in words.
     """
-    from speclight.simulate.memory import memory_limit_bytes
+    from speclight.simulation.memory import memory_limit_bytes
 
     limit = memory_limit_bytes()
     if n_bytes > limit:

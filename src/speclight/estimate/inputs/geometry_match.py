@@ -84,7 +84,7 @@ def check_scenario_sees(
     light
         ``"sun"``: the target must be sunlit too; ``"laser"``: above the horizon only.
     """
-    from speclight.simulate.geometry_stage import scenario_geometry
+    from speclight.simulation.geometry_stage import scenario_geometry
 
     time_utc = np.asarray(time_utc, dtype="datetime64[ns]")
     if time_utc.size == 0:

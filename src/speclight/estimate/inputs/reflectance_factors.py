@@ -12,7 +12,7 @@ Band reflectance factors (eq. 5 of the reference paper), from
   ``laser_reflectance_factor_material``) with the ``material_reflectance`` labels is kept
   where present;
 * a CSV of count rates (:func:`speclight.estimate.read_measured`) with a scenario: the
-  scenario is simulated at the measured epochs (:func:`speclight.simulate.simulate`) and the
+  scenario is simulated at the measured epochs (:func:`speclight.simulation.simulate`) and the
   rates are turned into factors by :func:`speclight.instrument.reflectance_factor_m2_sr`
   with that simulation's range, source spectrum at the aperture and band responses, as
   ``speclight simulate`` does for its own rates (the Sun where the scenario has it on, else
@@ -245,7 +245,7 @@ def _factors_from_rates(
     light: str | None,
 ) -> ReflectanceFactors:
     from speclight import instrument
-    from speclight.simulate import simulate
+    from speclight.simulation import simulate
 
     names = [b.name for b in loaded.scenario.instrument.bands]
     lc = lc.select_bands(names)

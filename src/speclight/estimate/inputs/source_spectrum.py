@@ -87,9 +87,9 @@ def coaxial_laser_source_W_m2_nm(
 
 def laser_lines_per_nm(loaded: LoadedScenario, wavelength_nm: ArrayLike) -> F64:
     """The scenario's laser lines (K, L) [nm-1] on the grid, zero off their support (as
-    :mod:`speclight.simulate.ranging_stage` keeps them); a notice for a transmitter that is
+    :mod:`speclight.simulation.ranging_stage` keeps them); a notice for a transmitter that is
     not at the observer's site (its uplink transmission is taken as the observer's)."""
-    from speclight.simulate.ranging_stage import SUPPORT_THRESHOLD, line_shape_per_nm
+    from speclight.simulation.ranging_stage import SUPPORT_THRESHOLD, line_shape_per_nm
 
     sc = loaded.scenario
     wl = np.asarray(wavelength_nm, dtype=np.float64)

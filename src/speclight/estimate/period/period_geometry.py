@@ -93,7 +93,7 @@ def pass_geometry(
         t_in, gcrs, phase = found
     elif loaded is not None:
         from speclight.attitude.quaternion import quat_rotate
-        from speclight.simulate.geometry_stage import scenario_geometry
+        from speclight.simulation.geometry_stage import scenario_geometry
 
         geo = scenario_geometry(loaded, lc.time_utc)
         vector = geo.observer_direction_body if source == "laser" else geo.phase_vector_body

@@ -352,7 +352,7 @@ def check_periodogram_cost(
         check_cost,
         duration,
     )
-    from speclight.simulate.memory import memory_limit_bytes
+    from speclight.simulation.memory import memory_limit_bytes
 
     n_freq = SAMPLES_PER_PEAK * series.span_s * (1.0 / min_p - 1.0 / max_p) + 1
     points = np.bincount(series.band, minlength=series.n_bands)

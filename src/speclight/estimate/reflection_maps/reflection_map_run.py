@@ -8,7 +8,7 @@ and averages the epochs on HEALPix pixels (:func:`.reflection_map_core.reflectio
 * under the Sun the **phase vector** ``phase_vector_body``; under coaxial lasers (phase angle
   0) the **observer direction** ``observer_direction_body``, where the phase vector is;
 * from the NetCDF itself, or, for a CSV (or a NetCDF without them), from the scenario's
-  geometry at the measured epochs (:func:`speclight.simulate.geometry_stage.scenario_geometry`:
+  geometry at the measured epochs (:func:`speclight.simulation.geometry_stage.scenario_geometry`:
   orbit, site, Sun and attitude, nothing rendered).
 
 RMAP.nc: ``reflectance_factor(band, pixel)`` [m2 sr-1] (NaN where no epoch),
@@ -200,7 +200,7 @@ def _directions(
                 field="--scenario",
             )
     assert loaded is not None  # a CSV without a scenario is refused when read
-    from speclight.simulate.geometry_stage import scenario_geometry
+    from speclight.simulation.geometry_stage import scenario_geometry
 
     geo = scenario_geometry(loaded, data.time_utc)
     d = geo.phase_vector_body if data.light == "sun" else geo.observer_direction_body

@@ -123,7 +123,7 @@ def endmembers_from_scenario(
     InputError
         A scenario without a target.
     """
-    from speclight.simulate.reflection import build_target
+    from speclight.simulation.reflection import build_target
 
     if loaded.scenario.target is None:
         raise InputError("the scenario has no target materials", field="--endmembers")

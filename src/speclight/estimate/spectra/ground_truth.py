@@ -2,7 +2,7 @@
 
 For simulated light curves with ``render: {per_material: true}`` the output carries each
 material's share of the band reflectance factors (``reflectance_factor_material``, or
-``laser_reflectance_factor_material`` under lasers; :mod:`speclight.simulate.per_material`).
+``laser_reflectance_factor_material`` under lasers; :mod:`speclight.simulation.per_material`).
 Where a material's BRDF is its reflectance spectrum times a geometric factor (Lambertian, and
 microfacet models with the reflectance given as numbers), its share is
 ``F_k(t, j) = g_k(t) s_kj``: a contribution ``g_k(t)`` [m2 sr-1] times the band signature

@@ -99,7 +99,7 @@ def phase_vector_track(
 
 def inertial_epochs(geo: Any, period_s: float) -> EpochGeometry:
     """The Sun and observer directions in GCRS of a pass's geometry (a
-    :class:`~speclight.simulate.geometry_stage.Geometry`: they do not depend on the candidate
+    :class:`~speclight.simulation.geometry_stage.Geometry`: they do not depend on the candidate
     spin axis), with the spin period [s]."""
     q = geo.quaternion_body_to_gcrs
     return EpochGeometry(
@@ -165,8 +165,8 @@ def spin_axis_measured(
     from speclight.estimate.spin_axis.spin_axis_limits import check_search_cost
     from speclight.estimate.spin_axis.spin_axis_refine import check_refine_options
     from speclight.maps.map_lookup import check_map_matches
-    from speclight.simulate.geometry_stage import scenario_geometry
-    from speclight.simulate.radiometry import wavelength_grid_nm
+    from speclight.simulation.geometry_stage import scenario_geometry
+    from speclight.simulation.radiometry import wavelength_grid_nm
 
     check_search_options(grid_deg, n_phases)
     check_refine_options(refine_method, period_bound)

@@ -2,7 +2,7 @@
 
 A chunk of ``n`` directions renders ``n x G`` geometries at once (``G``: phase angles x
 rolls, phase 0 once), in one process: its peak memory is that of a ``simulate`` run of as
-many epochs (:func:`speclight.simulate.memory.estimate_memory`: render batch, channel
+many epochs (:func:`speclight.simulation.memory.estimate_memory`: render batch, channel
 weights, spectra). A chunk that cannot fit under the memory limit is refused before any
 work, with the largest chunk that fits; the workers of a local cluster, each rendering one
 chunk, are as many as fit (:func:`speclight.scale.executor.local_workers`). The store's
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from speclight.errors import InputError
 from speclight.scenario import LoadedScenario
-from speclight.simulate.memory import estimate_memory, memory_limit_bytes
+from speclight.simulation.memory import estimate_memory, memory_limit_bytes
 
 #: Most rolls of the Sun-observer plane: one per degree.
 MAX_ROLLS = 360
@@ -34,7 +34,7 @@ def check_chunk_memory(
     asked: int | None = None,
 ) -> int:
     """The peak memory of one chunk [bytes]; refuse a chunk above the limit (default
-    :func:`~speclight.simulate.memory.memory_limit_bytes`), naming the largest that fits.
+    :func:`~speclight.simulation.memory.memory_limit_bytes`), naming the largest that fits.
 
     ``asked``: the chunk the user gave, where ``chunk`` is that cut to the map's directions.
     """

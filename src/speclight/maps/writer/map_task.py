@@ -82,8 +82,8 @@ def map_engine(loaded: LoadedScenario, variant: str | None) -> MapEngine:
 
 def _build(loaded: LoadedScenario, variant: str | None) -> MapEngine:
     from speclight.render import RenderSession
-    from speclight.simulate.radiometry import instrument_response, wavelength_grid_nm
-    from speclight.simulate.reflection import build_target
+    from speclight.simulation.radiometry import instrument_response, wavelength_grid_nm
+    from speclight.simulation.reflection import build_target
 
     sc = loaded.scenario
     target = build_target(loaded)

@@ -167,7 +167,7 @@ def reflectivity_map(
     )
     path = store.check_store_path(output, {"scenario file": Path(loaded.source)})
     from speclight.illumination import solar_irradiance_W_m2_nm
-    from speclight.simulate.radiometry import wavelength_grid_nm
+    from speclight.simulation.radiometry import wavelength_grid_nm
 
     dirs = healpix_directions(nside)
     size = min(int(chunk), len(dirs))  # a chunk larger than the map is the whole map

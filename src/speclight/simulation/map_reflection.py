@@ -11,8 +11,8 @@ from speclight.constants import AU_M
 from speclight.illumination import solar_irradiance_W_m2_nm
 from speclight.maps.map_lookup import load_map
 from speclight.scenario import LoadedScenario
-from speclight.simulate.geometry_stage import Geometry
-from speclight.simulate.reflection import Reflection
+from speclight.simulation.geometry_stage import Geometry
+from speclight.simulation.reflection import Reflection
 
 F64 = NDArray[np.float64]
 

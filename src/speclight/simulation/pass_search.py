@@ -21,8 +21,8 @@ from speclight.orbit.staleness import warn_past_tables
 from speclight.orbit.timescale import time_from_utc
 from speclight.scenario import LoadedScenario
 from speclight.scenario.sections_geometry import FIRST_EPOCH_UTC, LAST_EPOCH_UTC
-from speclight.simulate.geometry_stage import scenario_trajectory
-from speclight.simulate.observed_track import observed_track
+from speclight.simulation.geometry_stage import scenario_trajectory
+from speclight.simulation.observed_track import observed_track
 
 #: Grid step of the search [s]: a LEO pass lasts several minutes, a shadow or twilight
 #: limit follows the last by more than a minute; maxima are refined however short.

@@ -1,6 +1,6 @@
 """Active illumination and laser ranging stage of the pipeline (lasers from the scenario).
 
-Use from :func:`speclight.simulate.pipeline.simulate`::
+Use from :func:`speclight.simulation.pipeline.simulate`::
 
     setup = prepare_ranging(loaded, geo, wavelength_nm, target, session)  # None without lasers
     # optional, for speed in single mode: reuse the Sun render's primary rays
@@ -22,7 +22,7 @@ the interreflections are added at their full optical path length
 (:mod:`speclight.render.laser_multibounce`, Monte Carlo with ``render.samples_per_pixel`` and
 ``render.seed``); single mode is single scattering, exact. In ``render.mode: map`` nothing is
 rendered: the target's returns come from the reflectivity map
-(:mod:`speclight.simulate.map_ranging`, ``RangingSetup.map_returns``) and the rest of this
+(:mod:`speclight.simulation.map_ranging`, ``RangingSetup.map_returns``) and the rest of this
 stage is the same.
 
 The centre of mass is the body-frame origin.
@@ -49,10 +49,10 @@ from speclight.render.laser_returns import LaserLight, LaserReturnAccumulator, L
 from speclight.render.path_scene import MAX_DEPTH as PATH_MAX_DEPTH
 from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
-from speclight.simulate.geometry_stage import Geometry
-from speclight.simulate.map_ranging import scenario_map_returns
-from speclight.simulate.radiometry import Radiometry, atmosphere_params
-from speclight.simulate.ranging_dataset import RangingResult
+from speclight.simulation.geometry_stage import Geometry
+from speclight.simulation.map_ranging import scenario_map_returns
+from speclight.simulation.radiometry import Radiometry, atmosphere_params
+from speclight.simulation.ranging_dataset import RangingResult
 from speclight.target import Target
 from speclight.wavelength_grid import grid_bin_bounds_nm
 
@@ -82,7 +82,7 @@ class RangingSetup:
     """Lasers, the render accumulator and the render session of one run, and the flag bits
     (N,) this stage sets (:data:`~speclight.schema.FLAG_LASER_BELOW_HORIZON`). In
     ``render.mode: map`` there is no render: ``map_returns`` gives the returns instead
-    (:mod:`speclight.simulate.map_ranging`)."""
+    (:mod:`speclight.simulation.map_ranging`)."""
 
     lasers: list[LaserSetup]
     accumulator: LaserReturnAccumulator | None
@@ -321,7 +321,7 @@ def _received(
         sc.telescope.aperture_diameter_m, sc.telescope.obstruction_diameter_m
     )
     # electrons per joule per bin x width (B, L); each band's own detector QE is folded
-    # into its response, as for the Sun's count rates (simulate/radiometry.py)
+    # into its response, as for the Sun's count rates (simulation/radiometry.py)
     kernel = photon_kernel(
         wavelength_nm,
         radiometry.optics,

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from speclight import instrument, schema
 from speclight.render.polarization import dolp_aolp
 from speclight.scenario import LoadedScenario
-from speclight.simulate.radiometry import Radiometry
+from speclight.simulation.radiometry import Radiometry
 
 F64 = NDArray[np.float64]
 

@@ -14,8 +14,8 @@ from speclight import schema
 from speclight.constants import AU_M
 from speclight.info import engine_versions
 from speclight.scenario import LoadedScenario
-from speclight.simulate.geometry_stage import Geometry
-from speclight.simulate.input_hashes import input_files_attribute
+from speclight.simulation.geometry_stage import Geometry
+from speclight.simulation.input_hashes import input_files_attribute
 
 
 def geometry_dataset(geo: Geometry, flags: NDArray[np.uint8] | None = None) -> xr.Dataset:

@@ -14,25 +14,25 @@ from speclight.progress import stage
 from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
 from speclight.scenario.sections_geometry import Observer
-from speclight.simulate.dataset import describe_run, geometry_dataset
-from speclight.simulate.geometry_stage import Geometry, scenario_geometry
-from speclight.simulate.map_reflection import map_reflection
-from speclight.simulate.memory import check_run_limits, grid_epochs
-from speclight.simulate.per_material import (
+from speclight.simulation.dataset import describe_run, geometry_dataset
+from speclight.simulation.geometry_stage import Geometry, scenario_geometry
+from speclight.simulation.map_reflection import map_reflection
+from speclight.simulation.memory import check_run_limits, grid_epochs
+from speclight.simulation.per_material import (
     add_per_material,
     laser_material_factors,
     material_labels,
     solar_material_factors,
 )
-from speclight.simulate.polarimetry import add_polarization
-from speclight.simulate.radiometry import (
+from speclight.simulation.polarimetry import add_polarization
+from speclight.simulation.radiometry import (
     atmosphere_transmission,
     instrument_response,
     wavelength_grid_nm,
 )
-from speclight.simulate.ranging_stage import laser_ranging, prepare_ranging
-from speclight.simulate.reflection import build_target, render_reflection
-from speclight.simulate.spectral_dataset import add_images, add_spectral
+from speclight.simulation.ranging_stage import laser_ranging, prepare_ranging
+from speclight.simulation.reflection import build_target, render_reflection
+from speclight.simulation.spectral_dataset import add_images, add_spectral
 
 
 @dataclass

@@ -1,7 +1,7 @@
 """The reflection stage's intensity and its derivatives in the roughness, for a fit.
 
 :class:`ReflectionGradient` gives, for a fixed geometry and a set of observable epochs, the
-target's intensity as :func:`speclight.simulate.reflection.render_reflection` computes it
+target's intensity as :func:`speclight.simulation.reflection.render_reflection` computes it
 (single-scattering render) and its derivatives in the roughness of chosen materials
 (:func:`speclight.render.single_gradient.render_single_gradient`). Both are linear in the
 renders they sum, so the derivative is the same sum of the renders' derivatives:
@@ -11,9 +11,9 @@ renders they sum, so the derivative is the same sum of the renders' derivatives:
   :func:`~speclight.target.articulation.joint_angles_rad` grouped by
   :func:`~speclight.render.articulated.posed_groups`, as the pipeline does;
 * Earthshine: one render per lit cell of the visible Earth cap and epoch
-  (:func:`~speclight.simulate.earthshine_stage.earthshine_cells`), the target as built
+  (:func:`~speclight.simulation.earthshine_stage.earthshine_cells`), the target as built
   (articulated parts at their reference pose, as in the pipeline), summed per epoch by
-  :func:`~speclight.simulate.earthshine_stage.sum_over_cells`.
+  :func:`~speclight.simulation.earthshine_stage.sum_over_cells`.
 
 Only ``render.mode: single`` and ``beckmann`` / ``ggx`` materials have a derivative here
 (:func:`speclight.render.single_gradient.gradient_problem`).
@@ -32,9 +32,9 @@ from speclight.render.articulated import posed_groups
 from speclight.render.session import RenderSession
 from speclight.render.single_gradient import render_single_gradient
 from speclight.scenario import LoadedScenario
-from speclight.simulate.earthshine_stage import EarthshineCells, earthshine_cells, sum_over_cells
-from speclight.simulate.geometry_stage import Geometry
-from speclight.simulate.reflection import build_joints, build_target
+from speclight.simulation.earthshine_stage import EarthshineCells, earthshine_cells, sum_over_cells
+from speclight.simulation.geometry_stage import Geometry
+from speclight.simulation.reflection import build_joints, build_target
 from speclight.target.articulation import joint_angles_rad
 from speclight.target.parts import Target
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from speclight.errors import InputError
 from speclight.orbit.pass_finder import Interval, Pass
-from speclight.simulate.pass_search import PassSearch
+from speclight.simulation.pass_search import PassSearch
 
 #: File formats by suffix.
 FORMATS = (".csv", ".json")

@@ -51,8 +51,8 @@ from speclight.maps.map_lookup import FIELD, ReflectivityMap, healpix_weights, l
 from speclight.ranging.bins import range_bin_edges_m
 from speclight.render.laser_returns import COAXIAL_RAD, LaserLight, LaserReturns
 from speclight.scenario import LoadedScenario
-from speclight.simulate.radiometry import instrument_response
-from speclight.simulate.reflection import build_target
+from speclight.simulation.radiometry import instrument_response
+from speclight.simulation.reflection import build_target
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]

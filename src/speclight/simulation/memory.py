@@ -28,7 +28,7 @@ BENCHMARKS.md, "Memory"):
 * with lasers: per epoch the range histograms (band x range bin, float64, accumulated and
   stored) and each laser's spectral intensity;
 * with ``render.per_material``: per epoch, material and bin the shares (N, M, L) of
-  :mod:`speclight.simulate.per_material` (the render's output and the accumulated shares,
+  :mod:`speclight.simulation.per_material` (the render's output and the accumulated shares,
   float64), and per epoch, material and band the factors and their file copy,
   :data:`BYTES_PER_EPOCH_MATERIAL_BIN` and :data:`BYTES_PER_EPOCH_MATERIAL_BAND` (counted
   from the allocations, not measured).
@@ -108,7 +108,7 @@ class MemoryEstimate:
 
 def grid_epochs(scenario: Scenario) -> int:
     """Epochs of the scenario's time grid (the count of
-    :func:`speclight.simulate.geometry_stage.time_grid`, without building it)."""
+    :func:`speclight.simulation.geometry_stage.time_grid`, without building it)."""
     grid = scenario.time
     span_s = (grid.stop - grid.start).total_seconds()
     return math.floor(span_s / grid.step_s + 1e-9) + 1

@@ -27,8 +27,8 @@ from speclight.scenario.sections_light import (
     ShippedTable,
 )
 from speclight.scenario.sections_light import Material as MaterialModel
-from speclight.simulate.earthshine_stage import earthshine_intensity
-from speclight.simulate.geometry_stage import Geometry, pole_body
+from speclight.simulation.earthshine_stage import earthshine_intensity
+from speclight.simulation.geometry_stage import Geometry, pole_body
 from speclight.target import Material, Reflectance, Target
 from speclight.target.articulation import (
     Joint,
@@ -247,7 +247,7 @@ def _render_lit(
     sc = loaded.scenario
     assert sc.target is not None
     if progress and sc.render.mode == "path":
-        from speclight.simulate.memory import path_render_note
+        from speclight.simulation.memory import path_render_note
 
         print(path_render_note(sc, idx.size), file=sys.stderr)  # the bar follows
     common = _render_options(loaded, geo, idx, on_hits, session)

@@ -3,7 +3,7 @@
 :func:`earthshine_cells` lists the renders (one per lit cell of the visible Earth cap and
 epoch: :mod:`speclight.illumination.earthshine`), :func:`sum_over_cells` adds them up per
 epoch; :func:`earthshine_intensity` (the reflection stage) and the roughness-gradient pass
-(:mod:`speclight.simulate.reflection_gradient`) both go through them, so that they light the
+(:mod:`speclight.simulation.reflection_gradient`) both go through them, so that they light the
 target alike.
 """
 
@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
-from speclight.simulate.geometry_stage import Geometry, pole_body
+from speclight.simulation.geometry_stage import Geometry, pole_body
 from speclight.target.parts import Target
 
 F64 = NDArray[np.float64]

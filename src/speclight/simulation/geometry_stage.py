@@ -33,8 +33,8 @@ from speclight.scenario.sections_geometry import (
     TimeGrid,
     TorqueFreeAttitude,
 )
-from speclight.simulate.attitude_stage import profile_attitude
-from speclight.simulate.observed_track import observed_track, track_sky_position
+from speclight.simulation.attitude_stage import profile_attitude
+from speclight.simulation.observed_track import observed_track, track_sky_position
 
 
 @dataclass

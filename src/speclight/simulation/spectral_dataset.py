@@ -8,8 +8,8 @@ from numpy.typing import NDArray
 
 from speclight import schema
 from speclight.render.result import RenderImage
-from speclight.simulate.radiometry import Radiometry
-from speclight.simulate.reflection import Reflection
+from speclight.simulation.radiometry import Radiometry
+from speclight.simulation.reflection import Reflection
 
 
 def add_spectral(

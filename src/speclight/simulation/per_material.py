@@ -4,7 +4,7 @@ With ``render: {per_material: true}`` (single mode) the target is rendered once 
 :func:`speclight.render.material_contributions`, which splits the single-scattering intensity
 by material (the pixels that see each material, with the shadows of the whole target), and
 each share is carried through the same atmosphere and instrument chain as the total
-(:func:`speclight.simulate.radiometry.band_reflectance_factor`). The chain is linear in the
+(:func:`speclight.simulation.radiometry.band_reflectance_factor`). The chain is linear in the
 intensity, so the shares sum to ``reflectance_factor`` over the materials (to rounding).
 
 For the lasers the same is done with each laser as the light (its direction and spectral
@@ -35,9 +35,9 @@ from speclight.scenario.sections_light import (
     ReflectancePairs,
     ShippedTable,
 )
-from speclight.simulate.geometry_stage import Geometry
-from speclight.simulate.radiometry import Radiometry, band_reflectance_factor
-from speclight.simulate.ranging_stage import RangingSetup, laser_irradiance_W_m2_nm
+from speclight.simulation.geometry_stage import Geometry
+from speclight.simulation.radiometry import Radiometry, band_reflectance_factor
+from speclight.simulation.ranging_stage import RangingSetup, laser_irradiance_W_m2_nm
 from speclight.target import Target
 
 F64 = NDArray[np.float64]
