@@ -122,22 +122,74 @@ def _fail(message: str, code: int) -> None:
     raise typer.Exit(code)
 
 
+def cli_words(message: str, flags: dict[str, str]) -> str:
+    """A core's message in the command line's words: ``flags`` maps Python parameter names
+    to flags. Cores name a parameter as Python code would (``n_phases = 0 must be ...``,
+    ``use method='slsqp'``, ``pass force=True``, or ```bin_s``` in prose):
+
+    * ```name``` -> ``flag``; ``name=True`` -> ``flag``; ``name='v'`` and ``name=v`` ->
+      ``flag v``; ``name=['a', 'b']`` -> ``flag a b``; ``name = `` -> ``flag = ``;
+    * a name with an underscore (``min_period_s``) wherever it stands as a word; a plain word
+      (``draws``) only in the forms above, so that the prose around it stays.
+    """
+    for name, flag in flags.items():
+        n = re.escape(name)
+        message = message.replace(f"`{name}`", flag)
+        message = re.sub(rf"(?<![\w.-]){n}=True\b", flag, message)
+        message = re.sub(rf"(?<![\w.-]){n}=\[([^\]]*)\]", _listed(flag), message)
+        message = re.sub(rf"(?<![\w.-]){n}='([^']*)'", rf"{flag} \1", message)
+        message = re.sub(rf"(?<![\w.-]){n}=(?=[^\s=])", f"{flag} ", message)
+        tail = r"(?![\w-])" if "_" in name else r"(?= = )"
+        message = re.sub(rf"(?<![\w.-]){n}{tail}", flag, message)
+    return message
+
+
+def _listed(flag: str) -> Callable[[re.Match[str]], str]:
+    """``name=['a', 'b']`` -> ``flag a b`` (a list option given as its values)."""
+    return lambda m: f"{flag} " + " ".join(v.strip().strip("'") for v in m.group(1).split(","))
+
+
 @contextmanager
 def _flag_names(**flags: str) -> Iterator[None]:
     """Say the command-line flags where a plain-array core's error names its Python
-    parameters (``n_phases = 0`` -> ``--phases = 0``): ``flags`` maps parameter names to
-    flags. A name with an underscore is replaced wherever it stands; a plain word
-    (``draws``) only as ``draws =``, so that the prose around it stays."""
+    parameters (``n_phases = 0`` -> ``--phases = 0``; :func:`cli_words`): ``flags`` maps
+    parameter names to flags; the error's field becomes the flag too."""
     try:
         yield
     except InputError as exc:
-        if exc.field not in flags:
+        message = cli_words(exc.message, flags)
+        field = flags.get(str(exc.field), exc.field)
+        if message == exc.message and field == exc.field:
             raise
-        message = exc.message
-        for name, flag in flags.items():
-            tail = r"(?!\w)" if "_" in name else r"(?= = )"
-            message = re.sub(rf"(?<![\w-]){re.escape(name)}{tail}", flag, message)
-        raise InputError(message, source=exc.source, field=flags[str(exc.field)]) from None
+        raise InputError(message, source=exc.source, field=field) from None
+
+
+#: Python parameter -> flag, per command (the cores' errors name the parameters).
+FIT_FLAGS = {"free": "--free", "method": "--method", "bin_s": "--bin-s"}
+UNMIX_FLAGS = {
+    "endmembers": "--endmembers", "extract": "--extract", "n": "--n", "method": "--method",
+    "loaded": "--scenario", "bin_s": "--bin-s", "light": "--source",
+}  # fmt: skip
+REFLECTION_MAP_FLAGS = {
+    "nside": "--nside", "loaded": "--scenario", "light": "--source",
+    "endmembers": "--endmembers", "method": "--method", "bin_s": "--bin-s",
+}  # fmt: skip
+MAP_FLAGS = {
+    "output": "--output", "force": "--force", "directions": "--directions",
+    "phase_angles_deg": "--phase-angles-deg", "rolls": "--rolls", "chunk": "--chunk",
+    "n_workers": "--workers",
+}  # fmt: skip
+SPIN_AXIS_FLAGS = {
+    "grid_deg": "--grid-deg", "n_phases": "--phases", "period_s": "--period-s",
+    "bands": "--bands", "refine_method": "--refine", "period_bound": "--period-bound",
+    "y": "MEASURED", "bmap": "--map", "map_path": "--map", "ranging_weight": "--ranging-weight",
+    "light": "--source", "phase_angles_deg": "--phase-angles-deg",
+}  # fmt: skip
+PERIOD_FLAGS = {
+    "min_period_s": "--min-period-s", "max_period_s": "--max-period-s", "draws": "--draws",
+    "harmonics": "--harmonics", "seed": "--seed", "synodic": "--synodic", "bin_s": "--bin-s",
+    "loaded": "--scenario", "source": "--source",
+}  # fmt: skip
 
 
 def _guarded(func: Callable[[], Any]) -> Any:
@@ -351,17 +403,18 @@ def fit(
     """
 
     def run() -> None:
-        from speclight.estimate.fitting.fit_run import fit_scenario, parse_free, parse_method
+        from speclight.estimate.fitting.fit_run import check_free, check_method, fit_scenario
         from speclight.estimate.inputs.measured import read_measured
         from speclight.plot.figure_output import claim_outputs, write_outputs
         from speclight.scenario import load_scenario
 
-        names = parse_free(free)
-        chosen = parse_method(method)
+        with _flag_names(**FIT_FLAGS):
+            names = check_free([p.strip() for p in free.split(",") if p.strip()])
+            chosen = check_method(method)
         inputs = {"scenario file": scenario, "measurements": measured}
         with (
             claim_outputs(output, plot_file, force, inputs) as (claim, figure),
-            _flag_names(bin_s="--bin-s"),
+            _flag_names(**FIT_FLAGS),
         ):
             result = fit_scenario(
                 load_scenario(scenario), read_measured(measured), free=names, bin_s=bin_s,
@@ -521,9 +574,12 @@ def unmix(
         from speclight.plot.figure_output import claim_outputs, write_outputs
 
         members = _endmember_files(measured, endmembers)
-        check_unmix_options(members, extract, n, method, source)
+        with _flag_names(**UNMIX_FLAGS):
+            check_unmix_options(
+                endmembers=members, extract=extract, n=n, method=method, light=source
+            )
         inputs = _measured_inputs(measured[0], scenario, members)
-        flags = _flag_names(bin_s="--bin-s")
+        flags = _flag_names(**UNMIX_FLAGS)
         with claim_outputs(output, plot_file, force, inputs) as (claim, figure), flags:
             loaded = _optional_scenario(scenario)
             ds = unmix_measured(
@@ -628,10 +684,11 @@ def reflection_map_cmd(
         from speclight.plot.figure_output import claim_outputs, write_outputs
 
         members = _endmember_files(measured, endmembers)
-        check_nside(nside)
-        check_light(source)
+        with _flag_names(**REFLECTION_MAP_FLAGS):
+            check_nside(nside)
+            check_light(source)
         inputs = _measured_inputs(measured[0], scenario, members)
-        flags = _flag_names(bin_s="--bin-s")
+        flags = _flag_names(**REFLECTION_MAP_FLAGS)
         with claim_outputs(output, plot_file, force, inputs) as (claim, figure), flags:
             loaded = _optional_scenario(scenario)
             ds = reflection_map_measured(
@@ -724,20 +781,24 @@ def reflectivity_map(
         from speclight.scenario import load_scenario
 
         angles = _phase_angles(phase_angles_deg)
-        check_map_options(directions, angles, rolls, chunk, workers)  # before loading
-        result = build(
-            load_scenario(scenario),
-            output,
-            directions=directions,
-            phase_angles_deg=angles,
-            rolls=rolls,
-            chunk=chunk,
-            force=force,
-            progress=sys.stderr.isatty(),
-            scheduler=scheduler,
-            n_workers=workers,
-            announce=True,
-        )
+        with _flag_names(**MAP_FLAGS):
+            check_map_options(  # before loading
+                directions=directions, phase_angles_deg=angles, rolls=rolls, chunk=chunk,
+                n_workers=workers,
+            )  # fmt: skip
+            result = build(
+                load_scenario(scenario),
+                output,
+                directions=directions,
+                phase_angles_deg=angles,
+                rolls=rolls,
+                chunk=chunk,
+                force=force,
+                progress=sys.stderr.isatty(),
+                scheduler=scheduler,
+                n_workers=workers,
+                announce=True,
+            )
         _raise_if_signalled()
         if result.damaged:
             typer.echo(
@@ -851,15 +912,11 @@ def spin_axis(
         from speclight.plot.figure_output import claim_outputs, write_outputs
         from speclight.scenario import load_scenario
 
-        flags = dict(
-            grid_deg="--grid-deg", n_phases="--phases", period_s="--period-s", bands="--bands",
-            refine_method="--refine", period_bound="--period-bound", y="MEASURED", bmap="--map",
-            ranging_weight="--ranging-weight",
-        )  # fmt: skip
+        flags = SPIN_AXIS_FLAGS
         with _flag_names(**flags):
             check_search_options(grid_deg, phases)
             check_refine_options(refine_method, period_bound if free_period else None)
-        check_light(source)
+            check_light(source)
         names = [b.strip() for b in bands.split(",") if b.strip()] if bands else None
         inputs = {"scenario file": scenario, "measured file": measured, "map": map_file}
         with (
@@ -871,11 +928,11 @@ def spin_axis(
                 loaded,
                 measured,
                 map_file,
-                period_s,
-                grid_deg,
-                phases,
-                names,
-                not no_refine,
+                period_s=period_s,
+                grid_deg=grid_deg,
+                n_phases=phases,
+                bands=names,
+                refine=not no_refine,
                 light=source,
                 ranging_weight=ranging_weight,
                 refine_method=refine_method,
@@ -1009,10 +1066,7 @@ def period(
             "double" if if_symmetric == "double" else "keep" if if_symmetric == "keep" else "auto"
         )
         inputs = _measured_inputs(measured, scenario)
-        flags = _flag_names(
-            min_period_s="--min-period-s", max_period_s="--max-period-s", draws="--draws",
-            harmonics="--harmonics", seed="--seed", synodic="--synodic", bin_s="--bin-s",
-        )  # fmt: skip
+        flags = _flag_names(**PERIOD_FLAGS)
         with claim_outputs(output, plot_file, force, inputs) as (claim, figure), flags:
             loaded = _optional_scenario(scenario)
             result = estimate_period(

@@ -11,7 +11,9 @@
 * Mitsuba and Dr.Jit are imported only inside ``speclight.render``;
 * the render variant is chosen in one place (``render/session.py`` calls ``choose_variant``);
 * no two modules share a file name (a newcomer can tell them apart), ``__init__`` aside;
-* physical constants are defined once (``speclight.constants``).
+* physical constants are defined once (``speclight.constants``);
+* the estimators and the maps do not speak the command line: their errors name the Python
+  parameter (``grid_deg``), and ``speclight.cli`` says the flag (``--grid-deg``).
 """
 
 import ast
@@ -188,3 +190,14 @@ def test_physical_constants_are_defined_once():
     pattern = re.compile(r"(299[_ ]?792[_ ]?458|6\.62607015|149[_ ]?597[_ ]?870)")
     places = [str(p.relative_to(ROOT)) for p in ROOT.rglob("*.py") if pattern.search(p.read_text())]
     assert places == ["constants.py"]
+
+
+def test_cores_name_parameters_not_flags():
+    pattern = re.compile(r"""(field=|FIELD = )f?["']-""")
+    speaking = [
+        str(p.relative_to(ROOT))
+        for folder in ("estimate", "maps")
+        for p in (ROOT / folder).rglob("*.py")
+        if pattern.search(p.read_text())
+    ]
+    assert speaking == []

@@ -160,7 +160,7 @@ def test_extracted_laser_signatures_against_the_truth(tmp_path: Path, simulated:
     [
         ("cube-materials-laser", "sun", "NaN at every epoch (no Sun light); try --source laser"),
         ("cube-materials", "laser", "has no laser_reflectance_factor(time, band)"),
-        ("cube-materials", "lazer", "unknown source 'lazer' (choices: sun, laser)"),
+        ("cube-materials", "lazer", "--source = 'lazer': unknown source (choices: sun, laser)"),
     ],
 )
 def test_a_source_the_data_lack_is_refused(

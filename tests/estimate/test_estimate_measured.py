@@ -147,7 +147,7 @@ def test_binning_averages_rates_and_combines_sigmas(tmp_path):
         ["2020-01-01T00:00:01", "2020-01-01T00:00:03", "2020-01-01T00:00:04.5"], "datetime64[ns]"
     )
     np.testing.assert_array_equal(binned.time_utc, expected)
-    with pytest.raises(InputError, match="--bin-s"):
+    with pytest.raises(InputError, match="bin_s = "):  # the Python parameter, not the flag
         bin_light_curve(lc, 0.0)
 
 

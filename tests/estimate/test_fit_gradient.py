@@ -205,7 +205,7 @@ def test_gradient_method_refusals_name_the_reason():
     truth = simulate(parse_scenario(_cube(), source="truth")).dataset
     lc = _measured(truth)
     loaded = parse_scenario(_cube(), source="start")
-    with pytest.raises(InputError, match=r"--method = 'newton': give one of slsqp, gradient"):
+    with pytest.raises(InputError, match=r"method = 'newton': give one of slsqp, gradient"):
         fit_scenario(loaded, lc, free=("albedo", "roughness"), method="newton")
     path = replace_fields(loaded, {"render.mode": "path"})
     with pytest.raises(InputError, match="single-scattering render only"):

@@ -118,7 +118,7 @@ def test_a_chunk_above_the_memory_limit_is_refused_with_the_largest_that_fits(re
         <= limit
         < limits.chunk_bytes(loaded, fits + 1, geoms)
     )
-    assert message.startswith("--chunk: --chunk = 1000000: a chunk renders 1000000 directions")
+    assert message.startswith("chunk: chunk = 1000000: a chunk renders 1000000 directions")
     assert "GiB of memory, more than the limit" in message
 
 

@@ -39,17 +39,17 @@ def nside_for(n_directions: int) -> int:
     n = int(n_directions)
     if n < MIN_DIRECTIONS:
         raise InputError(
-            f"--directions = {n_directions} must be >= {MIN_DIRECTIONS} (HEALPix nside 1)",
-            field="--directions",
+            f"directions = {n_directions} must be >= {MIN_DIRECTIONS} (HEALPix nside 1)",
+            field="directions",
         )
     nside = 1
     while 12 * nside * nside < n:
         nside *= 2
     if nside > MAX_NSIDE:
         raise InputError(
-            f"--directions = {n_directions} needs HEALPix nside {nside}; accepted: at most "
+            f"directions = {n_directions} needs HEALPix nside {nside}; accepted: at most "
             f"{12 * MAX_NSIDE**2} directions (nside {MAX_NSIDE})",
-            field="--directions",
+            field="directions",
         )
     return nside
 

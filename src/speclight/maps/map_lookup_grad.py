@@ -116,9 +116,16 @@ def intensity_jacobian(
     """The map's interpolated channels (N, C), as :meth:`ReflectivityMap.intensity_1au`, and
     their derivatives (N, C, K) with respect to K parameters.
 
-    ``sun_body``, ``observer_body``: (N, 3) unit vectors in the body frame; ``d_sun``,
-    ``d_observer``: (N, 3, K) their derivatives (perpendicular to them: changes of
-    direction). NaN rows where the map gives NaN (phase angle 180 deg, NaN inputs).
+    NaN rows where the map gives NaN (phase angle 180 deg, NaN inputs).
+
+    Parameters
+    ----------
+    bmap
+        The map.
+    sun_body, observer_body
+        Unit vectors (N, 3) towards the Sun and the observer, body frame.
+    d_sun, d_observer
+        Their derivatives (N, 3, K) (perpendicular to them: changes of direction).
     """
     from astropy import units as u
     from astropy_healpix import bilinear_interpolation_weights

@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 import sys
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -108,23 +109,21 @@ def _num(x: float) -> float | None:
     return x if math.isfinite(x) else None
 
 
-def parse_free(text: str) -> tuple[str, ...]:
-    """``--free albedo,roughness`` -> the parameter names, checked."""
-    names = tuple(p.strip() for p in text.split(",") if p.strip())
-    bad = [p for p in names if p not in FREE_CHOICES]
-    if bad or not names:
+def check_free(free: Sequence[str]) -> tuple[str, ...]:
+    """The parameters to fit, checked: one or more of :data:`FREE_CHOICES`."""
+    names = tuple(free)
+    if not names or any(p not in FREE_CHOICES for p in names):
         raise InputError(
-            f"--free = {text!r}: give a comma-separated list of {', '.join(FREE_CHOICES)}",
-            field="--free",
+            f"free = {names!r}: give one or more of {', '.join(FREE_CHOICES)}", field="free"
         )
     return names
 
 
-def parse_method(text: str) -> str:
-    """``--method`` -> the method name, checked."""
-    if text not in METHODS:
-        raise InputError(f"--method = {text!r}: give one of {', '.join(METHODS)}", field="--method")
-    return text
+def check_method(method: str) -> str:
+    """The roughness fit's method, checked: one of :data:`METHODS`."""
+    if method not in METHODS:
+        raise InputError(f"method = {method!r}: give one of {', '.join(METHODS)}", field="method")
+    return method
 
 
 def rough_materials(loaded: LoadedScenario) -> list[str]:
@@ -177,9 +176,8 @@ def fit_scenario(
     """
     from speclight.simulation import simulate
 
-    for p in free:
-        parse_free(p)
-    parse_method(method)
+    check_free(free)
+    check_method(method)
     sc = loaded.scenario
     if sc.target is None:
         raise InputError("the scenario has no target to fit", field="target")
@@ -194,9 +192,9 @@ def fit_scenario(
     rough = rough_materials(loaded) if "roughness" in free else []
     if "roughness" in free and not rough:
         raise InputError(
-            "--free roughness: the scenario has no material with a roughness "
+            "free=roughness: the scenario has no material with a roughness "
             f"(bsdf {', '.join(ROUGH_BSDFS)})",
-            field="--free",
+            field="free",
         )
     if rough and method == "gradient":
         from speclight.estimate.fitting.roughness_gradient import gradient_problems
@@ -204,8 +202,8 @@ def fit_scenario(
         problems = gradient_problems(loaded, rough)
         if problems:
             raise InputError(
-                "--method gradient: " + "; ".join(problems) + " (use --method slsqp)",
-                field="--method",
+                "method='gradient': " + "; ".join(problems) + " (use method='slsqp')",
+                field="method",
             )
     base = _for_fitting(loaded)
     show = progress and sys.stderr.isatty()
@@ -224,13 +222,19 @@ def fit_scenario(
     notes: list[str] = []
     if rough:
         if method == "gradient":
-            fit = fit_rough_gradient(base, first, m, sigma, rough, "albedo" in free, show, bins)
+            fit = fit_rough_gradient(
+                base, first, m=m, sigma=sigma, rough=rough, fit_scale="albedo" in free,
+                show=show, bins=bins,
+            )  # fmt: skip
             method_text = (
                 "gradient: least squares (trust region) over log roughness with the analytic "
                 "Jacobian (variable projection), weighted least squares for scales"
             )
         else:
-            fit = fit_rough_slsqp(base, first, m, sigma, rough, "albedo" in free, show, scan, bins)
+            fit = fit_rough_slsqp(
+                base, first, m=m, sigma=sigma, rough=rough, fit_scale="albedo" in free,
+                show=show, scan=scan, bins=bins,
+            )  # fmt: skip
             method_text = (
                 "SLSQP over roughness (variable projection), weighted least squares for scales"
             )
@@ -245,7 +249,7 @@ def fit_scenario(
         model = ds["count_rate"].transpose("time", "band").values.astype(float)
         model = np.where(usable[:, None], model, np.nan)
         if "albedo" not in free:
-            raise InputError("--free must include albedo or roughness", field="--free")
+            raise InputError("`free` must include albedo or roughness", field="free")
         if bins is not None:
             model = bins.mean(model)
         m_fit, s_fit = (m, sigma) if bins is None else (bins.mean(m), bins.sigma(sigma))
@@ -367,8 +371,8 @@ __all__ = [
     "FREE_CHOICES",
     "METHODS",
     "FitResult",
+    "check_free",
+    "check_method",
     "fit_scenario",
-    "parse_free",
-    "parse_method",
     "rough_materials",
 ]

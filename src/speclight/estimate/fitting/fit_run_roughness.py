@@ -32,6 +32,7 @@ def _with_roughness(loaded: LoadedScenario, values: dict[str, float]) -> LoadedS
 def fit_rough_slsqp(
     base: LoadedScenario,
     first: Any,
+    *,
     m: F64,
     sigma: F64,
     rough: list[str],
@@ -40,8 +41,28 @@ def fit_rough_slsqp(
     scan: bool = True,
     bins: EpochBins | None = None,
 ) -> Any:
-    """SLSQP over the roughness (:mod:`.roughness_fit`) of the measurements ``m`` (N, B) and
-    ``sigma``, simulated at their epochs; ``bins``: both averaged over them (:mod:`.fit_bins`)."""
+    """SLSQP over the roughness (:mod:`.roughness_fit`), the scenario simulated at the
+    measured epochs for every roughness value tried.
+
+    Parameters
+    ----------
+    base
+        The scenario to fit (its roughness values are the start).
+    first
+        The simulation of ``base`` at the measured epochs (its geometry is reused).
+    m, sigma
+        Measured count rates and their standard deviations (N, B) [s-1]; NaN: not used.
+    rough
+        Names of the materials whose roughness is fitted.
+    fit_scale
+        Fit a scale per band too (``free`` includes ``albedo``).
+    show
+        Print the iterations on a terminal.
+    scan
+        With one roughness: scan the bounds before SLSQP.
+    bins
+        Rates, model and measurements averaged over these bins (:mod:`.fit_bins`), or None.
+    """
     from speclight.simulation import simulate
 
     usable, start = _usable_and_start(base, m, rough)
@@ -78,6 +99,7 @@ def fit_rough_slsqp(
 def fit_rough_gradient(
     base: LoadedScenario,
     first: Any,
+    *,
     m: F64,
     sigma: F64,
     rough: list[str],
@@ -85,8 +107,25 @@ def fit_rough_gradient(
     show: bool,
     bins: EpochBins | None = None,
 ) -> Any:
-    """The trust-region fit with analytic derivatives (:mod:`.gradient_fit`) of ``m`` (N, B)
-    and ``sigma``; ``bins``: rates, derivatives and measurements averaged over them."""
+    """The trust-region fit with analytic derivatives (:mod:`.gradient_fit`).
+
+    Parameters
+    ----------
+    base
+        The scenario to fit (its roughness values are the start).
+    first
+        The simulation of ``base`` at the measured epochs (its geometry is reused).
+    m, sigma
+        Measured count rates and their standard deviations (N, B) [s-1]; NaN: not used.
+    rough
+        Names of the materials whose roughness is fitted.
+    fit_scale
+        Fit a scale per band too (``free`` includes ``albedo``).
+    show
+        Print the iterations on a terminal.
+    bins
+        Rates, derivatives and measurements averaged over these bins, or None.
+    """
     from speclight.estimate.fitting.gradient_fit import fit_roughness_gradient
     from speclight.estimate.fitting.roughness_gradient import RoughnessRates
 

@@ -45,7 +45,19 @@ MAX_EVALUATIONS = 60
 def projected_residuals(
     c: F64, dc: F64, measured: F64, sigma: F64, fit_scale: bool
 ) -> tuple[F64, F64, F64]:
-    """Residuals (N*B,), their Jacobian in alpha (N*B, K) and the scales (B,) (module doc)."""
+    """Residuals (N*B,), their Jacobian in alpha (N*B, K) and the scales (B,) (module doc).
+
+    Parameters
+    ----------
+    c
+        Model count rates (N, B) [s-1] at the roughness values ``alpha``.
+    dc
+        Their derivatives with respect to the K roughness values (N, B, K) [s-1].
+    measured, sigma
+        Measured rates and their standard deviations (N, B) [s-1]; NaN: not used.
+    fit_scale
+        Scales in closed form per band (``False``: fixed at 1).
+    """
     w, cc, m = masked_weights(c, measured, sigma)
     d = np.where(w[None] > 0, np.nan_to_num(dc), 0.0)
     sw = np.sqrt(w)

@@ -289,6 +289,21 @@ def chi2_profile(
     A quadratic minimum rises by PROFILE_SIGMAS^2 = 4 on both sides. Much less means that the
     linearised std is wrong: chi2 is flat on that side (the data give only a bound), or the
     fit stopped on a slope (negative: chi2 is lower there).
+
+    Parameters
+    ----------
+    chi2
+        Chi-square as a function of the roughness values (K,).
+    alpha, std
+        The fitted roughness values and their standard deviations (K,).
+    bounds
+        The roughness bounds (low, high).
+    n_data
+        Measurements fitted (finite entries).
+    fit_scale
+        Whether a scale per band was fitted (its parameters count in the dof).
+    chi2_bands
+        The chi-square per band (B,): its size is the number of scales fitted.
     """
     lo, hi = bounds
     best = chi2(alpha)

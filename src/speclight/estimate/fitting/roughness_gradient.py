@@ -44,7 +44,7 @@ def gradient_problems(loaded: LoadedScenario, rough: list[str]) -> list[str]:
     if sc.render.mode != "single":
         out.append(
             f"render.mode is '{sc.render.mode}': derivatives exist for the single-scattering "
-            "render only (set render.mode: single, or use --method slsqp)"
+            "render only (set render.mode: single, or use method='slsqp')"
         )
     if sc.target is not None:
         target = build_target(loaded)

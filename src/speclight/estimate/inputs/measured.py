@@ -136,15 +136,15 @@ def read_measured(path: str | Path, source: str = "sun") -> MeasuredLightCurve:
     """
     p = Path(path)
     if source not in ("sun", "laser"):
-        raise InputError(f"--source = '{source}' (choices: sun, laser)", field="--source")
+        raise InputError(f"source = '{source}' (choices: sun, laser)", field="source")
     if p.suffix.lower() in (".nc", ".nc4", ".netcdf", ".h5"):
         return _read_netcdf(p, source)
     if source == "laser":
         raise InputError(
-            "--source laser reads the laser return rates of a speclight NetCDF; a CSV holds "
-            "count rates only (use --source sun)",
+            "source='laser' reads the laser return rates of a speclight NetCDF; a CSV holds "
+            "count rates only (use source='sun')",
             source=str(p),
-            field="--source",
+            field="source",
         )
     c = read_csv_columns(p)
     ones = np.ones(c.time_utc.size, np.int64)
@@ -185,10 +185,10 @@ def measured_from_dataset(ds: xr.Dataset, src: str, source: str = "sun") -> Meas
     if source == "laser":
         if "return_rate" not in ds:
             raise InputError(
-                "--source laser: no laser return rates (return_rate) in it: the scenario "
-                "had no lasers (use --source sun)",
+                "source='laser': no laser return rates (return_rate) in it: the scenario "
+                "had no lasers (use source='sun')",
                 source=src,
-                field="--source",
+                field="source",
             )
         name = "laser_reflectance_factor"
     if name not in ds or "band" not in ds.coords:
@@ -250,7 +250,7 @@ def bin_light_curve(lc: MeasuredLightCurve, bin_s: float) -> MeasuredLightCurve:
     measurements), ``n_samples`` the number of epochs averaged. Empty bins are left out.
     """
     if not (np.isfinite(bin_s) and bin_s > 0):
-        raise InputError(f"--bin-s = {bin_s!r} must be a duration > 0 s", field="--bin-s")
+        raise InputError(f"bin_s = {bin_s!r} must be a duration > 0 s", field="bin_s")
     dt = (lc.time_utc - lc.time_utc[0]) / np.timedelta64(1, "s")
     key = np.floor(dt / bin_s).astype(np.int64)
     uniq, counts = np.unique(key, return_counts=True)

@@ -56,7 +56,16 @@ def dataset_namers(t: NDArray[np.datetime64], bands: list[str]) -> tuple[Namer, 
 def check_epoch(t: np.datetime64, where: str, text: str, src: str, field: str) -> np.datetime64:
     """``t`` (any unit) as ``datetime64[ns]`` if it lies within the ephemeris span.
 
-    ``where`` names the place (``"line 5"``), ``text`` the time as given.
+    Parameters
+    ----------
+    t
+        The epoch (UTC).
+    where
+        The place in the file, for the message (``"line 5"``).
+    text
+        The time as given.
+    src, field
+        The file and the field the error names.
     """
     if not FIRST_EPOCH <= t.astype("datetime64[s]") <= LAST_EPOCH:
         raise InputError(
@@ -106,8 +115,21 @@ def check_rates(
     what: str = "rate",
 ) -> None:
     """Refuse infinite, subnormal and (above ``max_abs``) huge values of ``rate`` (N, B);
-    NaN is "no measurement". ``what`` names the values (``"rate"``), ``max_abs`` None: no
-    upper bound."""
+    NaN is "no measurement".
+
+    Parameters
+    ----------
+    rate
+        The values (N, B) [s-1].
+    row, column
+        Name an entry's row (``"line 5"``) and column for the message.
+    src, field
+        The file and the field the error names.
+    max_abs
+        Largest magnitude accepted [s-1]; None: no upper bound.
+    what
+        What the values are, for the message (``"rate"``).
+    """
     size = np.abs(rate)
     bad = np.isinf(rate) | ((size > 0) & (size < TINY))
     if max_abs is not None:
@@ -126,7 +148,17 @@ def check_rates(
 
 def check_sigmas(sigma: F64, rate: F64, row: Namer, column: Namer, src: str, field: str) -> None:
     """Refuse sigmas (N, B) that are infinite, not above 0, below ``SIGMA_FLOOR x |rate|`` or
-    above :data:`MAX_RATE_PER_S`; NaN is "not given"."""
+    above :data:`MAX_RATE_PER_S`; NaN is "not given".
+
+    Parameters
+    ----------
+    sigma, rate
+        The standard deviations and the rates they belong to (N, B) [s-1].
+    row, column
+        Name an entry's row and column for the message.
+    src, field
+        The file and the field the error names.
+    """
     given = ~np.isnan(sigma)
     with np.errstate(invalid="ignore"):
         floor = SIGMA_FLOOR * np.where(np.isfinite(rate), np.abs(rate), 0.0)
@@ -150,7 +182,19 @@ def check_sigmas(sigma: F64, rate: F64, row: Namer, column: Namer, src: str, fie
 
 
 def check_signal(rate: F64, names: list[str], src: str, field: str, what: str = "rate") -> None:
-    """Refuse a band (column ``j`` of ``rate``) without any value above 0."""
+    """Refuse a band (column ``j`` of ``rate``) without any value above 0.
+
+    Parameters
+    ----------
+    rate
+        The values (N, B) [s-1].
+    names
+        The band names (B,).
+    src, field
+        The file and the field the error names.
+    what
+        What the values are, for the message.
+    """
     with np.errstate(invalid="ignore"):
         some = np.any(rate > 0, axis=0)
     if not np.all(some):
@@ -166,7 +210,19 @@ def check_signal(rate: F64, names: list[str], src: str, field: str, what: str = 
 def no_usable_epochs(
     n_epochs: int, scenario: str, src: str, field: str = "MEASURED", what: str = "measured"
 ) -> InputError:
-    """The error for measurements none of whose epochs the scenario can model."""
+    """The error for measurements none of whose epochs the scenario can model.
+
+    Parameters
+    ----------
+    n_epochs
+        Epochs measured.
+    scenario
+        The scenario's source, for the message.
+    src, field
+        The file and the field the error names.
+    what
+        What the epochs are (``"measured"``).
+    """
     return InputError(
         f"none of the {n_epochs} {what} epochs is usable: the scenario {scenario} has the "
         "target below the minimum elevation, in daylight, unlit or without an orbit at every "

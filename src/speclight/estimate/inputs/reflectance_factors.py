@@ -127,6 +127,7 @@ def bin_factors(time: NDArray[np.datetime64], values: F64, bin_s: float, src: st
 def read_reflectance_factors(
     path: str | Path,
     loaded: LoadedScenario | None = None,
+    *,
     bin_s: float | None = None,
     progress: bool = False,
     light: str | None = None,
@@ -162,9 +163,9 @@ def read_reflectance_factors(
     if p.suffix.lower() not in (".nc", ".nc4", ".netcdf", ".h5"):
         if loaded is None:
             raise InputError(
-                f"{src} is a CSV of count rates: give --scenario SCENARIO.yaml to turn them "
+                f"{src} is a CSV of count rates: give loaded=SCENARIO to turn them "
                 "into reflectance factors (eq. 5 needs the geometry, Sun and instrument)",
-                field="--scenario",
+                field="loaded",
             )
         lc = read_measured(p)
         return _factors_from_rates(lc, loaded, bin_s, progress, light)
@@ -175,7 +176,7 @@ def read_reflectance_factors(
         raise InputError(
             f"the dataset has no {var}(time, band) (simulate writes it for a "
             f"{'laser-lit' if chosen == 'laser' else 'sunlit'} target with bands); "
-            "give a CSV of rates with --scenario instead",
+            "give a CSV of rates with loaded=SCENARIO instead",
             source=src,
             field=FIELD,
         )
@@ -185,9 +186,9 @@ def read_reflectance_factors(
         other = "sun" if chosen == "laser" else "laser"
         raise InputError(
             f"{var} is NaN at every epoch (no {'laser' if chosen == 'laser' else 'Sun'} "
-            f"light); try --source {other}",
+            f"light); try light='{other}'",
             source=src,
-            field="--source",
+            field="light",
         )
     checked = measured_from_dataset(ds, src, chosen)  # the checks of every MEASURED reader
     row, column = dataset_namers(checked.time_utc, checked.band_names)
@@ -228,9 +229,9 @@ def dataset_scenario(ds: xr.Dataset, src: str) -> LoadedScenario:
     if "scenario_yaml" not in ds.attrs:
         raise InputError(
             "the dataset does not carry its scenario (attribute scenario_yaml): give "
-            "--scenario SCENARIO.yaml",
+            "loaded=SCENARIO",
             source=src,
-            field="--scenario",
+            field="loaded",
         )
     from speclight.scenario import parse_scenario
 
@@ -260,7 +261,7 @@ def _factors_from_rates(
         light = "sun" if loaded.scenario.illumination.sun else "laser"
     if light == "sun":
         if not loaded.scenario.illumination.sun:
-            raise InputError("--source sun but the scenario has the Sun off", field="--source")
+            raise InputError("light='sun' but the scenario has the Sun off", field="light")
         source = sun_source_W_m2_nm(ds)
     else:
         source = laser_source_W_m2_nm(ds, loaded)

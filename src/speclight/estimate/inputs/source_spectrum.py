@@ -131,7 +131,7 @@ def laser_source_W_m2_nm(ds: xr.Dataset, loaded: LoadedScenario) -> F64:
         raise InputError(
             "the dataset has no laser_irradiance(time, laser) and transmission: it was not "
             "simulated with lasers",
-            field="--source",
+            field="light",
         )
     wl = ds["wavelength"].values
     return coaxial_laser_source_W_m2_nm(
@@ -149,8 +149,8 @@ def default_light(ds: xr.Dataset) -> Light:
 
 
 def check_light(light: str | None) -> None:
-    """Refuse an unknown ``--source``."""
+    """Refuse an unknown ``light`` (the command line's ``--source``)."""
     if light is not None and light not in LIGHTS:
         raise InputError(
-            f"unknown source '{light}' (choices: {', '.join(LIGHTS)})", field="--source"
+            f"light = '{light}': unknown source (choices: {', '.join(LIGHTS)})", field="light"
         )

@@ -129,7 +129,22 @@ def rotation_period(
     min_period_s: float,
     if_symmetric: IfSymmetric = "auto",
 ) -> RotationDecision:
-    """Decide between the photometric and the rotation period (module docstring)."""
+    """Decide between the photometric and the rotation period (module docstring).
+
+    Parameters
+    ----------
+    series
+        The light curves.
+    period_s
+        The photometric period (the periodogram's best) [s].
+    harmonics
+        Harmonics of the model folded at ``period_s`` and ``2 period_s``.
+    min_period_s
+        Shortest period searched [s].
+    if_symmetric
+        ``auto``, ``double`` or ``keep``: the rotation period when the halves of the 2P fold
+        agree.
+    """
     tests: list[HalvesTest] = []
     p_ph, factor = period_s, 1.0
     for _ in range(2):  # the best peak may be a multiple of the photometric period

@@ -73,7 +73,21 @@ class BootstrapMaxima:
 def bootstrap_maxima(
     series: BandSeries, frequency_hz: F64, harmonics: int, draws: int = DRAWS, seed: int = SEED
 ) -> BootstrapMaxima:
-    """Periodogram maxima of ``draws`` permutations of ``series`` (module docstring)."""
+    """Periodogram maxima of ``draws`` permutations of ``series`` (module docstring).
+
+    Parameters
+    ----------
+    series
+        The light curves.
+    frequency_hz
+        The frequency grid searched [Hz].
+    harmonics
+        Harmonics of the periodogram's model.
+    draws
+        Permutations.
+    seed
+        Seed of the permutations.
+    """
     rng = np.random.default_rng(seed)
     maxima = np.empty(draws)
     for i in range(draws):

@@ -280,6 +280,7 @@ class PeriodResult:
 
 
 def check_period_options(
+    *,
     min_period_s: float | None,
     max_period_s: float | None,
     harmonics: int,
@@ -287,7 +288,21 @@ def check_period_options(
     seed: int,
     synodic: str,
 ) -> None:
-    """Refuse options outside their ranges (before any file is read)."""
+    """Refuse options outside their ranges (before any file is read).
+
+    Parameters
+    ----------
+    min_period_s, max_period_s
+        The period range searched [s], or None (the defaults).
+    harmonics
+        Harmonics of the periodogram's model, 1..20.
+    draws
+        Bootstrap draws of the false-alarm probability, 1..:data:`MAX_DRAWS`.
+    seed
+        Seed of the bootstrap, >= 0.
+    synodic
+        ``auto``, ``report`` or ``bisector``.
+    """
     if not 1 <= harmonics <= 20:
         raise InputError(f"harmonics = {harmonics} must be 1..20", field="harmonics")
     for name, v in (("min_period_s", min_period_s), ("max_period_s", max_period_s)):
@@ -343,9 +358,22 @@ def _period_range(
 
 
 def check_periodogram_cost(
-    series: BandSeries, min_p: float, max_p: float, harmonics: int, draws: int
+    series: BandSeries, *, min_p: float, max_p: float, harmonics: int, draws: int
 ) -> None:
-    """Refuse a frequency grid and bootstrap that cannot finish (:mod:`.limits`)."""
+    """Refuse a frequency grid and bootstrap that cannot finish
+    (:mod:`speclight.estimate.inputs.cost_limits`).
+
+    Parameters
+    ----------
+    series
+        The light curves.
+    min_p, max_p
+        The period range searched [s].
+    harmonics
+        Harmonics of the periodogram's model.
+    draws
+        Bootstrap draws.
+    """
     from speclight.estimate.inputs.cost_limits import (
         ANNOUNCE_SECONDS,
         MAX_SECONDS,
@@ -383,6 +411,7 @@ def check_periodogram_cost(
 
 def estimate_period(
     measured: str | Path,
+    *,
     loaded: LoadedScenario | None = None,
     bands: list[str] | None = None,
     min_period_s: float | None = None,
@@ -397,14 +426,50 @@ def estimate_period(
 ) -> PeriodResult:
     """Rotation period of the light curves in ``measured`` (module docstring).
 
-    ``loaded``: the scenario of the geometry (for a NetCDF default: the one it carries); one
-    given here is checked against the measurements (:func:`.scenario_match.check_scenario_sees`).
     Errors name the Python parameters (``min_period_s``, ``draws``, ...).
+
+    Parameters
+    ----------
+    measured
+        Light curves: a speclight NetCDF or a CSV of count rates
+        (:func:`speclight.estimate.read_measured`).
+    loaded
+        The scenario of the geometry, for the synodic correction (for a NetCDF default: the
+        one it carries); one given here is checked against the measurements
+        (:func:`speclight.estimate.inputs.geometry_match.check_scenario_sees`).
+    bands
+        Bands to use (default: all).
+    min_period_s, max_period_s
+        The period range searched [s] (default ``2 K dt`` and a third of the span).
+    harmonics
+        Harmonics ``K`` of the periodogram's model.
+    bin_s
+        Average the epochs into bins of this many seconds.
+    draws
+        Bootstrap draws of the false-alarm probability.
+    seed
+        Seed of the bootstrap.
+    if_symmetric
+        ``auto``, ``double`` or ``keep``: the rotation period when the halves of the 2P fold
+        agree (docs/period.md).
+    synodic
+        ``auto``, ``report`` or ``bisector``: the synodic correction applied, only reported,
+        or applied where the median phase angle is at most 30 deg.
+    source
+        ``sun`` (the count rates) or ``laser`` (a NetCDF's laser return rates).
+
+    Returns
+    -------
+    PeriodResult
+        The periods, their uncertainties and the decisions; ``.to_json()`` is PERIOD.json.
     """
     from speclight.estimate.inputs.cost_limits import check_bin_s
     from speclight.estimate.period.period_geometry import pass_geometry
 
-    check_period_options(min_period_s, max_period_s, harmonics, draws, seed, synodic)
+    check_period_options(
+        min_period_s=min_period_s, max_period_s=max_period_s, harmonics=harmonics,
+        draws=draws, seed=seed, synodic=synodic,
+    )  # fmt: skip
     lc = read_measured(measured, source)
     if bands:
         lc = lc.select_bands(list(bands), subset=True)
@@ -428,7 +493,7 @@ def estimate_period(
 
         check_scenario_sees(given, measured, lc.time_utc[weight > 0], source)
     min_p, max_p = _period_range(series, min_period_s, max_period_s, harmonics)
-    check_periodogram_cost(series, min_p, max_p, harmonics, draws)
+    check_periodogram_cost(series, min_p=min_p, max_p=max_p, harmonics=harmonics, draws=draws)
     freq = frequency_grid(series.span_s, min_p, max_p, SAMPLES_PER_PEAK)
     power = multiband_power(series, freq, harmonics)
     if not np.any(np.isfinite(power)):

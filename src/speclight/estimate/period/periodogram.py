@@ -152,10 +152,23 @@ def harmonic_chi2(
     phase_rad: F64 | None = None,
     trend_degree: int = 0,
 ) -> tuple[float, int, list[F64]]:
-    """Weighted least-squares fit of the harmonics ``orders`` of ``frequency_hz`` per band
-    (``phase_rad``: per point, see :func:`design_matrix`), with a polynomial in time of
-    ``trend_degree`` per band beside the constant (the coefficients of the harmonics come
-    first, the trend's last).
+    """Weighted least-squares fit of the harmonics ``orders`` of ``frequency_hz`` per band,
+    with a polynomial in time per band beside the constant (the coefficients of the
+    harmonics come first, the trend's last).
+
+    Parameters
+    ----------
+    series
+        The light curves.
+    frequency_hz
+        The fundamental frequency [Hz].
+    orders
+        The harmonics fitted (1 = the fundamental).
+    phase_rad
+        A phase per point added to the harmonics' argument [rad] (see
+        :func:`design_matrix`), or None.
+    trend_degree
+        Degree of the polynomial trend in time per band (0: the constant alone).
 
     Returns
     -------
@@ -231,6 +244,21 @@ def refine_peak(
     Recipes, 15.6). That rule assumes independent residuals; a light curve that changes over
     a pass leaves residuals correlated over many epochs, so ``sigma_f`` is multiplied by
     :func:`red_noise_inflation`, from the residuals' spectrum near the harmonics.
+
+    Parameters
+    ----------
+    series
+        The light curves.
+    frequency_hz
+        The peak's frequency on the grid [Hz].
+    orders
+        The harmonics of the model.
+    phase_rad
+        A phase per point added to the harmonics' argument [rad], or None.
+    trend_degree
+        Degree of the polynomial trend in time per band.
+    within
+        The searched frequency range (low, high) [Hz], or None.
     """
     from scipy.optimize import minimize_scalar
 
@@ -276,6 +304,19 @@ def red_noise_inflation(
     level of Montgomery & O'Donoghue 1999, DSSN 13, 28, as a ratio to the white level). The
     factor is ``sqrt(sum w_k / sum (w_k / R_k))`` with ``w_k = k^2 A_k^2``, the amplitudes
     ``A_k`` averaged over the bands with weights ``sum 1/dy^2``; it is not allowed below 1.
+
+    Parameters
+    ----------
+    series
+        The light curves.
+    frequency_hz
+        The fitted frequency [Hz].
+    orders
+        The harmonics of the model.
+    coefs
+        The fit's coefficients per band (:func:`harmonic_chi2`).
+    residuals
+        The normalised residuals, in the order of the series' points.
     """
     from astropy.timeseries import LombScargle
 
@@ -315,7 +356,23 @@ def residual_lag1_correlation(
 ) -> tuple[float, F64]:
     """Lag-1 autocorrelation of the normalised residuals, consecutive points of each band
     pooled (``sum r_i r_(i+1) / sum r_i^2``, capped at 0.99), and the normalised residuals
-    (in the order of the series' points)."""
+    (in the order of the series' points).
+
+    Parameters
+    ----------
+    series
+        The light curves.
+    frequency_hz
+        The fitted frequency [Hz].
+    orders
+        The harmonics of the model.
+    coefs
+        The fit's coefficients per band (:func:`harmonic_chi2`).
+    phase_rad
+        A phase per point added to the harmonics' argument [rad], or None.
+    trend_degree
+        Degree of the polynomial trend in time per band.
+    """
     num = den = 0.0
     out = np.zeros(series.y.size)
     for b, beta in enumerate(coefs):

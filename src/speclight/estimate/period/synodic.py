@@ -136,8 +136,29 @@ def sidereal_period(
     not_applied_why: str = "not asked for (--synodic bisector applies it)",
 ) -> SynodicCorrection:
     """The sidereal period by the bisector-phase fit (module docstring); without an axis,
-    only the bound; with ``apply=False`` the fit is reported but not applied (with
-    ``not_applied_why`` in its ``method``)."""
+    only the bound.
+
+    Parameters
+    ----------
+    series
+        The light curves.
+    synodic_period_s
+        The period found by the periodogram [s].
+    harmonics
+        Harmonics of the model.
+    t_s
+        Epochs of the geometry [s], on the time axis of ``series``.
+    pab_gcrs
+        The phase-angle bisector at every epoch (N, 3), GCRS unit vectors.
+    weight
+        Weight of every epoch in the bisector's mean rate (N,).
+    axis_gcrs
+        The spin axis (3,), GCRS unit vector, or None (unknown: only the bound).
+    apply
+        Apply the fit to the period (``False``: reported, not applied).
+    not_applied_why
+        Why it is not applied, written into the correction's ``method``.
+    """
     speed = bisector_angular_speed(t_s, pab_gcrs, weight)
     bound = float(synodic_period_s**2 * speed / (2 * np.pi))
     if axis_gcrs is None:

@@ -31,7 +31,7 @@ I64 = NDArray[np.int64]
 MAX_NSIDE = 256
 
 
-def check_nside(nside: int, field: str = "--nside") -> int:
+def check_nside(nside: int, field: str = "nside") -> int:
     """``nside`` if it is a power of 2 from 1 to ``MAX_NSIDE``, else an :class:`InputError`."""
     if isinstance(nside, bool) or not isinstance(nside, (int, np.integer)):
         raise InputError(f"{field} = {nside!r} must be an integer power of 2", field=field)

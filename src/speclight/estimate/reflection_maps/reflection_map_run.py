@@ -114,7 +114,10 @@ def reflection_map_measured(
     """
     nside = check_nside(nside)
     check_light(light)
-    check_unmix_options(endmembers or [SCENARIO_ENDMEMBERS], None, None, method, light)
+    check_unmix_options(
+        endmembers=endmembers or [SCENARIO_ENDMEMBERS], extract=None, n=None, method=method,
+        light=light,
+    )  # fmt: skip
     p = Path(measured)
     is_nc = p.suffix.lower() in NETCDF_SUFFIXES
     if endmembers == [SCENARIO_ENDMEMBERS] and loaded is None and is_nc:
@@ -122,7 +125,7 @@ def reflection_map_measured(
         loaded = dataset_scenario(head, str(p))
     if not is_nc and loaded is not None:  # the scenario's geometry: can it be the target?
         _check_csv_scenario(p, loaded, light)
-    data = read_reflectance_factors(p, loaded, bin_s, progress, light)
+    data = read_reflectance_factors(p, loaded, bin_s=bin_s, progress=progress, light=light)
     direction, offset, origin = _directions(p, is_nc, data, loaded, bin_s)
     rmap = reflection_map(direction, data.factor, nside)
     if not np.any(rmap.n_samples > 0):
@@ -148,7 +151,7 @@ def reflection_map_measured(
         )
     if endmembers:
         if endmembers == [SCENARIO_ENDMEMBERS] and loaded is None:
-            raise InputError("--endmembers scenario needs --scenario SCENARIO.yaml", field="-e")
+            raise InputError("endmembers=['scenario'] needs loaded=SCENARIO", field="endmembers")
         ds = _with_abundance(ds, data, rmap.pixel, endmembers, method, loaded)
     return ds
 
@@ -194,10 +197,10 @@ def _directions(
             return unit_vectors(d), offset, f"{p}: {var}"
         if loaded is None:
             raise InputError(
-                f"the dataset has no {var}(time, xyz): give --scenario SCENARIO.yaml for the "
+                f"the dataset has no {var}(time, xyz): give loaded=SCENARIO for the "
                 "geometry at its epochs",
                 source=str(p),
-                field="--scenario",
+                field="loaded",
             )
     assert loaded is not None  # a CSV without a scenario is refused when read
     from speclight.simulation.geometry_stage import scenario_geometry
@@ -308,7 +311,7 @@ def _with_abundance(
         raise InputError(
             f"{len(members.names)} endmembers is more than the {n_bands} bands; give at most "
             f"{n_bands}",
-            field="--endmembers",
+            field="endmembers",
         )
     n_pix = ds.sizes["pixel"]
     # unmix the mapped pixels only (their signatures: the mean over each pixel's epochs)

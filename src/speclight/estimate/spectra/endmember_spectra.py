@@ -89,12 +89,12 @@ def endmembers_from_files(
     if twice:
         raise InputError(
             f"endmember name(s) {', '.join(twice)} given twice (names are the file stems)",
-            field="--endmembers",
+            field="endmembers",
         )
     from speclight.target.reflectance import Reflectance
 
     spectra = [
-        Reflectance.table_file(p, field="--endmembers").evaluate(bands.wavelength_nm) for p in paths
+        Reflectance.table_file(p, field="endmembers").evaluate(bands.wavelength_nm) for p in paths
     ]
     return _signatures(names, np.array(spectra, dtype=float), bands, source_W_m2_nm)
 
@@ -126,7 +126,7 @@ def endmembers_from_scenario(
     from speclight.simulation.reflection import build_target
 
     if loaded.scenario.target is None:
-        raise InputError("the scenario has no target materials", field="--endmembers")
+        raise InputError("the scenario has no target materials", field="endmembers")
     target = build_target(loaded)
     names: list[str] = []
     spectra: list[F64] = []

@@ -54,47 +54,60 @@ from speclight.io.user_dataset import read_user_dataset
 if TYPE_CHECKING:
     from speclight.scenario import LoadedScenario
 
-#: ``--endmembers`` value that takes the scenario's materials.
+#: ``endmembers`` value that takes the scenario's materials.
 SCENARIO_ENDMEMBERS = "scenario"
 
 
 def check_unmix_options(
+    *,
     endmembers: list[str] | None,
     extract: str | None,
     n: int | None,
     method: str,
     light: str | None = None,
 ) -> None:
-    """Refuse inconsistent options before any work (one-line :class:`InputError`)."""
+    """Refuse inconsistent options before any work (one-line :class:`InputError`).
+
+    Parameters
+    ----------
+    endmembers
+        Endmember spectrum files, or ``["scenario"]``; or None with ``extract``.
+    extract
+        ``atgp``, ``pca`` or ``nfindr``, or None with ``endmembers``.
+    n
+        Endmembers to extract (with ``extract`` only).
+    method
+        The unmixing method (:data:`speclight.estimate.UNMIX_METHODS`).
+    light
+        ``sun``, ``laser`` or None (what the data have).
+    """
     check_light(light)
     if method not in UNMIX_METHODS:
         raise InputError(
             f"unknown method '{method}'{did_you_mean(method, UNMIX_METHODS)} "
             f"(choices: {', '.join(UNMIX_METHODS)})",
-            field="--method",
+            field="method",
         )
     if bool(endmembers) == (extract is not None):
         raise InputError(
-            "give --endmembers E1.csv E2.csv ... (or --endmembers scenario) or "
-            "--extract atgp|pca|nfindr --n K, one of them",
-            field="--endmembers",
+            "give endmembers=[E1.csv, E2.csv, ...] (or endmembers=['scenario']) or "
+            "extract=atgp|pca|nfindr with n=K, one of them",
+            field="endmembers",
         )
     if extract is not None:
         if extract not in ENDMEMBER_METHODS:
             raise InputError(
                 f"unknown extraction '{extract}'{did_you_mean(extract, ENDMEMBER_METHODS)} "
                 f"(choices: {', '.join(ENDMEMBER_METHODS)})",
-                field="--extract",
+                field="extract",
             )
         if n is None:
-            raise InputError(
-                f"--extract {extract} needs --n K (the number of endmembers)", field="--n"
-            )
+            raise InputError(f"extract='{extract}' needs n=K (the number of endmembers)", field="n")
         if n < 1:
-            raise InputError(f"--n = {n} must be >= 1", field="--n")
+            raise InputError(f"n = {n} must be >= 1", field="n")
     elif n is not None:
         raise InputError(
-            "--n is the number of endmembers to extract; use it with --extract", field="--n"
+            "`n` is the number of endmembers to extract; use it with `extract`", field="n"
         )
 
 
@@ -141,28 +154,26 @@ def unmix_measured(
         Inconsistent options, a bad file, more endmembers than bands, signatures that
         cannot be told apart.
     """
-    check_unmix_options(endmembers, extract, n, method, light)
+    check_unmix_options(endmembers=endmembers, extract=extract, n=n, method=method, light=light)
     if endmembers == [SCENARIO_ENDMEMBERS] and loaded is None:
         if Path(measured).suffix.lower() not in (".nc", ".nc4", ".netcdf", ".h5"):
-            raise InputError(
-                "--endmembers scenario needs --scenario SCENARIO.yaml", field="--scenario"
-            )
+            raise InputError("endmembers=['scenario'] needs loaded=SCENARIO", field="loaded")
         head = read_user_dataset(measured, "MEASURED", what="measurements", variables=())
         if "scenario_yaml" not in head.attrs:
             raise InputError(
-                "--endmembers scenario needs --scenario SCENARIO.yaml (the dataset does "
+                "endmembers=['scenario'] needs loaded=SCENARIO (the dataset does "
                 "not carry the scenario it was simulated from)",
-                field="--scenario",
+                field="loaded",
             )
         loaded = dataset_scenario(head, str(measured))
-    data = read_reflectance_factors(measured, loaded, bin_s, progress, light)
+    data = read_reflectance_factors(measured, loaded, bin_s=bin_s, progress=progress, light=light)
     n_bands = len(data.bands.band_names)
     if extract is not None:
         assert n is not None
         if n > n_bands:
             raise InputError(
-                f"--n = {n} endmembers is more than the {n_bands} bands; ask for --n <= {n_bands}",
-                field="--n",
+                f"n = {n} endmembers is more than the {n_bands} bands; ask for `n` <= {n_bands}",
+                field="n",
             )
         found = extract_endmembers(data.factor, n, extract)  # type: ignore[arg-type]
         names = [f"{extract}-{k + 1}" for k in range(n)]
@@ -182,7 +193,7 @@ def unmix_measured(
             raise InputError(
                 f"{len(members.names)} endmembers is more than the {n_bands} bands: the "
                 f"contributions are not determined; give at most {n_bands}",
-                field="--endmembers",
+                field="endmembers",
             )
     sig = members.signatures if members.signatures_epoch is None else members.signatures_epoch
     result = unmix_per_epoch(data.factor, sig, method)  # type: ignore[arg-type]
@@ -202,7 +213,7 @@ def check_distinct(members: Endmembers) -> None:
         raise InputError(
             f"endmembers '{members.names[i]}' and '{members.names[j]}' have proportional band "
             "signatures (the same spectral shape): unmixing cannot tell them apart; drop one",
-            field="--endmembers",
+            field="endmembers",
         )
 
 

@@ -137,7 +137,26 @@ def grid_errors(
     progress: Callable[[int, int], None] | None = None,
     ranging: RangingTerm | None = None,
 ) -> tuple[F64, NDArray[np.int64]]:
-    """Misfit (A, n_phases) of every axis of the RA x Dec grid (A = n_ra n_dec, RA fastest)."""
+    """Misfit (A, n_phases) of every axis of the RA x Dec grid (A = n_ra n_dec, RA fastest)
+    and the best phase's index per axis.
+
+    Parameters
+    ----------
+    sfm
+        The map in the spin frame (:func:`.spin_axis_lookup.spin_frame_map`).
+    geo
+        Sun and observer directions and times of the epochs.
+    y
+        Measured band light curves (T, B).
+    ra_deg, dec_deg
+        The grid's RA and Dec values [deg].
+    chunk
+        Axes per lookup call (memory, not the result).
+    progress
+        Called with (done, total) axes, or None.
+    ranging
+        The range-offset term, or None.
+    """
     e_i, e_r = grid_terms(sfm, geo, y, ra_deg, dec_deg, chunk, progress, ranging)
     out = e_i if e_r is None or ranging is None else e_i + float(ranging.weight or 0.0) * e_r
     return out, np.argmin(out, axis=1)
@@ -154,7 +173,25 @@ def grid_terms(
     ranging: RangingTerm | None = None,
 ) -> tuple[F64, F64 | None]:
     """Intensity term (A, n_phases) and ranging term (or None) of every grid candidate
-    (:func:`.spin_axis_grid.grid_pass`)."""
+    (:func:`.spin_axis_grid.grid_pass`).
+
+    Parameters
+    ----------
+    sfm
+        The map in the spin frame (:func:`.spin_axis_lookup.spin_frame_map`).
+    geo
+        Sun and observer directions and times of the epochs.
+    y
+        Measured band light curves (T, B).
+    ra_deg, dec_deg
+        The grid's RA and Dec values [deg].
+    chunk
+        Axes per lookup call (memory, not the result).
+    progress
+        Called with (done, total) axes, or None.
+    ranging
+        The range-offset term, or None.
+    """
     from speclight.estimate.spin_axis.spin_axis_grid import grid_pass
 
     dd, rr = np.meshgrid(dec_deg, ra_deg, indexing="ij")

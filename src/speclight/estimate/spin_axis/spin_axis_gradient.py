@@ -92,7 +92,25 @@ class SpinMisfit:
         ranging: RangingTerm | None = None,
     ) -> SpinMisfit:
         """The misfit around the axis (RA, Dec) [deg]: ``x = (0, 0, radians(phase), 0)`` is
-        the spin model's candidate (RA, Dec, phase) with the period ``geo.period_s``."""
+        the spin model's candidate (RA, Dec, phase) with the period ``geo.period_s``.
+
+        Parameters
+        ----------
+        bmap
+            The band map (:func:`.spin_axis_lookup.load_band_map`).
+        geo
+            Sun and observer directions and times of the epochs.
+        y
+            Measured band light curves (T, B).
+        spin_body_axis
+            The spin axis in the body frame (3,), or None (+z).
+        ra_deg, dec_deg
+            The axis the parameters are measured from [deg].
+        free_period
+            The period is a fourth parameter.
+        ranging
+            The range-offset term, or None.
+        """
         m = body_axis_to_z(spin_body_axis)
         to_body = np.eye(3) if m is None else quat_to_matrix(m).T
         span = float(np.max(np.abs(geo.t_s))) if geo.t_s.size else 0.0

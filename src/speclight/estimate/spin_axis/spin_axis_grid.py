@@ -56,8 +56,16 @@ BLOCK_BYTES = 1024**2
 def misfit_from_sums(s1: F64, s2: F64, sy: F64, yy: F64, n_t: int) -> F64:
     """Mean squared difference of mean-normalised curves from the sums over epochs.
 
-    ``s1 = sum p``, ``s2 = sum p^2``, ``sy = sum p y_n`` (..., B, K) and ``yy = sum y_n^2``
-    (B,): ``sum_t (p / mean p - y_n)^2 = s2 / pm^2 - 2 sy / pm + yy`` with ``pm = s1 / T``.
+    ``sum_t (p / mean p - y_n)^2 = s2 / pm^2 - 2 sy / pm + yy`` with ``pm = s1 / T``.
+
+    Parameters
+    ----------
+    s1, s2, sy
+        ``sum p``, ``sum p^2`` and ``sum p y_n`` over the epochs (..., B, K).
+    yy
+        ``sum y_n^2`` (B,).
+    n_t
+        Epochs ``T``.
     """
     with np.errstate(invalid="ignore", divide="ignore"):
         pm = s1 / n_t
@@ -250,6 +258,27 @@ def grid_pass(
     (numpy's gathers, ufuncs and einsum release the GIL; default 1: on the shared 2-core
     machine of BENCHMARKS.md two threads were not faster). The result does not depend on
     ``chunk``, ``block_bytes`` or ``workers``.
+
+    Parameters
+    ----------
+    sfm
+        The map in the spin frame.
+    geo
+        Sun and observer directions and times of the epochs.
+    y
+        Measured band light curves (T, B).
+    ra_all, dec_all
+        The axes [deg] (A,).
+    chunk
+        Axes per lookup call.
+    progress
+        Called with (done, total) axes, or None.
+    ranging
+        The range-offset term, or None.
+    block_bytes
+        Gathered floats per block [bytes].
+    workers
+        Threads over the chunks.
     """
     n_t, n_b = y.shape
     n_k = sfm.n_phases

@@ -67,7 +67,23 @@ def search_cost(
     ranging: bool = False,
 ) -> tuple[float, float, float, float]:
     """(bytes, seconds) of the spin-frame map(s) and (bytes, seconds) of the grid pass of a
-    search (module docstring)."""
+    search (module docstring).
+
+    Parameters
+    ----------
+    nside
+        The map's HEALPix nside.
+    n_phase_angles, n_rolls
+        The map's phase angles and rolls.
+    grid_deg
+        The RA/Dec grid step [deg].
+    n_phases
+        Rotation phases tried per axis.
+    n_epochs, n_bands
+        Epochs and bands measured.
+    ranging
+        A range-offset term too.
+    """
     n_b = n_bands
     map_bytes, map_s, _ = _frame_map_cost(nside, n_phase_angles * n_rolls, n_phases, n_b)
     if ranging:
@@ -96,6 +112,21 @@ def check_search_cost(
 
     The error names ``n_phases`` where the phases make it large (the search with the default
     72 phases would fit), else ``grid_deg``.
+
+    Parameters
+    ----------
+    nside
+        The map's HEALPix nside.
+    n_phase_angles, n_rolls
+        The map's phase angles and rolls.
+    grid_deg
+        The RA/Dec grid step [deg].
+    n_phases
+        Rotation phases tried per axis.
+    n_epochs, n_bands
+        Epochs and bands measured.
+    ranging
+        A range-offset term too.
     """
     import warnings
 

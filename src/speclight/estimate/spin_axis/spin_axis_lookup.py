@@ -32,7 +32,7 @@ from speclight.maps.map_lookup import ReflectivityMap, read_header
 
 F64 = NDArray[np.float64]
 F32 = NDArray[np.float32]
-FIELD = "--map"
+FIELD = "map_path"
 
 
 def load_band_map(path: str | Path) -> ReflectivityMap:

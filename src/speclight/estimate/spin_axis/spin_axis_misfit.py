@@ -31,7 +31,23 @@ def exact_misfit(
     phase_deg: float,
     ranging: RangingTerm | None = None,
 ) -> float:
-    """The misfit of one candidate with the map's own interpolation (no spin-frame grid)."""
+    """The misfit of one candidate with the map's own interpolation (no spin-frame grid).
+
+    Parameters
+    ----------
+    bmap
+        The band map (:func:`.spin_axis_lookup.load_band_map`).
+    geo
+        Sun and observer directions and times of the epochs.
+    y
+        Measured band light curves (T, B).
+    spin_body_axis
+        The spin axis in the body frame (3,), or None (+z).
+    ra_deg, dec_deg, phase_deg
+        The candidate: the axis (GCRS) and the rotation phase at the scenario start [deg].
+    ranging
+        The range-offset term, or None.
+    """
     if not -90.0 <= dec_deg <= 90.0:
         return float("inf")
     q = spin_attitude(geo.t_s, ra_deg, dec_deg, geo.period_s, phase_deg, spin_body_axis)

@@ -43,7 +43,7 @@ from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, SpinFra
 from speclight.maps.map_lookup import ReflectivityMap, read_header
 
 F64 = NDArray[np.float64]
-FIELD = "--map"
+FIELD = "map_path"
 #: Largest ranging weight accepted: the intensity term, about 1e-3..1, would then count for
 #: less than 1e-6 of the misfit.
 MAX_WEIGHT = 1e6
@@ -74,7 +74,7 @@ def laser_band_map(path: str | Path, kernel: F64, need_offsets: bool) -> Reflect
         angles = ", ".join(f"{a:g}" for a in header.phase_angle_deg)
         raise InputError(
             f"the map {path} has no phase angle 0 (it has {angles} deg): laser light and "
-            "ranging returns need the coaxial slice; make it with --phase-angles-deg 0,...",
+            "ranging returns need the coaxial slice; make it with phase_angles_deg=0,...",
             field=FIELD,
         )
     group: Any = zarr.open_group(str(path), mode="r")
@@ -82,7 +82,7 @@ def laser_band_map(path: str | Path, kernel: F64, need_offsets: bool) -> Reflect
     if need_offsets and not has_offsets:
         raise InputError(
             f"the map {path} has no range_offset (it was made from a scenario without lasers); "
-            "make it with the lasers on, or give --ranging-weight 0",
+            "make it with the lasers on, or give ranging_weight=0",
             field=FIELD,
         )
     wl = header.wavelength_nm

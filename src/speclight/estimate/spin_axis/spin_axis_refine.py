@@ -104,9 +104,30 @@ def refine_candidate(
 ) -> Refined:
     """Refine ``start`` (RA, Dec, phase) [deg] with ``method`` (module docstring).
 
-    ``period_bound``: None for the period ``geo.period_s`` fixed, else the fraction of it by
-    which the fitted period may differ; ``start_period_s``: where the period starts (default
-    ``geo.period_s``, the centre of the bound).
+    Parameters
+    ----------
+    bmap
+        The band map.
+    geo
+        Sun and observer directions and times of the epochs.
+    y
+        Measured band light curves (T, B).
+    spin_body_axis
+        The spin axis in the body frame (3,), or None (+z).
+    start
+        The candidate (RA, Dec, phase) [deg] to refine.
+    step_deg
+        The grid step [deg] (the initial simplex's size).
+    method
+        ``nelder-mead``, ``gradient``, ``gradient-continuation``, ``gauss-newton`` or
+        ``slsqp``.
+    period_bound
+        None for the period ``geo.period_s`` fixed, else the fraction of it by which the
+        fitted period may differ.
+    ranging
+        The range-offset term, or None.
+    start_period_s
+        Where the period starts [s] (default ``geo.period_s``, the centre of the bound).
     """
     check_refine_options(method, period_bound)
     model, x0, bounds = _setup(
@@ -135,7 +156,29 @@ def refine_staged(
 ) -> Refined:
     """The ``gradient`` refinement run on each of ``stages`` in turn
     (:mod:`.spin_axis_continuation`), each from where the last ended, then on the real
-    misfit; the evaluations of all stages are counted."""
+    misfit; the evaluations of all stages are counted.
+
+    Parameters
+    ----------
+    bmap
+        The band map.
+    geo
+        Sun and observer directions and times of the epochs.
+    y
+        Measured band light curves (T, B).
+    spin_body_axis
+        The spin axis in the body frame (3,), or None (+z).
+    start
+        The candidate (RA, Dec, phase) [deg] to refine.
+    stages
+        The coarsened misfits, coarsest first.
+    period_bound
+        None for a fixed period, else the fraction by which the period may differ.
+    ranging
+        The range-offset term, or None.
+    start_period_s
+        Where the period starts [s] (default ``geo.period_s``).
+    """
     check_refine_options("gradient", period_bound)
     model, x, bounds = _setup(
         bmap, geo, y, spin_body_axis, start, period_bound, ranging, start_period_s

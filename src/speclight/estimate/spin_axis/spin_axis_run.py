@@ -73,12 +73,23 @@ class SpinAxisRun:
 def phase_vector_track(
     epochs: EpochGeometry,
     spin_body_axis: list[float],
+    *,
     ra_deg: float,
     dec_deg: float,
     phase_deg: float,
 ) -> tuple[F64, F64]:
     """Body-frame longitude and latitude [deg] of the phase vector at every epoch for one
-    spin axis and phase (the observation track of the reference's Figure 18)."""
+    spin axis and phase (the observation track of the reference's Figure 18).
+
+    Parameters
+    ----------
+    epochs
+        Sun and observer directions and times of the epochs.
+    spin_body_axis
+        The spin axis in the body frame (3,).
+    ra_deg, dec_deg, phase_deg
+        The candidate: the axis (GCRS) and the rotation phase at the scenario start [deg].
+    """
     from speclight.attitude.quaternion import quat_to_matrix
     from speclight.attitude.spin import spin_attitude
     from speclight.maps.map_geometry import lonlat_deg, map_coordinates
@@ -141,10 +152,16 @@ def _spin_model(loaded: LoadedScenario, period_s: float | None) -> tuple[float, 
     return float(period_s), [float(v) for v in axis], spin
 
 
+def _candidate(answer: tuple[float, ...]) -> dict[str, float]:
+    """``(RA, Dec, phase, ...)`` [deg] as :func:`phase_vector_track`'s keywords."""
+    return {"ra_deg": answer[0], "dec_deg": answer[1], "phase_deg": answer[2]}
+
+
 def spin_axis_measured(
     loaded: LoadedScenario,
     measured: str | Path,
     map_path: str | Path,
+    *,
     period_s: float | None = None,
     grid_deg: float = 2.0,
     n_phases: int = 72,
@@ -157,8 +174,45 @@ def spin_axis_measured(
     refine_method: str = "nelder-mead",
     period_bound: float | None = None,
 ) -> SpinAxisRun:
-    """Search the spin axis of a measured pass against a reflectivity map (module doc);
-    ``refine_method`` and ``period_bound`` (a free period): :func:`.spin_axis_search`."""
+    """Search the spin axis of a measured pass against a reflectivity map (module doc).
+
+    Parameters
+    ----------
+    loaded
+        The scenario: orbit, observer, bands, ``attitude.spin_body_axis`` and
+        ``attitude.period_s``.
+    measured
+        The measured pass: a speclight NetCDF or a CSV of band count rates.
+    map_path
+        The reflectivity map of the target (``speclight reflectivity-map``).
+    period_s
+        Rotation period [s] (default: the scenario's).
+    grid_deg
+        RA/Dec grid step [deg], 0.01..90.
+    n_phases
+        Rotation phases tried per axis.
+    bands
+        Bands to use (default: all the scenario's).
+    refine
+        Refine the best candidate locally.
+    chunk
+        Axes per lookup call (memory, not the result).
+    progress
+        Called with (done, total) axes, or None.
+    light
+        ``sun`` or ``laser`` (coaxial, the map's phase-0 slice); default: what the data have.
+    ranging_weight
+        Weight of the range-offset term (0: off); default 1 where the data and the map have
+        range offsets.
+    refine_method, period_bound
+        The refinement's method and, for a free period, the fraction by which it may differ
+        (:func:`.spin_axis_core.spin_axis_search`).
+
+    Returns
+    -------
+    SpinAxisRun
+        The search's result, the light, the ranging weight and the time taken.
+    """
     from speclight.estimate.inputs.geometry_match import check_scenario_sees
     from speclight.estimate.inputs.measured import read_measured
     from speclight.estimate.inputs.reflectance_factors import read_reflectance_factors
@@ -265,8 +319,8 @@ def spin_axis_measured(
     if period_bound is not None and np.isfinite(result.refined_period_s):
         refined_epochs = dataclasses.replace(epochs, period_s=result.refined_period_s)
     tracks = {
-        "best": phase_vector_track(epochs, body_axis, *result.best[:3]),
-        "refined": phase_vector_track(refined_epochs, body_axis, *result.refined[:3]),
+        "best": phase_vector_track(epochs, body_axis, **_candidate(result.best)),
+        "refined": phase_vector_track(refined_epochs, body_axis, **_candidate(result.refined)),
     }
     truth = None
     if spin is not None:

@@ -33,10 +33,22 @@ def check_chunk_memory(
     limit_bytes: int | None = None,
     asked: int | None = None,
 ) -> int:
-    """The peak memory of one chunk [bytes]; refuse a chunk above the limit (default
-    :func:`~speclight.simulation.memory.memory_limit_bytes`), naming the largest that fits.
+    """The peak memory of one chunk [bytes]; refuse a chunk above the limit, naming the
+    largest that fits.
 
-    ``asked``: the chunk the user gave, where ``chunk`` is that cut to the map's directions.
+    Parameters
+    ----------
+    loaded
+        The scenario (render settings and spectrum set the cost of a geometry).
+    chunk
+        Directions per chunk, cut to the map's directions.
+    n_geometries
+        Geometries rendered per direction (phase angles x rolls, phase 0 once).
+    limit_bytes
+        The limit [bytes] (default
+        :func:`~speclight.simulation.memory.memory_limit_bytes`).
+    asked
+        The chunk the user gave, for the message (default ``chunk``).
     """
     limit = memory_limit_bytes() if limit_bytes is None else int(limit_bytes)
     need = chunk_bytes(loaded, chunk, n_geometries)
@@ -51,12 +63,12 @@ def check_chunk_memory(
             too_many = mid
     accepted = f"at most {fits} for this map" if fits else "none: fewer phase angles x rolls"
     raise InputError(
-        f"--chunk = {asked or chunk}: a chunk renders {chunk} directions x {n_geometries} "
+        f"chunk = {asked or chunk}: a chunk renders {chunk} directions x {n_geometries} "
         f"geometries = {chunk * n_geometries} at once, about {need / 1024**3:.3g} GiB of "
         f"memory, more than the limit of {limit / 1024**3:.3g} GiB (half the physical "
         f"memory, or the process limit); accepted: {accepted} (render.resolution_px and "
         "spectrum.step_nm set the cost of each geometry)",
-        field="--chunk",
+        field="chunk",
     )
 
 
@@ -74,6 +86,6 @@ def check_rolls(rolls: int) -> None:
     """Refuse rolls outside 1..:data:`MAX_ROLLS`."""
     if not 1 <= int(rolls) <= MAX_ROLLS:
         raise InputError(
-            f"--rolls = {rolls} must be in 1..{MAX_ROLLS} (one roll per degree at most)",
-            field="--rolls",
+            f"rolls = {rolls} must be in 1..{MAX_ROLLS} (one roll per degree at most)",
+            field="rolls",
         )

@@ -33,7 +33,28 @@ def render_chunk(
 ) -> tuple[F64, F64]:
     """Intensity (n, P, R, L) and unit count rates (n, P, R, B) of one chunk of directions.
 
-    ``workers``: processes of the numpy ray caster (Dr.Jit variants ignore it).
+    Parameters
+    ----------
+    loaded
+        The scenario.
+    target, session
+        The built target and the render session (kept per worker).
+    dirs
+        The chunk's phase-vector directions (n, 3), body frame.
+    geoms
+        (phase index, roll index, phase [rad], roll [rad]) rendered per direction.
+    shapes
+        The store's sizes (:mod:`speclight.maps.map_format`).
+    wl
+        The wavelength grid [nm] (L,).
+    solar
+        The Sun's spectral irradiance at 1 AU [W m-2 nm-1] (L,).
+    kernel
+        The instrument response (optics, QE, bands) of ``simulate``.
+    k
+        The chunk's index (for messages).
+    workers
+        Processes of the numpy ray caster (Dr.Jit variants ignore it).
     """
     from speclight.render import render_intensity
 
@@ -99,6 +120,21 @@ def coaxial_returns(
       (:func:`speclight.ranging.link.downlink_conversion` and ``band_histograms``) for a
       range of 1 m, an aperture of 1 m^2 and no atmosphere (transmission 1), with the
       scenario's optics, QE and bands; (n, 0, bins) without bands.
+
+    Parameters
+    ----------
+    target, session
+        The built target and the render session.
+    dirs
+        The phase-vector directions (n, 3), body frame (the laser and the observer along it).
+    wl
+        The wavelength grid [nm] (L,).
+    loaded
+        The scenario.
+    kernel
+        The instrument response (optics, QE, bands).
+    edges_m
+        The range bin edges [m] (bins + 1,).
     """
     from speclight.instrument.photometry import photon_kernel
     from speclight.ranging import link

@@ -16,7 +16,7 @@ from speclight.io import zarr_store_path
 from speclight.io.store_io import readable
 from speclight.maps.map_format import DATA_ARRAYS, DIMS, FORMAT_NAME
 
-FIELD = "--output"
+FIELD = "output"
 TODO, DONE, FAILED = 0, 1, 2
 
 
@@ -40,6 +40,19 @@ def open_or_create(
     ``parameters`` yet: :func:`mark_created` was not reached, e.g. on a full disk) holds no
     rendered chunk and is created again. The caller writes the coordinates and metadata of
     a new store, then calls :func:`mark_created`.
+
+    Parameters
+    ----------
+    path
+        The store (a folder).
+    parameters
+        What a resumed run must match (nside, phase angles, rolls, chunk, scenario hash).
+    shapes
+        The arrays' sizes (direction, phase, roll, wavelength, band, range_bin, ranging).
+    chunk
+        Directions per chunk.
+    force
+        Replace an existing map.
     """
     import zarr
 
@@ -51,12 +64,12 @@ def open_or_create(
         except Exception as exc:  # not a Zarr group at all
             raise InputError(
                 f"{path} exists and is not a speclight reflectivity map ({exc}); choose another "
-                "name or pass --force to replace it",
+                "name or pass force=True to replace it",
                 field=FIELD,
             ) from None
         if complete:
             raise InputError(
-                f"{path} exists and is complete; choose another name or pass --force to "
+                f"{path} exists and is complete; choose another name or pass force=True to "
                 "render it again",
                 field=FIELD,
             )
@@ -64,14 +77,14 @@ def open_or_create(
             diff = sorted(k for k in set(old) | set(parameters) if old.get(k) != parameters.get(k))
             raise InputError(
                 f"{path} is an unfinished map made with other parameters ({', '.join(diff)}); "
-                "rerun with the same ones to resume it, or pass --force to start again",
+                "rerun with the same ones to resume it, or pass force=True to start again",
                 field=FIELD,
             )
         return group, True
-    if path.exists():  # --force, or unfinished: replace a map, never another folder
+    if path.exists():  # force, or unfinished: replace a map, never another folder
         if any(path.iterdir()) and _format_of(path) != FORMAT_NAME:
             raise InputError(
-                f"{path} is a folder but not a speclight reflectivity map; --force replaces "
+                f"{path} is a folder but not a speclight reflectivity map; force=True replaces "
                 "only maps: choose another name",
                 field=FIELD,
             )

@@ -59,34 +59,49 @@ class MapRun:
 
 
 def check_map_options(
+    *,
     directions: int,
     phase_angles_deg: Sequence[float],
     rolls: int,
     chunk: int,
-    workers: int | None = None,
+    n_workers: int | None = None,
 ) -> tuple[int, list[float], int]:
-    """Validate the options; return ``(nside, sorted phase angles, stored rolls)``."""
+    """Validate the options; return ``(nside, sorted phase angles, stored rolls)``.
+
+    Parameters
+    ----------
+    directions
+        At least this many phase-vector directions (>= 12).
+    phase_angles_deg
+        Phase angles [deg], 0..179, none twice.
+    rolls
+        Rolls of the Sun-observer plane, 1..360.
+    chunk
+        Directions per chunk, >= 1.
+    n_workers
+        Workers of a local cluster, >= 1, or None.
+    """
     nside = nside_for(directions)
     angles = [float(a) for a in phase_angles_deg]
     if not angles or not all(np.isfinite(angles)):
         raise InputError(
-            f"--phase-angles-deg = {phase_angles_deg} must be one or more numbers",
-            field="--phase-angles-deg",
+            f"phase_angles_deg = {phase_angles_deg} must be one or more numbers",
+            field="phase_angles_deg",
         )
     if min(angles) < 0 or max(angles) > MAX_PHASE_ANGLE_DEG:
         raise InputError(
-            f"--phase-angles-deg = {phase_angles_deg}: each must be in 0..{MAX_PHASE_ANGLE_DEG:g}",
-            field="--phase-angles-deg",
+            f"phase_angles_deg = {phase_angles_deg}: each must be in 0..{MAX_PHASE_ANGLE_DEG:g}",
+            field="phase_angles_deg",
         )
     if len(set(angles)) != len(angles):
         raise InputError(
-            f"--phase-angles-deg = {phase_angles_deg} repeats an angle", field="--phase-angles-deg"
+            f"phase_angles_deg = {phase_angles_deg} repeats an angle", field="phase_angles_deg"
         )
     check_rolls(rolls)
     if int(chunk) < 1:
-        raise InputError(f"--chunk = {chunk} must be >= 1", field="--chunk")
-    if workers is not None and int(workers) < 1:
-        raise InputError(f"--workers = {workers} must be >= 1", field="--workers")
+        raise InputError(f"chunk = {chunk} must be >= 1", field="chunk")
+    if n_workers is not None and int(n_workers) < 1:
+        raise InputError(f"n_workers = {n_workers} must be >= 1", field="n_workers")
     stored_rolls = 1 if all(a == 0 for a in angles) else int(rolls)
     return nside, sorted(angles), stored_rolls
 
@@ -163,8 +178,9 @@ def reflectivity_map(
             field="render.mode",
         )
     nside, angles, n_rolls = check_map_options(
-        directions, phase_angles_deg, rolls, chunk, n_workers
-    )
+        directions=directions, phase_angles_deg=phase_angles_deg, rolls=rolls, chunk=chunk,
+        n_workers=n_workers,
+    )  # fmt: skip
     path = store.check_store_path(output, {"scenario file": Path(loaded.source)})
     from speclight.illumination import solar_irradiance_W_m2_nm
     from speclight.simulation.radiometry import wavelength_grid_nm
@@ -216,7 +232,7 @@ def reflectivity_map(
         states, damaged = _chunks_to_do(path, group, resumed, size)
         todo = [k for k in range(states.size) if states[k] != store.DONE]
         check_free_space(
-            path, store_bytes(shapes) * len(todo) // states.size, "the map", "--directions"
+            path, store_bytes(shapes) * len(todo) // states.size, "the map", "`directions`"
         )
         if max_chunks is not None:
             todo = todo[: max(int(max_chunks), 0)]
