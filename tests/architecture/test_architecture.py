@@ -10,7 +10,8 @@
   is one thing, not a function or a module depending on what was imported first);
 * Mitsuba and Dr.Jit are imported only inside ``speclight.render``;
 * the render variant is chosen in one place (``render/session.py`` calls ``choose_variant``);
-* no two modules share a file name (a newcomer can tell them apart), ``__init__`` aside;
+* no two modules share a file name (a newcomer can tell them apart), ``__init__`` and
+  ``__main__`` aside;
 * physical constants are defined once (``speclight.constants``);
 * the estimators and the maps do not speak the command line: their errors name the Python
   parameter (``grid_deg``), and ``speclight.cli`` says the flag (``--grid-deg``).
@@ -182,7 +183,9 @@ def test_the_variant_is_chosen_in_one_place():
 
 
 def test_module_file_names_are_unique():
-    names = Counter(p.name for p in ROOT.rglob("*.py") if p.name != "__init__.py")
+    names = Counter(
+        p.name for p in ROOT.rglob("*.py") if p.name not in ("__init__.py", "__main__.py")
+    )
     assert [n for n, c in names.items() if c > 1] == []
 
 
