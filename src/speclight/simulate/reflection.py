@@ -127,6 +127,8 @@ def _material(loaded: LoadedScenario, name: str, m: MaterialModel) -> Material:
         diffuse_reflectance=None
         if diffuse is None
         else _reflectance(loaded, diffuse, f"{field}.diffuse_reflectance"),
+        extension=m.extension,
+        coefficients=m.coefficients,
         **files,
     )
 
