@@ -113,22 +113,30 @@ class MeasuredBRDF:
         """Weight of the support [0, 1] at half-vector angles [deg]: 1 inside, 0 outside."""
         return self._bilinear(self.support, theta_h_deg, theta_d_deg)
 
-    def parts(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64) -> tuple[F64, F64]:
-        """f [sr-1] at the shading cosines, split into the table's part (inside the support)
-        and the extension's part (outside it); their sum is the material's BRDF."""
+    def table_part(self, cos_h: F64, cos_d: F64) -> F64:
+        """The table's part of f [sr-1] at the shading cosines: f times the support weight."""
+        th = np.degrees(np.arccos(np.clip(cos_h, -1.0, 1.0)))
+        td = np.degrees(np.arccos(np.clip(cos_d, -1.0, 1.0)))
+        return self.inside(th, td) * self(th, td)
+
+    def extension_part(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64) -> F64:
+        """The extension's part of f [sr-1]: the fitted model times one minus the support
+        weight (0 inside the support). With :meth:`table_part`, the material's BRDF."""
         from speclight.target.brdf_fit.form_coefficients import evaluate
 
         th = np.degrees(np.arccos(np.clip(cos_h, -1.0, 1.0)))
         td = np.degrees(np.arccos(np.clip(cos_d, -1.0, 1.0)))
-        w = self.inside(th, td)
+        out = 1.0 - self.inside(th, td)
+        some = np.flatnonzero(out > 0)
         name, coefficients = self.extension
-        out = (1.0 - w) * evaluate(name, coefficients, cos_i, cos_o, cos_h, cos_d)
-        return w * self(th, td), np.where(w < 1.0, out, 0.0)
+        ci, co, ch, cd = (np.asarray(c)[some] for c in (cos_i, cos_o, cos_h, cos_d))
+        out[some] *= evaluate(name, coefficients, ci, co, ch, cd)
+        return out
 
 
 def angular_step_deg(samples: TableSamples) -> float:
     """The smallest step of theta_o between neighbouring samples of one curve [deg]."""
-    steps = []
+    steps: list[float] = []
     for ti in np.unique(samples.theta_i_deg):
         to = np.unique(samples.theta_o_deg[samples.theta_i_deg == ti])
         steps.extend(np.diff(to))

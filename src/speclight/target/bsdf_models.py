@@ -134,7 +134,10 @@ MEASURED_TABLE = BsdfModel(
     modes=("single",),
     channels="1 + 1: the table f(theta_h, theta_d) cos theta_i inside its support, the "
     "extension f cos theta_i outside it; both x R(lambda) / R(table wavelength)",
-    examples=({"bsdf": "measured", "brdf_table": "starlink_v1p5_chassis_532nm"},),
+    examples=(
+        {"bsdf": "measured", "brdf_table": "starlink_v1p5_chassis_532nm"},
+        {"bsdf": "measured", "brdf_table": "starlink_v1p5_solar_array_532nm", "extension": "abg"},
+    ),
     form="lab table",
     check=_read_lab_table,
 )

@@ -38,12 +38,29 @@ F64 = NDArray[np.float64]
 class ArrayOps:
     """The array functions the forms use, numpy's; path mode passes Dr.Jit's."""
 
-    sqrt = staticmethod(np.sqrt)
-    clip = staticmethod(np.clip)
-    maximum = staticmethod(np.maximum)
-    minimum = staticmethod(np.minimum)
-    log10 = staticmethod(np.log10)
-    power = staticmethod(np.power)
+    @staticmethod
+    def sqrt(x: Any) -> Any:
+        return np.sqrt(x)
+
+    @staticmethod
+    def clip(x: Any, low: float, high: float) -> Any:
+        return np.clip(x, low, high)
+
+    @staticmethod
+    def maximum(x: Any, y: Any) -> Any:
+        return np.maximum(x, y)
+
+    @staticmethod
+    def minimum(x: Any, y: Any) -> Any:
+        return np.minimum(x, y)
+
+    @staticmethod
+    def log10(x: Any) -> Any:
+        return np.log10(x)
+
+    @staticmethod
+    def power(x: Any, y: Any) -> Any:
+        return np.power(x, y)
 
     @staticmethod
     def exp10(x: Any) -> Any:
