@@ -1,9 +1,11 @@
 """Least-squares fits of the analytic forms to a measured table, in log space.
 
 The misfit is ``log10 f_model - log10 f_measured`` at every sample with both zenith angles
-below 90 deg and a positive BRDF (as lumos-sat's ``lumos.brdf.tools.fit``, which fits these
-forms to the same tables: each sample counts the same, decades of the specular peak and of
-the diffuse floor alike). Each fit starts from a few first guesses (the lobe's width spans
+below 90 deg and a BRDF above ``min_brdf`` (0 by default: every positive sample), as in
+lumos-sat's ``lumos.brdf.tools.fit``, which fits these forms to the same tables (with its
+``clip = 1e-3``, leaving out the Starlink v1.5 tables' 1e-4 sr-1 entries at grazing
+exitance): each sample counts the same, decades of the specular peak and of the diffuse
+floor alike. Each fit starts from a few first guesses (the lobe's width spans
 decades) with :func:`scipy.optimize.least_squares` within the coefficients' ranges, keeps the
 best, and then checks the directional albedo (:mod:`.directional_albedo`): a fit that
 reflects more than it receives at some incidence is refitted with the albedo held at most 1
@@ -14,14 +16,14 @@ conserves energy. The residual is reported per incidence angle (RMS and largest,
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares, minimize
 
-from speclight.errors import InputError
+from speclight.errors import InputError, did_you_mean
 from speclight.target.brdf_fit.directional_albedo import max_albedo
 from speclight.target.brdf_fit.form_coefficients import BINOMIAL_SHAPE, FORMS, AnalyticForm
 from speclight.target.brdf_samples import TableSamples
@@ -54,7 +56,9 @@ class BrdfFit:
     rms_dex_all
         RMS over all samples [dex].
     left_out
-        Samples not fitted (zenith >= 90 deg or BRDF <= 0).
+        Samples not fitted (zenith >= 90 deg or BRDF <= ``min_brdf``).
+    min_brdf
+        The BRDF [sr-1] at or below which samples were left out.
     albedo, albedo_incidence_deg
         The largest directional albedo of the fit [1] and its incidence [deg].
     constrained
@@ -72,6 +76,7 @@ class BrdfFit:
     left_out: int
     albedo: float
     albedo_incidence_deg: float
+    min_brdf: float = 0.0
     constrained: bool = field(default=False)
 
 
@@ -115,6 +120,7 @@ def fit_table_samples(
     model: str,
     distribution: str = "ggx",
     fresnel: str = "schlick",
+    min_brdf: float = 0.0,
 ) -> BrdfFit:
     """Fit analytic ``model`` (a name of :data:`~.form_coefficients.FORMS`) to a table.
 
@@ -127,15 +133,31 @@ def fit_table_samples(
     distribution, fresnel
         ``microfacet`` only: the normal distribution (``ggx``, ``beckmann``) and the Fresnel
         term (``schlick``, ``exact``).
+    min_brdf
+        Samples at or below this BRDF [sr-1] are left out (>= 0; lumos-sat used 1e-3).
     """
     if model not in FORMS:
-        raise InputError(f"unknown model '{model}' (choices: {', '.join(FORMS)})", field="model")
+        raise InputError(
+            f"model = {model!r}{did_you_mean(model, FORMS)} is not an analytic model "
+            f"(choices: {', '.join(FORMS)})",
+            field="model",
+        )
+    for name, value in (("distribution", distribution), ("fresnel", fresnel)):
+        choices = next(c.choices for c in FORMS["microfacet"].coefficients if c.name == name)
+        if value not in choices:
+            raise InputError(
+                f"{name} = {value!r}{did_you_mean(value, choices)} must be one of "
+                f"{', '.join(choices)}",
+                field=name,
+            )
+    if not (np.isfinite(min_brdf) and min_brdf >= 0):
+        raise InputError(f"min_brdf = {min_brdf!r} sr-1 must be >= 0", field="min_brdf")
     form = FORMS[model]
-    keep = samples.usable() & (samples.brdf > 0)
+    keep = samples.usable() & (samples.brdf > min_brdf)
     if np.count_nonzero(keep) < 4:
         raise InputError(
-            f"only {int(keep.sum())} samples have zenith angles below 90 deg and a positive "
-            "BRDF: a fit needs at least 4",
+            f"only {int(keep.sum())} samples have zenith angles below 90 deg and a BRDF above "
+            f"{min_brdf:g} sr-1: a fit needs at least 4",
             source=samples.source,
         )
     cosines = tuple(c[keep] for c in samples.cosines())
@@ -150,7 +172,8 @@ def fit_table_samples(
         return model_log(p) - measured
 
     best = None
-    for x0, bounds in _starts(model, samples.brdf[keep]):
+    starts = _starts(model, samples.brdf[keep])
+    for x0, bounds in starts:
         sol = least_squares(residual, x0, bounds=bounds, x_scale="jac")
         if best is None or sol.cost < best.cost:
             best = sol
@@ -159,12 +182,13 @@ def fit_table_samples(
     albedo, at = max_albedo(lambda *c: form.evaluate(*c, unpack(p)))
     constrained = albedo > 1.0 + ALBEDO_TOLERANCE
     if constrained:
-        p = _energy_constrained(form, unpack, residual, p, albedo)
+        p = _energy_constrained(form, unpack, residual, p, albedo, starts[0][1])
         albedo, at = max_albedo(lambda *c: form.evaluate(*c, unpack(p)))
     coefficients = unpack(p)
     if np.isfinite(samples.wavelength_nm):
         coefficients["wavelength_nm"] = float(samples.wavelength_nm)
-    return _report(samples, keep, residual(p), model, coefficients, albedo, at, constrained)
+    fit = _report(samples, keep, residual(p), model, coefficients, albedo, at, constrained)
+    return replace(fit, min_brdf=float(min_brdf))
 
 
 def _energy_constrained(
@@ -173,8 +197,10 @@ def _energy_constrained(
     residual: Callable[[F64], F64],
     p: F64,
     albedo: float,
+    bounds: tuple[F64, F64],
 ) -> F64:
-    """The least-squares parameters with the largest albedo held at most 1 (SLSQP)."""
+    """The least-squares parameters with the largest albedo held at most 1 (SLSQP, within
+    the parameters' ``bounds``)."""
 
     def slack(q: F64) -> float:
         return 1.0 - max_albedo(lambda *c: form.evaluate(*c, unpack(q)))[0]
@@ -184,6 +210,7 @@ def _energy_constrained(
         lambda q: 0.5 * float(np.sum(residual(q) ** 2)),
         start,
         method="SLSQP",
+        bounds=list(zip(*bounds, strict=True)),
         constraints=[{"type": "ineq", "fun": slack}],
         options={"maxiter": 60, "ftol": 1e-8},
     )
