@@ -75,8 +75,6 @@ class Material:
 
     def __post_init__(self) -> None:
         field = f"target.materials.{self.name}"
-        if isinstance(self.coefficients, Mapping):  # an immutable copy
-            object.__setattr__(self, "coefficients", FrozenCoefficients(self.coefficients))
         check_bsdf_name(self.bsdf, f"{field}.bsdf")
         if not isinstance(self.reflectance, Reflectance):
             raise InputError(
@@ -87,6 +85,8 @@ class Material:
         if problems:
             key, message = problems[0]
             raise InputError(message, field=f"{field}.{key}")
+        if isinstance(self.coefficients, Mapping):  # checked: now an immutable copy
+            object.__setattr__(self, "coefficients", FrozenCoefficients(self.coefficients))
         check = self.model.check
         if check is not None:  # reads the material's file (an RGL .bsdf)
             check(self, field)

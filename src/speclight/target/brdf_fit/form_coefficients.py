@@ -65,7 +65,7 @@ class Coefficient:
         if self.kind == "choice":
             if value not in self.choices:
                 hint = did_you_mean(str(value), self.choices)
-                return f"{where}{hint} must be one of {', '.join(self.choices)} ({self.meaning})"
+                return f"{where} must be one of {', '.join(self.choices)}{hint} ({self.meaning})"
             return None
         if self.kind == "matrix":
             return _matrix_problem(where, value, self.meaning)
@@ -140,7 +140,10 @@ class AnalyticForm:
         for key in given:
             if key not in names:
                 hint = did_you_mean(str(key), names)
-                return f"unknown coefficient '{key}'{hint} of bsdf '{self.name}' ({self.names()})"
+                return (
+                    f"unknown coefficient '{key}' of bsdf '{self.name}'{hint} "
+                    f"(accepted: {self.names()})"
+                )
         for c in accepted:
             if c.name not in given:
                 if c is WAVELENGTH or c.kind == "choice":
