@@ -53,7 +53,7 @@ def test_light_from_outside_the_support_is_reported():
                  brdf_table="starlink_v1p5_chassis_532nm")  # fmt: skip
     sun = np.array([c[0] for c in CASES])
     obs = np.array([c[1] for c in CASES])
-    r = render_intensity(plate(1.0, 1.0, m), sun, obs, np.ones((3, 2)), WL, resolution_px=16)  # fmt: skip
+    r = render_intensity(plate(1.0, 1.0, m), sun, obs, np.ones((3, 2)), WL, resolution_px=16)
     assert np.all(r.intensity_W_sr_nm > 0)  # never dark
     fraction = r.outside_support_W_sr_nm / r.intensity_W_sr_nm
     np.testing.assert_array_equal(fraction, np.array([[c[2]] * 2 for c in CASES]))

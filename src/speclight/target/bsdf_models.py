@@ -179,8 +179,9 @@ _ANALYTIC = (
     ),
     _analytic(
         "abg",
-        "Harvey's ABg scatter A / (B + |beta - beta_0|^g) (Harvey 1976, doi:10.1117/12.954861; "
-        "Zemax; lumos-sat's ABG)",
+        "Harvey's ABg scatter A / (B + x^g), x the distance between the view and mirror "
+        "directions projected on the surface (Harvey 1976, doi:10.1117/12.954861; Zemax; "
+        "lumos-sat's ABG)",
         {"a": 9.737e-5, "b": 8.448e-6, "g": 2.686},  # Kandula et al. 2025's boom
     ),
     _analytic(
