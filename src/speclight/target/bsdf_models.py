@@ -158,6 +158,7 @@ MEASURED_RGL = BsdfModel(
 
 
 def _analytic(name: str, summary: str, *examples: Mapping[str, Any]) -> BsdfModel:
+    """An analytic model; an example with a ``reflectance`` key is taken as a whole."""
     return BsdfModel(
         name,
         summary,
@@ -166,7 +167,10 @@ def _analytic(name: str, summary: str, *examples: Mapping[str, Any]) -> BsdfMode
         reflectance_kinds=("constant", "table"),
         reflectance_default=1.0,
         channels="one: f cos theta_i x R(lambda) / R(coefficients.wavelength_nm)",
-        examples=tuple({"bsdf": name, "coefficients": dict(e)} for e in examples),
+        examples=tuple(
+            dict(e) if "reflectance" in e else {"bsdf": name, "coefficients": dict(e)}
+            for e in examples
+        ),
     )
 
 
@@ -176,6 +180,11 @@ _ANALYTIC = (
         "energy-normalised Phong lobe about the mirror direction and a diffuse term "
         "(Lafortune & Willems 1994; lumos-sat's PHONG)",
         {"kd": 0.2, "ks": 0.5, "n": 30.0},
+        {  # coloured: scaled by R(lambda) / R(532 nm)
+            "bsdf": "phong",
+            "coefficients": {"kd": 0.2, "ks": 0.5, "n": 30.0, "wavelength_nm": 532.0},
+            "reflectance": {"wavelength_nm": [400.0, 1000.0], "value": [0.6, 0.4]},
+        },
     ),
     _analytic(
         "abg",

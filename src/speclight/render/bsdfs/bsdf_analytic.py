@@ -14,7 +14,12 @@ from typing import Any
 
 import numpy as np
 
-from speclight.render.bsdfs.bsdf_interface import F64, MaterialBsdf, normalised_reflectance
+from speclight.render.bsdfs.bsdf_interface import (
+    F64,
+    MaterialBsdf,
+    normalised_reflectance,
+    spectrum_grid,
+)
 from speclight.target.brdf_fit.form_coefficients import evaluate
 
 
@@ -48,4 +53,6 @@ class AnalyticBsdf(MaterialBsdf):
 
         from speclight.render.bsdfs.path_analytic import analytic_bsdf
 
-        return analytic_bsdf(mi, self, lo_nm, hi_nm)
+        grid = spectrum_grid(lo_nm, hi_nm)
+        ratio = self.spectral_ratio(grid)
+        return analytic_bsdf(mi, self.material.bsdf, self.coefficients, grid, ratio)

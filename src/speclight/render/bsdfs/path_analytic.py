@@ -16,16 +16,13 @@ bias. As in :mod:`.path_coat`, the class is defined per variant on first use, si
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-from speclight.render.bsdfs.bsdf_interface import irregular_spectrum, spectrum_grid
+from speclight.render.bsdfs.bsdf_interface import F64, irregular_spectrum
 from speclight.target.brdf_fit.analytic_forms import ArrayOps
 from speclight.target.brdf_fit.form_coefficients import evaluate
-
-if TYPE_CHECKING:
-    from speclight.render.bsdfs.bsdf_analytic import AnalyticBsdf
 
 _CLASSES: dict[str, Any] = {}
 LOG10_2 = float(np.log10(2.0))
@@ -45,18 +42,19 @@ def sampling_lobe(model: str, c: dict[str, Any]) -> tuple[float, float]:
     return 0.5, 0.1
 
 
-def analytic_bsdf(mi: Any, bsdf: AnalyticBsdf, lo_nm: float, hi_nm: float) -> Any:
-    """A Mitsuba BSDF object (active variant) of an analytic material over [lo_nm, hi_nm]."""
+def analytic_bsdf(
+    mi: Any, model: str, coefficients: dict[str, Any], wavelength_nm: F64, ratio: F64
+) -> Any:
+    """A Mitsuba BSDF object (active variant) of analytic ``model`` with ``coefficients``,
+    its BRDF scaled by the spectrum ``ratio`` [1] given at ``wavelength_nm`` [nm]."""
     cls = _CLASSES.get(mi.variant())
     if cls is None:
         cls = _CLASSES[mi.variant()] = _define(mi)
     out = cls(mi.Properties())
-    grid = spectrum_grid(lo_nm, hi_nm)
-    ratio = bsdf.spectral_ratio(grid)
     texture = None
     if np.any(ratio != 1.0):
-        texture = mi.load_dict(irregular_spectrum(grid, ratio))
-    out.configure(bsdf.material.bsdf, bsdf.coefficients, texture)
+        texture = mi.load_dict(irregular_spectrum(wavelength_nm, ratio))
+    out.configure(model, coefficients, texture)
     return out
 
 
