@@ -62,8 +62,8 @@ GRID_D_DEG = np.linspace(0.0, 90.0, 181)
 #: The analytic models a table may be extended with (fitted to it on first use).
 EXTENSIONS: tuple[str, ...] = ("microfacet", "phong", "abg", "binomial")
 #: The extension of a table that names none: its directional albedo is at most 1 for every
-#: coefficient value, and it fits the shipped tables best in the median of the
-#: per-incidence residuals (docs/brdf-models.md).
+#: coefficient value and it rises toward grazing angles as Fresnel reflection does (the
+#: binomial and ABg forms fit the shipped tables more closely: docs/brdf-models.md).
 DEFAULT_EXTENSION = "microfacet"
 
 
@@ -203,7 +203,15 @@ def load_brdf_table(name_or_path: str, extension: str = DEFAULT_EXTENSION) -> Me
 
     samples = read_table_samples(name_or_path)
     values, support = _grid(samples)
-    fit = fit_table_samples(samples, extension)
+    try:
+        fit = fit_table_samples(samples, extension)
+    except InputError as exc:
+        raise InputError(
+            f"fitting the table's extension ({extension}), which holds outside its support: "
+            f"{exc.message}",
+            source=samples.source,
+            field=exc.field,
+        ) from None
     return MeasuredBRDF(
         values, support, samples.wavelength_nm, samples.source, (extension, fit.coefficients)
     )
