@@ -17,10 +17,13 @@ from numpy.typing import NDArray
 
 F64 = NDArray[np.float64]
 Cosines = Callable[[F64, F64, F64, F64], F64]
-#: Panel edges [rad] of the angle from the mirror direction, and Gauss nodes per panel.
-PANEL_EDGES_RAD = (0.0, 1e-4, 1e-3, 1e-2, 0.05, 0.2, np.pi)
-NODES_PER_PANEL = 16
-AZIMUTHS = 96
+#: Panel edges [rad] of the angle from the mirror direction, and Gauss nodes per panel;
+#: the outer panels resolve where the horizon cuts a wide lobe. Against 64 nodes x 512
+#: azimuths: within 2e-5 for Phong (n = 30), ABg, GGX (alpha = 0.2) and Beckmann (alpha =
+#: 0.05) lobes at 10, 50 and 80 deg incidence.
+PANEL_EDGES_RAD = (0.0, 1e-4, 1e-3, 1e-2, 0.05, 0.2, 0.6, 1.2, np.pi)
+NODES_PER_PANEL = 24
+AZIMUTHS = 128
 #: Incidence angles [deg] at which :func:`max_albedo` looks for the largest albedo.
 INCIDENCE_GRID_DEG = (0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 87.0)
 
