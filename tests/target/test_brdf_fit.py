@@ -15,9 +15,13 @@ import numpy as np
 import pytest
 
 from speclight.errors import InputError
-from speclight.target.brdf_fit.directional_albedo import max_albedo, shading_cosines
+from speclight.target.brdf_fit.directional_albedo import (
+    ALBEDO_TOLERANCE,
+    max_albedo,
+    shading_cosines,
+)
 from speclight.target.brdf_fit.form_coefficients import evaluate
-from speclight.target.brdf_fit.log_fit import ALBEDO_TOLERANCE, fit_table_samples
+from speclight.target.brdf_fit.log_fit import fit_table_samples
 from speclight.target.brdf_samples import read_table_samples
 
 INCIDENCE_DEG = (5.0, 30.0, 60.0, 75.0)

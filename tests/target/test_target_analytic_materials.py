@@ -12,6 +12,7 @@ from speclight.errors import InputError
 from speclight.render.bsdfs import material_bsdf
 from speclight.scenario.sections_light import Material as ScenarioMaterial
 from speclight.target import Material, Reflectance, material_from_spec
+from speclight.target.brdf_fit.directional_albedo import EnergyWarning
 
 PHONG = {"kd": 0.1, "ks": 0.4, "n": 30.0}
 
@@ -92,3 +93,19 @@ def test_a_table_without_a_wavelength_refuses_a_spectral_reflectance(tmp_path):
     m = Material("m", "measured", refl, brdf_table=str(table))
     with pytest.raises(InputError, match="a spectral reflectance is normalised at the wave"):
         material_bsdf(m, "single").main_factor(np.ones(1), np.array([500.0]))
+
+
+def test_a_material_that_creates_energy_is_a_notice(tmp_path):
+    # Kandula et al. 2025's ABg fit of a bare aluminium chassis (starlink_gen2_surfaces.txt)
+    # reflects 1.74 times the light it receives at normal incidence; accepted as given (a
+    # published model), with a notice
+    coefficients = {"a": 0.01999, "b": 2.285e-6, "g": 2.264}
+    with pytest.warns(EnergyWarning, match=r"bsdf abg\) reflects 1\.7\d times the light"):
+        material_from_spec("bare", {"bsdf": "abg", "coefficients": coefficients})
+    # a table of a uniform f = 1 sr-1: albedo pi (Lambert) where it holds, less where its
+    # (bounded) extension does: 3.08 at normal incidence
+    table = tmp_path / "bright.csv"
+    rows = [f"{ti} -180 {to} 0 1.0" for ti in (5.0, 40.0, 70.0) for to in range(-85, 86)]
+    table.write_text("\n".join(rows) + "\n")
+    with pytest.warns(EnergyWarning, match=r"bright.csv .* reflects 3\.0\d times"):
+        Material("m", "measured", Reflectance.constant(1.0), brdf_table=str(table))

@@ -199,6 +199,7 @@ def _grid(samples: TableSamples) -> tuple[F64, F64]:
 def load_brdf_table(name_or_path: str, extension: str = DEFAULT_EXTENSION) -> MeasuredBRDF:
     """A shipped (by name) or user BRDF table with its support and ``extension`` (one of
     :data:`EXTENSIONS`, fitted to the table; see the module doc)."""
+    from speclight.target.brdf_fit.directional_albedo import warn_if_creating_energy
     from speclight.target.brdf_fit.log_fit import fit_table_samples
 
     samples = read_table_samples(name_or_path)
@@ -212,6 +213,13 @@ def load_brdf_table(name_or_path: str, extension: str = DEFAULT_EXTENSION) -> Me
             source=samples.source,
             field=exc.field,
         ) from None
-    return MeasuredBRDF(
+    table = MeasuredBRDF(
         values, support, samples.wavelength_nm, samples.source, (extension, fit.coefficients)
     )
+    warn_if_creating_energy(
+        f"BRDF table {samples.source} (with its {extension} extension)",
+        lambda *c: table.table_part(c[2], c[3]) + table.extension_part(*c),
+        "its in-plane curves, extended to all azimuths, reflect more light than arrives; "
+        "use an analytic model fitted to it (speclight brdf-fit) instead",
+    )
+    return table

@@ -31,11 +31,18 @@ checked by :mod:`speclight.target.brdf_fit.form_coefficients`.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from functools import cache
 from types import MappingProxyType
 from typing import Any, Literal
 
 from speclight.errors import InputError, did_you_mean
-from speclight.target.brdf_fit.form_coefficients import FORMS, coefficient_problem
+from speclight.target.brdf_fit.directional_albedo import warn_if_creating_energy
+from speclight.target.brdf_fit.form_coefficients import (
+    FORMS,
+    FrozenCoefficients,
+    coefficient_problem,
+    evaluate,
+)
 from speclight.target.brdf_table import DEFAULT_EXTENSION, EXTENSIONS, load_brdf_table
 from speclight.target.bsdf_model_types import BsdfModel, BsdfParameter
 from speclight.target.rgl_file import check_rgl_material, is_rgl_path
@@ -157,6 +164,23 @@ MEASURED_RGL = BsdfModel(
 )
 
 
+@cache
+def _albedo_checked(name: str, coefficients: FrozenCoefficients, label: str) -> None:
+    """Warn (once per model, coefficients and material) when they create energy."""
+    warn_if_creating_energy(
+        label,
+        lambda *c: evaluate(name, coefficients, *c),
+        "check its coefficients (speclight brdf-fit holds a fit to at most 1)",
+    )
+
+
+def _check_energy(material: Any, where: str) -> None:
+    """A notice when a material's analytic BRDF reflects more than it receives."""
+    if isinstance(material.coefficients, FrozenCoefficients):
+        label = f"{where} (bsdf {material.bsdf})"
+        _albedo_checked(material.bsdf, material.coefficients, label)
+
+
 def _analytic(name: str, summary: str, *examples: Mapping[str, Any]) -> BsdfModel:
     """An analytic model; an example with a ``reflectance`` key is taken as a whole."""
     return BsdfModel(
@@ -171,6 +195,7 @@ def _analytic(name: str, summary: str, *examples: Mapping[str, Any]) -> BsdfMode
             dict(e) if "reflectance" in e else {"bsdf": name, "coefficients": dict(e)}
             for e in examples
         ),
+        check=_check_energy,
     )
 
 

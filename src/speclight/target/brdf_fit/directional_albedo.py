@@ -10,6 +10,7 @@ the trapezoid rule in the azimuth about it.
 from __future__ import annotations
 
 import itertools
+import warnings
 from collections.abc import Callable
 
 import numpy as np
@@ -17,6 +18,16 @@ from numpy.typing import NDArray
 
 F64 = NDArray[np.float64]
 Cosines = Callable[[F64, F64, F64, F64], F64]
+#: Albedo above which a BRDF is taken to create energy (this quadrature's accuracy on the
+#: narrowest lobes, with a margin).
+ALBEDO_TOLERANCE = 1e-3
+
+
+class EnergyWarning(UserWarning):
+    """A BRDF that reflects more light than it receives at some incidence (a directional
+    albedo above 1); the run goes on as given."""
+
+
 #: Panel edges [rad] of the angle from the mirror direction, and Gauss nodes per panel;
 #: the outer panels resolve where the horizon cuts a wide lobe. Against 64 nodes x 512
 #: azimuths: within 2e-5 for Phong (n = 30), ABg, GGX (alpha = 0.2) and Beckmann (alpha =
@@ -72,3 +83,17 @@ def max_albedo(brdf: Cosines) -> tuple[float, float]:
     albedos = [directional_albedo(brdf, np.radians(t)) for t in INCIDENCE_GRID_DEG]
     k = int(np.argmax(albedos))
     return albedos[k], INCIDENCE_GRID_DEG[k]
+
+
+def warn_if_creating_energy(what: str, brdf: Cosines, remedy: str) -> float:
+    """Issue an :class:`EnergyWarning` naming ``what`` and ``remedy`` when ``brdf``'s largest
+    albedo exceeds 1 (+ :data:`ALBEDO_TOLERANCE`); returns that albedo."""
+    albedo, at = max_albedo(brdf)
+    if albedo > 1.0 + ALBEDO_TOLERANCE:
+        warnings.warn(
+            f"{what} reflects {albedo:.2f} times the light it receives at {at:g} deg "
+            f"incidence (directional albedo above 1): {remedy}",
+            EnergyWarning,
+            stacklevel=3,
+        )
+    return albedo

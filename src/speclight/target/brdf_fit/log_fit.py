@@ -24,15 +24,13 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares, minimize
 
 from speclight.errors import InputError, did_you_mean
-from speclight.target.brdf_fit.directional_albedo import max_albedo
+from speclight.target.brdf_fit.directional_albedo import ALBEDO_TOLERANCE, max_albedo
 from speclight.target.brdf_fit.form_coefficients import BINOMIAL_SHAPE, FORMS, AnalyticForm
 from speclight.target.brdf_samples import TableSamples
 
 F64 = NDArray[np.float64]
 #: Smallest model value taken into log space [sr-1] (a form that is 0 somewhere).
 LOG_FLOOR = 1e-30
-#: Albedo above which a fit is refitted under the constraint (the quadrature's accuracy).
-ALBEDO_TOLERANCE = 1e-3
 
 
 @dataclass(frozen=True)
