@@ -121,3 +121,25 @@ def test_uncommented_header_line_is_skipped(tmp_path):
     table = write_table(tmp_path / "t.csv", *CASES[0], header="phi_i theta_i phi_o theta_o brdf")
     samples = read_table_samples(str(table))
     assert samples.brdf.size == 4 * 171 and np.isnan(samples.wavelength_nm)
+
+
+def test_coefficients_and_parameter_vectors_round_trip():
+    # the vector a fit varies (pack) and the coefficients it stands for (unpack): the same
+    # model (issue 24 item 7 fits observations through them)
+    from speclight.target.brdf_fit.form_coefficients import BINOMIAL_SHAPE, FORMS
+
+    shapes = {"binomial": BINOMIAL_SHAPE, "microfacet": {"distribution": "ggx", "fresnel": "exact"}}
+    examples = {
+        **dict(CASES),
+        "binomial": {"b": [[0.5, -0.3]], "c": [[0.1] * 10], "d": 3.0, "l1": -5},
+        "microfacet": {**CASES[2][1], "fresnel": "exact"},
+    }
+    for name, form in FORMS.items():
+        coefficients = examples[name]
+        back = form.unpack(form.pack(coefficients), **shapes.get(name, {}))
+        for key, value in coefficients.items():
+            if isinstance(value, str):
+                assert back[key] == value
+            else:  # abg packs log10 of a and b: rounding through 10**log10
+                want = np.asarray(value, dtype=float)
+                np.testing.assert_allclose(np.asarray(back[key], dtype=float), want, rtol=1e-14)
