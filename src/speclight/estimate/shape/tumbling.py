@@ -1,0 +1,189 @@
+"""Tumbling (non-principal-axis) rotation: the torque-free state fitted to light curves.
+
+The body's EGI (``normals``, ``areas``: e.g. the scenario's mesh, :func:`.egi.mesh_egi`) and
+scattering law are given; the state at ``t0`` is fitted: the attitude ``q0`` (body to
+ecliptic J2000, as a rotation vector), the body rates ``omega0`` [rad/s] and the principal
+moments (body axes principal) as ``I = tr(M) 1 - M`` of second moments
+``M = diag(exp(u1), exp(u2), 1)`` (any ``u`` gives moments that satisfy the triangle
+inequality of a real body), and for calibrated data a log-scale of the areas. The attitude at
+each epoch comes from speclight's torque-free propagation
+(:func:`speclight.attitude.torque_free_attitude`, closed form), the brightness from the
+convex model (:func:`.convex_model.facet_brightness`).
+
+Light curves do not fix the state uniquely (Kaasalainen 2001, A&A 376, 302; Pravec et al.
+2005, Icarus 173, 108): a body symmetry maps a state onto another with the same light
+curve, and different precession/rotation combinations fit nearly as well. So the fit is
+multi-start (:data:`N_STARTS` random states: uniform attitudes, rates from the period range,
+second moments log-uniform), each run by trust-region least squares
+(:func:`scipy.optimize.least_squares`, gradient from 2-point differences), and every
+solution within ``chi2_min + delta s^2`` (``delta`` the 99 % point of chi-square with as many
+degrees of freedom as parameters) is kept. Solutions are grouped into families by what
+a body symmetry does not change: the direction of the angular momentum in the ecliptic
+frame (within :data:`FAMILY_ANGLE_DEG`), the rotation rate ``|H| / I_max`` and the sorted
+moment ratios (within :data:`FAMILY_RELATIVE`); every family is reported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import stats
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+
+from speclight.attitude import torque_free_attitude
+from speclight.attitude.quaternion import quat_conjugate, quat_rotate
+from speclight.estimate.shape.convex_model import facet_brightness, relative_residuals
+from speclight.estimate.shape.ecliptic import angular_distance_deg
+from speclight.estimate.shape.inversion_data import InversionData
+from speclight.estimate.shape.scattering import ScatteringLaw
+
+F64 = NDArray[np.float64]
+N_STARTS = 32
+FAMILY_ANGLE_DEG = 10.0
+FAMILY_RELATIVE = 0.05
+SECONDS_PER_DAY = 86400.0
+MOMENT_SPREAD = 2.0  # second moments drawn log-uniform within e^(+-2)
+MOMENT_BOUND = 6.0  # and kept within e^(+-6) (a needle or a disk: moment ratios to 5e-3)
+MAX_EVALUATIONS = 200
+
+
+@dataclass(frozen=True)
+class TumblingState:
+    """One fitted torque-free state (module doc).
+
+    Attributes
+    ----------
+    q0
+        (4,) body-to-ecliptic quaternion at ``t0`` (scalar first).
+    omega0_body_rad_s
+        (3,) body rates at ``t0`` [rad/s].
+    moments
+        (3,) principal moments along the body axes, the largest 1 [1].
+    chi2
+        Sum of squared residuals.
+    """
+
+    q0: F64
+    omega0_body_rad_s: F64
+    moments: F64
+    chi2: float
+
+    @property
+    def momentum_direction(self) -> F64:
+        """Unit angular momentum in ecliptic J2000."""
+        h = quat_rotate(self.q0, self.moments * self.omega0_body_rad_s)
+        return np.asarray(h / np.linalg.norm(h))
+
+    @property
+    def rate_rad_s(self) -> float:
+        """``|H| / I_max`` [rad/s]."""
+        return float(np.linalg.norm(self.moments * self.omega0_body_rad_s) / np.max(self.moments))
+
+    @property
+    def moment_ratios(self) -> F64:
+        """(2,) the smaller moments over the largest, sorted."""
+        m = np.sort(self.moments)
+        return np.asarray(m[:2] / m[2])
+
+
+@dataclass(frozen=True)
+class TumblingFit:
+    """Result of :func:`fit_tumbling`: ``families`` (each a list of states, lowest chi-square
+    first; families ordered by their best), ``threshold`` (the chi-square bound of the kept
+    states) and ``starts`` (every converged start)."""
+
+    families: list[list[TumblingState]]
+    threshold: float
+    starts: list[TumblingState]
+
+
+def _moments(u: F64) -> F64:
+    m = np.array([np.exp(u[0]), np.exp(u[1]), 1.0])
+    inertia = np.sum(m) - m
+    return np.asarray(inertia / np.max(inertia))
+
+
+class _Problem:
+    def __init__(self, data: InversionData, normals: F64, areas: F64, law: ScatteringLaw,
+                 t0_jd: float) -> None:  # fmt: skip
+        self.data, self.normals, self.areas, self.law = data, normals, areas, law
+        self.t_s = (data.time_jd - t0_jd) * SECONDS_PER_DAY
+        self.calibrated = bool(np.any(data.calibrated))
+
+    def state(self, x: F64) -> tuple[F64, F64, F64, float]:
+        q = Rotation.from_rotvec(x[:3]).as_quat(scalar_first=True)
+        scale = float(np.exp(x[8])) if self.calibrated else 1.0
+        return q, x[3:6], _moments(x[6:8]), scale
+
+    def residuals(self, x: F64) -> F64:
+        q0, w0, moments, scale = self.state(x)
+        q, _ = torque_free_attitude(self.t_s, moments, q0, w0)
+        qc = quat_conjugate(q)
+        s_b = quat_rotate(qc, self.data.sun_ecliptic)
+        o_b = quat_rotate(qc, self.data.observer_ecliptic)
+        lum = scale * facet_brightness(s_b, o_b, self.normals, self.areas, self.law,
+                                       self.data.cos_half_phase)  # fmt: skip
+        return relative_residuals(self.data, lum)
+
+
+def fit_tumbling(
+    data: InversionData,
+    normals: F64,
+    areas: F64,
+    law: ScatteringLaw,
+    t0_jd: float,
+    *,
+    min_period_h: float,
+    max_period_h: float,
+    n_starts: int = N_STARTS,
+    seed: int = 0,
+) -> TumblingFit:
+    """Multi-start fit of the torque-free state and its families (module doc)."""
+    prob = _Problem(data, normals, areas, law, t0_jd)
+    rng = np.random.default_rng(seed)
+    starts = []
+    for _ in range(n_starts):
+        rate = 2 * np.pi / (3600.0 * np.exp(rng.uniform(np.log(min_period_h), np.log(max_period_h))))
+        x0 = np.concatenate([Rotation.random(rng=rng).as_rotvec(),
+                             rate * _unit(rng.normal(size=3)),
+                             rng.uniform(-MOMENT_SPREAD, MOMENT_SPREAD, 2), [0.0]])  # fmt: skip
+        n_par = 9 if prob.calibrated else 8
+        lower, upper = np.full(n_par, -np.inf), np.full(n_par, np.inf)
+        lower[6:8], upper[6:8] = -MOMENT_BOUND, MOMENT_BOUND
+        res = least_squares(prob.residuals, x0[:n_par], bounds=(lower, upper), method="trf",
+                            x_scale="jac", max_nfev=MAX_EVALUATIONS)  # fmt: skip
+        q0, w0, moments, _ = prob.state(np.append(res.x, 0.0)[:9])
+        starts.append(TumblingState(q0, w0, moments, float(2.0 * res.cost)))
+    starts.sort(key=lambda s: s.chi2)
+    s2 = starts[0].chi2 / max(data.n_points - n_par, 1)
+    threshold = starts[0].chi2 + float(stats.chi2.ppf(0.99, n_par)) * s2
+    kept = [s for s in starts if s.chi2 <= threshold]
+    return TumblingFit(_families(kept), threshold, starts)
+
+
+def _unit(v: F64) -> F64:
+    return np.asarray(v / np.linalg.norm(v))
+
+
+def same_family(a: TumblingState, b: TumblingState) -> bool:
+    """True when two states agree in what a body symmetry leaves (module doc)."""
+    return bool(
+        angular_distance_deg(a.momentum_direction, b.momentum_direction) <= FAMILY_ANGLE_DEG
+        and abs(a.rate_rad_s / b.rate_rad_s - 1.0) <= FAMILY_RELATIVE
+        and np.all(np.abs(a.moment_ratios - b.moment_ratios) <= FAMILY_RELATIVE)
+    )
+
+
+def _families(states: list[TumblingState]) -> list[list[TumblingState]]:
+    families: list[list[TumblingState]] = []
+    for s in states:
+        for fam in families:
+            if same_family(fam[0], s):
+                fam.append(s)
+                break
+        else:
+            families.append([s])
+    return families
