@@ -48,6 +48,9 @@ SECONDS_PER_DAY = 86400.0
 MOMENT_SPREAD = 2.0  # second moments drawn log-uniform within e^(+-2)
 MOMENT_BOUND = 6.0  # and kept within e^(+-6) (a needle or a disk: moment ratios to 5e-3)
 MAX_EVALUATIONS = 200
+N_SEEDS = 6
+PHASE_DRIFT = 0.2  # turns of phase drift over the gap between rate-scale trials
+RATE_SPAN = 0.03  # relative rate error of a seed curve's solution covered by the trials
 
 
 @dataclass(frozen=True)
@@ -64,12 +67,15 @@ class TumblingState:
         (3,) principal moments along the body axes, the largest 1 [1].
     chi2
         Sum of squared residuals.
+    scale
+        Factor on the areas (calibrated data; 1 for relative).
     """
 
     q0: F64
     omega0_body_rad_s: F64
     moments: F64
     chi2: float
+    scale: float = 1.0
 
     @property
     def momentum_direction(self) -> F64:
@@ -92,12 +98,13 @@ class TumblingState:
 @dataclass(frozen=True)
 class TumblingFit:
     """Result of :func:`fit_tumbling`: ``families`` (each a list of states, lowest chi-square
-    first; families ordered by their best), ``threshold`` (the chi-square bound of the kept
-    states) and ``starts`` (every converged start)."""
+    first; families ordered by their best), ``worst_kept_chi2`` (the largest chi-square kept),
+    ``solutions`` (every final fit) and ``t0_jd`` (the states' epoch [d])."""
 
     families: list[list[TumblingState]]
-    threshold: float
-    starts: list[TumblingState]
+    worst_kept_chi2: float
+    solutions: list[TumblingState]
+    t0_jd: float
 
 
 def _moments(u: F64) -> F64:
@@ -134,34 +141,92 @@ def fit_tumbling(
     normals: F64,
     areas: F64,
     law: ScatteringLaw,
-    t0_jd: float,
     *,
     min_period_h: float,
     max_period_h: float,
     n_starts: int = N_STARTS,
     seed: int = 0,
+    initial_states: list[TumblingState] | None = None,
+    t0_jd: float | None = None,
 ) -> TumblingFit:
-    """Multi-start fit of the torque-free state and its families (module doc)."""
-    prob = _Problem(data, normals, areas, law, t0_jd)
+    """Multi-start fit of the torque-free state and its families (module doc).
+
+    The state's epoch ``t0`` is the middle of the longest light curve (the seed). Stage 1:
+    ``n_starts`` random starts fitted to the seed curve alone (a few rotations: a smoother
+    misfit). Stage 2: the seed's solutions within its threshold (at most
+    :data:`N_SEEDS`, one per family) are carried to all curves; over a gap of ``T`` the
+    rotation phase drifts by ``T / P`` turns per unit of relative rate error, so each starts
+    at rate scales ``1 + j dc``, ``dc =`` :data:`PHASE_DRIFT` ``P / T``, ``|j dc| <=``
+    :data:`RATE_SPAN` (a torque-free motion with its rates scaled by ``c`` is the same
+    motion ``c`` times faster), and the lowest of all is kept as in stage 1.
+
+    ``initial_states`` (at ``t0_jd``, default the seed curve's middle) are tried before the
+    random starts: a prior (e.g. the scenario's attitude) narrows a search that random
+    starts alone rarely win (docs/shape.md, "Limits").
+    """
+    counts = np.bincount(data.curve)
+    seed_curve = int(np.argmax(counts))
+    in_seed = np.flatnonzero(data.curve == seed_curve)
+    if t0_jd is None:
+        t0_jd = float(np.mean(data.time_jd[in_seed][[0, -1]]))
     rng = np.random.default_rng(seed)
-    starts = []
-    for _ in range(n_starts):
-        rate = 2 * np.pi / (3600.0 * np.exp(rng.uniform(np.log(min_period_h), np.log(max_period_h))))
-        x0 = np.concatenate([Rotation.random(rng=rng).as_rotvec(),
-                             rate * _unit(rng.normal(size=3)),
-                             rng.uniform(-MOMENT_SPREAD, MOMENT_SPREAD, 2), [0.0]])  # fmt: skip
-        n_par = 9 if prob.calibrated else 8
-        lower, upper = np.full(n_par, -np.inf), np.full(n_par, np.inf)
-        lower[6:8], upper[6:8] = -MOMENT_BOUND, MOMENT_BOUND
-        res = least_squares(prob.residuals, x0[:n_par], bounds=(lower, upper), method="trf",
+    seed_prob = _Problem(data.subset(in_seed), normals, areas, law, t0_jd)
+    x_starts = [_state_vector(s, 1.0) for s in initial_states or []]
+    x_starts += [_random_start(rng, min_period_h, max_period_h) for _ in range(n_starts)]
+    first = _fit_all(seed_prob, x_starts)
+    seeds = [fam[0] for fam in _families(_within(first, seed_prob))][:N_SEEDS]
+    prob = _Problem(data, normals, areas, law, t0_jd)
+    if data.n_curves == 1:
+        final = first
+    else:
+        gap_s = float(np.ptp(data.time_jd)) * SECONDS_PER_DAY
+        x_next = []
+        for sol in seeds:
+            period_s = 2 * np.pi / sol.rate_rad_s
+            dc = PHASE_DRIFT * period_s / gap_s
+            for j in np.arange(-np.floor(RATE_SPAN / dc), np.floor(RATE_SPAN / dc) + 1):
+                x_next.append(_state_vector(sol, 1.0 + j * dc))
+        final = _fit_all(prob, x_next)
+    kept = _within(final, prob)
+    return TumblingFit(_families(kept), kept[-1].chi2, final, t0_jd)
+
+
+def _random_start(rng: np.random.Generator, min_period_h: float, max_period_h: float) -> F64:
+    period_s = 3600.0 * np.exp(rng.uniform(np.log(min_period_h), np.log(max_period_h)))
+    return np.concatenate([Rotation.random(rng=rng).as_rotvec(),
+                           2 * np.pi / period_s * _unit(rng.normal(size=3)),
+                           rng.uniform(-MOMENT_SPREAD, MOMENT_SPREAD, 2), [0.0]])  # fmt: skip
+
+
+def _state_vector(s: TumblingState, rate_scale: float) -> F64:
+    m = 0.5 * np.sum(s.moments) - s.moments  # second moments of I = tr(M) 1 - M
+    u = np.log(np.clip(m[:2] / m[2], np.exp(-MOMENT_BOUND), np.exp(MOMENT_BOUND)))
+    return np.concatenate([Rotation.from_quat(s.q0, scalar_first=True).as_rotvec(),
+                           s.omega0_body_rad_s * rate_scale, u, [np.log(s.scale)]])  # fmt: skip
+
+
+def _fit_all(prob: _Problem, starts: list[F64]) -> list[TumblingState]:
+    n_par = 9 if prob.calibrated else 8
+    lower, upper = np.full(n_par, -np.inf), np.full(n_par, np.inf)
+    lower[6:8], upper[6:8] = -MOMENT_BOUND, MOMENT_BOUND
+    out = []
+    for x0 in starts:
+        x = x0[:n_par].copy()
+        x[6:8] = np.clip(x[6:8], -MOMENT_BOUND, MOMENT_BOUND)
+        res = least_squares(prob.residuals, x, bounds=(lower, upper), method="trf",
                             x_scale="jac", max_nfev=MAX_EVALUATIONS)  # fmt: skip
-        q0, w0, moments, _ = prob.state(np.append(res.x, 0.0)[:9])
-        starts.append(TumblingState(q0, w0, moments, float(2.0 * res.cost)))
-    starts.sort(key=lambda s: s.chi2)
-    s2 = starts[0].chi2 / max(data.n_points - n_par, 1)
-    threshold = starts[0].chi2 + float(stats.chi2.ppf(0.99, n_par)) * s2
-    kept = [s for s in starts if s.chi2 <= threshold]
-    return TumblingFit(_families(kept), threshold, starts)
+        q0, w0, moments, scale = prob.state(np.append(res.x, 0.0)[:9])
+        out.append(TumblingState(q0, w0, moments, float(2.0 * res.cost), scale))
+    out.sort(key=lambda s: s.chi2)
+    return out
+
+
+def _within(states: list[TumblingState], prob: _Problem) -> list[TumblingState]:
+    """The states within ``chi2_min + delta s^2`` (module doc)."""
+    n_par = 9 if prob.calibrated else 8
+    s2 = states[0].chi2 / max(prob.data.n_points - n_par, 1)
+    threshold = states[0].chi2 + float(stats.chi2.ppf(0.99, n_par)) * s2
+    return [s for s in states if s.chi2 <= threshold]
 
 
 def _unit(v: F64) -> F64:
