@@ -21,6 +21,8 @@ F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
 #: Fewest points per light curve: a relative curve of fewer carries almost no shape.
 MIN_POINTS_PER_CURVE = 3
+#: Relative sigma given to points that come without one (about 0.01 mag).
+NOMINAL_SIGMA = 0.01
 
 
 @dataclass(frozen=True)
@@ -141,12 +143,13 @@ def build_inversion_data(
 
 def from_damit(curves: list[DamitLightCurve], source: str) -> InversionData:
     """Inversion data from the light curves of a DAMIT ``.lc`` file. The file has no sigmas:
-    each point's sigma is its curve's mean brightness, so that all points weigh the same in
-    relative terms; the uncertainties are then scaled by the residuals (:mod:`.uncertainty`)."""
+    each point's sigma is :data:`NOMINAL_SIGMA` times its curve's mean brightness (0.01 mag),
+    so that all points weigh the same in relative terms; the uncertainties are then scaled
+    by the residuals (:mod:`.uncertainty`)."""
     return build_inversion_data(
         np.concatenate([c.time_jd for c in curves]),
         np.concatenate([c.brightness for c in curves]),
-        np.concatenate([np.full(c.time_jd.size, np.mean(c.brightness)) for c in curves]),
+        np.concatenate([np.full(c.time_jd.size, NOMINAL_SIGMA * np.mean(c.brightness)) for c in curves]),
         np.concatenate([c.sun_ecliptic_au for c in curves]),
         np.concatenate([c.observer_ecliptic_au for c in curves]),
         np.concatenate([np.full(c.time_jd.size, k) for k, c in enumerate(curves)]),

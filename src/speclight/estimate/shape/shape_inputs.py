@@ -28,6 +28,7 @@ from speclight.errors import InputError, did_you_mean
 from speclight.estimate.shape.damit_lc import read_damit_lc
 from speclight.estimate.shape.ecliptic import gcrs_to_ecliptic, julian_date
 from speclight.estimate.shape.inversion_data import (
+    NOMINAL_SIGMA,
     InversionData,
     build_inversion_data,
     from_damit,
@@ -144,7 +145,7 @@ def _speclight_input(
         # no sigmas: the same relative weight for every point (as a DAMIT file)
         means = np.array([np.nanmean(brightness[curve == c]) if np.any(np.isfinite(
             brightness[curve == c])) else 1.0 for c in range(curve.max() + 1)])  # fmt: skip
-        mean_sigma = 0.01 * means[curve]
+        mean_sigma = NOMINAL_SIGMA * means[curve]
     data = build_inversion_data(emitted_jd, brightness, mean_sigma, sun, obs, curve,
                                 np.ones(curve.max() + 1, bool), src)  # fmt: skip
     keep = np.isin(emitted_jd, data.time_jd)
