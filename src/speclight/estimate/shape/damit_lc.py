@@ -81,7 +81,7 @@ def read_damit_lc(path: str | Path) -> list[DamitLightCurve]:
     ------
     InputError
         Naming the file and line: a count that does not match the lines that follow, a
-        flag other than 0 or 1, a line that is not 8 numbers, a non-positive brightness, a
+        flag other than 0 or 1, a line that is not 8 numbers, a negative brightness, a
         zero Sun or observer vector.
     """
     src = str(path)
@@ -133,9 +133,9 @@ def _count(line: str, lineno: int, src: str, what: str) -> int:
 
 def _check_points(data: F64, linenos: list[int], src: str) -> None:
     for col, what in ((1, "brightness"),):
-        bad = np.flatnonzero(data[:, col] <= 0.0)
+        bad = np.flatnonzero(data[:, col] < 0.0)
         if bad.size:
-            raise InputError(f"line {linenos[bad[0]]}: {what} {data[bad[0], col]} must be > 0 "
+            raise InputError(f"line {linenos[bad[0]]}: {what} {data[bad[0], col]} must be >= 0 "
                              "(intensities, not magnitudes)", source=src, field=FIELD)  # fmt: skip
     for cols, what in ((slice(2, 5), "Sun"), (slice(5, 8), "observer")):
         zero = np.flatnonzero(np.linalg.norm(data[:, cols], axis=1) == 0.0)

@@ -25,7 +25,7 @@ from scipy.spatial import ConvexHull, HalfspaceIntersection
 from speclight.estimate.shape.egi import close_egi
 
 F64 = NDArray[np.float64]
-MAX_ITERATIONS = 2000
+MAX_ITERATIONS = 500
 
 
 @dataclass(frozen=True)
@@ -81,7 +81,7 @@ def minkowski_polyhedron(normals: F64, areas: F64) -> Polyhedron:
     h0 = np.ones(len(normals))
     res = minimize(objective, h0, jac=True, method="L-BFGS-B",
                    bounds=[(1e-6, None)] * len(normals),
-                   options={"maxiter": MAX_ITERATIONS, "gtol": 1e-10, "ftol": 1e-14})  # fmt: skip
+                   options={"maxiter": MAX_ITERATIONS, "gtol": 1e-9, "ftol": 1e-11})  # fmt: skip
     poly = polyhedron(normals, res.x)
     scale = np.sqrt(np.sum(areas) / np.sum(poly.facet_area))
     return Polyhedron(poly.vertices * scale, poly.faces, poly.facet_area * scale**2,
