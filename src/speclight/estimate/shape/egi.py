@@ -83,9 +83,14 @@ def egi_difference(areas: F64, reference: F64, normals: F64, fwhm_deg: float) ->
     return float(0.5 * np.sum(np.abs(p / p.sum() - q / q.sum())))
 
 
-def _is_closed(faces: NDArray[np.int64]) -> bool:
-    """True when every edge of the mesh is shared by exactly two faces."""
-    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+def _is_closed(vertices: F64, faces: NDArray[np.int64]) -> bool:
+    """True when every edge of the mesh is shared by exactly two faces (vertices at the
+    same place, to 1e-9 of the mesh's size, are one: faces built as separate quads)."""
+    v = np.asarray(vertices, float)
+    size = max(float(np.ptp(v)), 1e-300)
+    _, same = np.unique(np.round(v / (1e-9 * size)), axis=0, return_inverse=True)
+    f = same.ravel()[np.asarray(faces)]
+    edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
     _, counts = np.unique(edges, axis=0, return_counts=True)
     return bool(np.all(counts == 2))
 
@@ -104,7 +109,7 @@ def mesh_facets(parts: list[tuple[F64, NDArray[np.int64]]]) -> tuple[F64, F64]:
         unit = cross[keep] / (2.0 * area[keep, None])
         normals.append(unit)
         areas.append(area[keep])
-        if not _is_closed(np.asarray(faces)):
+        if not _is_closed(vertices, np.asarray(faces)):
             normals.append(-unit)
             areas.append(area[keep])
     return np.vstack(normals), np.concatenate(areas)
