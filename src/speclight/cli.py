@@ -1177,6 +1177,11 @@ def shape(
         int, typer.Option("--bootstrap", help="Bootstrap refits for the uncertainties.")
     ] = 0,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the bootstrap.")] = 0,
+    tumbling_starts: Annotated[
+        int,
+        typer.Option("--tumbling-starts", help="Also fit torque-free (tumbling) states from "
+                     "this many random starts, the scenario's target as the EGI (0: off)."),
+    ] = 0,
     plot_file: Annotated[
         str | None, typer.Option("--plot", metavar="FIG", help="Figure (.png, .pdf, .svg).")
     ] = None,
@@ -1194,17 +1199,22 @@ def shape(
         from speclight.estimate.shape.shape_run import ShapeOptions
 
         for name, value, ok in (("--nside", nside, nside in (1, 2, 4, 8, 16)),
-                                ("--bootstrap", bootstrap, bootstrap >= 0)):  # fmt: skip
+                                ("--bootstrap", bootstrap, bootstrap >= 0),
+                                ("--tumbling-starts", tumbling_starts, tumbling_starts >= 0)):  # fmt: skip
             if not ok:
                 raise InputError(f"{name} = {value} is not accepted (nside: 1, 2, 4, 8 or 16; "
-                                 "bootstrap: >= 0)", field=name)  # fmt: skip
+                                 "the others: >= 0)", field=name)  # fmt: skip
         names = [b.strip() for b in bands.split(",") if b.strip()] if bands else None
         options = ShapeOptions(*period_range_h, law=law, nside=nside,
                                search_nside=min(2, nside), pole_step_deg=pole_step_deg,
                                bootstrap_draws=bootstrap, seed=seed, progress=True)  # fmt: skip
         ds, _ = shape_files(lc=lc, fmt=fmt, scenario=scenario, options=options, output=output,
-                            plot=plot_file, force=force, bands=names)  # fmt: skip
+                            plot=plot_file, force=force, bands=names,
+                            tumbling_starts=tumbling_starts)  # fmt: skip
         a = ds.attrs
+        if "tumbling_families" in a:
+            typer.echo(f"tumbling: {a['tumbling_families']} solution families (SHAPE.nc "
+                       "tumbling_*)")
         typer.echo(f"period {a['period_h']:.7g} +- {a['period_std_h']:.2g} h, pole (lambda, "
                    f"beta) ({a['pole_lambda_deg']:.1f}, {a['pole_beta_deg']:.1f}) +- "
                    f"{a['pole_std_deg']:.2g} deg ecliptic J2000; {a['verdict']}")  # fmt: skip

@@ -33,6 +33,7 @@ def shape_files(
     plot: str | None,
     force: bool,
     bands: list[str] | None = None,
+    tumbling_starts: int = 0,
 ) -> tuple[xr.Dataset, ShapeRun]:
     """Read ``lc``, invert it, write ``output``, its OBJ and the figure ``plot``.
 
@@ -52,6 +53,8 @@ def shape_files(
         Overwrite existing outputs.
     bands
         Bands averaged into the brightness (default all).
+    tumbling_starts
+        Random starts of the tumbling fit (:mod:`.tumbling_run`; 0: none).
     """
     from speclight.io.netcdf import dataset_bytes
     from speclight.io.output import OutputClaim
@@ -71,6 +74,12 @@ def shape_files(
         data = read_shape_input(lc, fmt, loaded, bands)
         run = run_shape(data, options)
         ds = shape_dataset(run, str(obj) if run.polyhedron is not None else None)
+        if tumbling_starts > 0:
+            from speclight.estimate.shape.tumbling_run import add_tumbling, tumbling_fit
+
+            ds = add_tumbling(ds, tumbling_fit(
+                data, run.law, min_period_h=options.min_period_h,
+                max_period_h=options.max_period_h, n_starts=tumbling_starts, seed=options.seed))  # fmt: skip
         claim.write(dataset_bytes(ds))
         if run.polyhedron is not None:
             obj_claim.write(format_obj(run.polyhedron, f"speclight shape: EGI of {lc}").encode())
