@@ -29,19 +29,20 @@ from pathlib import Path
 
 import numpy as np
 import trimesh
+from threadpoolctl import threadpool_limits
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests" / "estimate" / "shape"))
-from synthetic import apparitions, lambert_mesh_brightness, to_body  # noqa: E402
+from synthetic import apparitions, lambert_mesh_brightness, to_body
 
-from speclight.estimate.shape import ShapeOptions, run_shape  # noqa: E402
-from speclight.estimate.shape.convex_fit import fit_convex  # noqa: E402
-from speclight.estimate.shape.convex_model import ConvexModel  # noqa: E402
-from speclight.estimate.shape.ecliptic import angular_distance_deg, pole_vector  # noqa: E402
-from speclight.estimate.shape.egi import facet_normals  # noqa: E402
-from speclight.estimate.shape.inversion_data import build_inversion_data  # noqa: E402
-from speclight.estimate.shape.period_scan import period_step_h  # noqa: E402
-from speclight.estimate.shape.scattering import scattering_law  # noqa: E402
-from speclight.estimate.shape.shape_inputs import ShapeInput  # noqa: E402
+from speclight.estimate.shape import ShapeOptions, run_shape
+from speclight.estimate.shape.convex_fit import fit_convex
+from speclight.estimate.shape.convex_model import ConvexModel
+from speclight.estimate.shape.ecliptic import angular_distance_deg, pole_vector
+from speclight.estimate.shape.egi import facet_normals
+from speclight.estimate.shape.inversion_data import build_inversion_data
+from speclight.estimate.shape.period_scan import period_step_h
+from speclight.estimate.shape.scattering import scattering_law
+from speclight.estimate.shape.shape_inputs import ShapeInput
 
 NOISE = 0.01
 
@@ -59,8 +60,9 @@ def _draw(rng: np.random.Generator, n_apparitions: int = 6, step_h: float = 0.3)
     sb, ob = (to_body(x, lam, bet, period, t, t0) for x in (sun, obs))
     y = lambert_mesh_brightness(np.asarray(m.vertices), np.asarray(m.faces), sb, ob)
     y = y * (1 + NOISE * rng.normal(size=y.size))
-    d = build_inversion_data(t, y, NOISE * y, sun, obs, curve,
-                             np.zeros(curve.max() + 1, bool), "draw")  # fmt: skip
+    d = build_inversion_data(
+        t, y, NOISE * y, sun, obs, curve, np.zeros(curve.max() + 1, bool), "draw"
+    )
     return d, lam, bet, period
 
 
@@ -73,35 +75,54 @@ def calibration(draws: int) -> None:
         lo = period - 3 * step * rng.uniform(0.2, 1.0)
         hi = period + 3 * step * rng.uniform(0.2, 1.0)
         t = time.perf_counter()
-        run = run_shape(ShapeInput(d, [], None, None, "1", "draw"),
-                        ShapeOptions(lo, hi, law="lambert", n_start_poles=4))  # fmt: skip
+        run = run_shape(
+            ShapeInput(d, [], None, None, "1", "draw"),
+            ShapeOptions(lo, hi, law="lambert", n_start_poles=4),
+        )
         seconds.append(time.perf_counter() - t)
         b, c = run.best, run.cov
         if angular_distance_deg(pole_vector(b.lambda_deg, b.beta_deg), pole_vector(lam, bet)) > 20:
             mirrors += 1
             reported += int(run.mirror_reported)
-            print(f"draw {k}: pole ({b.lambda_deg:.1f}, {b.beta_deg:.1f}) not the truth "
-                  f"({lam:.1f}, {bet:.1f}); mirror reported: {run.mirror_reported}")
+            print(
+                f"draw {k}: pole ({b.lambda_deg:.1f}, {b.beta_deg:.1f}) not the truth "
+                f"({lam:.1f}, {bet:.1f}); mirror reported: {run.mirror_reported}"
+            )
             continue
         dlam = (b.lambda_deg - lam + 180) % 360 - 180
-        z.append(((b.period_h - period) / c.period_h, (b.beta_deg - bet) / c.beta_deg,
-                  dlam / c.lambda_deg))  # fmt: skip
-        print(f"draw {k}: z = {np.round(z[-1], 2)}, sigma_P = {c.period_h:.2g} h, sigma_pole "
-              f"{c.pole_deg:.2g} deg, {seconds[-1]:.1f} s")  # fmt: skip
+        z.append(
+            (
+                (b.period_h - period) / c.period_h,
+                (b.beta_deg - bet) / c.beta_deg,
+                dlam / c.lambda_deg,
+            )
+        )
+        print(
+            f"draw {k}: z = {np.round(z[-1], 2)}, sigma_P = {c.period_h:.2g} h, sigma_pole "
+            f"{c.pole_deg:.2g} deg, {seconds[-1]:.1f} s"
+        )
     zz = np.array(z)
-    print(f"\n{len(z)} draws at the true pole, {mirrors} at another ({reported} with the mirror "
-          f"reported); median {np.median(seconds):.1f} s a draw")
+    print(
+        f"\n{len(z)} draws at the true pole, {mirrors} at another ({reported} with the mirror "
+        f"reported); median {np.median(seconds):.1f} s a draw"
+    )
     for name, col in zip(("period", "beta", "lambda cos beta"), zz.T, strict=True):
         print(f"  z({name}): std {np.std(col, ddof=1):.2f}, mean {np.mean(col):.2f}")
 
 
-def timing() -> None:
+def timing(blas_threads: int | None) -> None:
+    """One trial period and one pole-map fit; ``blas_threads``: BLAS threads (None: as
+    the library starts, all cores)."""
     rng = np.random.default_rng(1)
+    print(f"BLAS threads: {blas_threads or 'all'}")
     print("points facets  trial-period [s]  pole-map fit [s]")
     for n_app, nside in ((2, 2), (4, 2), (8, 2), (16, 2), (8, 1), (8, 4)):
         d, lam, bet, period = _draw(rng, n_apparitions=n_app)
-        model = ConvexModel(d, facet_normals(nside), scattering_law("lambert"), np.floor(d.time_jd[0]))
+        model = ConvexModel(
+            d, facet_normals(nside), scattering_law("lambert"), np.floor(d.time_jd[0])
+        )
         reps = 3
+        limit = threadpool_limits(limits=blas_threads, user_api="blas") if blas_threads else None
         t = time.perf_counter()
         for _ in range(reps):
             for pl, pb in ((0, 45), (120, -30), (240, 10), (60, -60)):
@@ -111,6 +132,8 @@ def timing() -> None:
         for _ in range(reps):
             fit_convex(model, lam, bet, period, free_pole=False, max_iterations=30)
         pole = (time.perf_counter() - t) / reps
+        if limit is not None:
+            limit.restore_original_limits()
         print(f"{d.n_points:6d} {len(model.normals):6d}  {trial:16.3f}  {pole:16.3f}")
 
 
@@ -121,7 +144,8 @@ def main() -> None:
     args = ap.parse_args()
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
     if args.part in ("timing", "all"):
-        timing()
+        timing(None)
+        timing(1)
     if args.part in ("calibration", "all"):
         calibration(args.draws)
 

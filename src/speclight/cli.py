@@ -1147,24 +1147,32 @@ def shape(
     ],
     period_range_h: Annotated[
         tuple[float, float],
-        typer.Option("--period-range-h", metavar="LO HI", help="Sidereal periods scanned, in hours."),
+        typer.Option(
+            "--period-range-h", metavar="LO HI", help="Sidereal periods scanned, in hours."
+        ),
     ],
     output: Annotated[
         str, typer.Option("--output", "-o", metavar="FILE", help="Output NetCDF (SHAPE.nc).")
     ] = "shape.nc",
     scenario: Annotated[
         Path | None,
-        typer.Option("--scenario", help="Scenario YAML: geometry and instrument (speclight "
-                     "input; a NetCDF's own by default)."),
+        typer.Option(
+            "--scenario",
+            help="Scenario YAML: geometry and instrument (speclight "
+            "input; a NetCDF's own by default).",
+        ),
     ] = None,
     fmt: Annotated[
         str, typer.Option("--format", help="Input format: speclight or damit.")
     ] = "speclight",
     law: Annotated[
         str,
-        typer.Option("--law", help="Scattering law: lambert, lommel-seeliger, ls-lambert, "
-                     "material:NAME (a scenario material) or auto (ls-lambert for DAMIT, "
-                     "lambert for speclight)."),
+        typer.Option(
+            "--law",
+            help="Scattering law: lambert, lommel-seeliger, ls-lambert, "
+            "material:NAME (a scenario material) or auto (ls-lambert for DAMIT, "
+            "lambert for speclight).",
+        ),
     ] = "auto",
     bands: Annotated[
         str | None, typer.Option("--bands", metavar="LIST", help="Comma-separated band names.")
@@ -1179,8 +1187,11 @@ def shape(
     seed: Annotated[int, typer.Option("--seed", help="Seed of the bootstrap.")] = 0,
     tumbling_starts: Annotated[
         int,
-        typer.Option("--tumbling-starts", help="Also fit torque-free (tumbling) states from "
-                     "this many random starts, the scenario's target as the EGI (0: off)."),
+        typer.Option(
+            "--tumbling-starts",
+            help="Also fit torque-free (tumbling) states from "
+            "this many random starts, the scenario's target as the EGI (0: off).",
+        ),
     ] = 0,
     plot_file: Annotated[
         str | None, typer.Option("--plot", metavar="FIG", help="Figure (.png, .pdf, .svg).")
@@ -1198,27 +1209,53 @@ def shape(
         from speclight.estimate.shape.shape_files import shape_files
         from speclight.estimate.shape.shape_run import ShapeOptions
 
-        for name, value, ok in (("--nside", nside, nside in (1, 2, 4, 8, 16)),
-                                ("--bootstrap", bootstrap, bootstrap >= 0),
-                                ("--tumbling-starts", tumbling_starts, tumbling_starts >= 0)):  # fmt: skip
+        for name, value, ok in (
+            ("--nside", nside, nside in (1, 2, 4, 8, 16)),
+            ("--bootstrap", bootstrap, bootstrap >= 0),
+            ("--tumbling-starts", tumbling_starts, tumbling_starts >= 0),
+        ):
             if not ok:
-                raise InputError(f"{name} = {value} is not accepted (nside: 1, 2, 4, 8 or 16; "
-                                 "the others: >= 0)", field=name)  # fmt: skip
+                raise InputError(
+                    f"{name} = {value} is not accepted (nside: 1, 2, 4, 8 or 16; the others: >= 0)",
+                    field=name,
+                )
         names = [b.strip() for b in bands.split(",") if b.strip()] if bands else None
-        options = ShapeOptions(*period_range_h, law=law, nside=nside,
-                               search_nside=min(2, nside), pole_step_deg=pole_step_deg,
-                               bootstrap_draws=bootstrap, seed=seed, progress=True)  # fmt: skip
-        ds, _ = shape_files(lc=lc, fmt=fmt, scenario=scenario, options=options, output=output,
-                            plot=plot_file, force=force, bands=names,
-                            tumbling_starts=tumbling_starts)  # fmt: skip
+        options = ShapeOptions(
+            *period_range_h,
+            law=law,
+            nside=nside,
+            search_nside=min(2, nside),
+            pole_step_deg=pole_step_deg,
+            bootstrap_draws=bootstrap,
+            seed=seed,
+            progress=True,
+        )
+        ds, _ = shape_files(
+            lc=lc,
+            fmt=fmt,
+            scenario=scenario,
+            options=options,
+            output=output,
+            plot=plot_file,
+            force=force,
+            bands=names,
+            tumbling_starts=tumbling_starts,
+        )
         a = ds.attrs
         if "tumbling_families" in a:
-            typer.echo(f"tumbling: {a['tumbling_families']} solution families (SHAPE.nc "
-                       "tumbling_*)")
-        typer.echo(f"period {a['period_h']:.7g} +- {a['period_std_h']:.2g} h, pole (lambda, "
-                   f"beta) ({a['pole_lambda_deg']:.1f}, {a['pole_beta_deg']:.1f}) +- "
-                   f"{a['pole_std_deg']:.2g} deg ecliptic J2000; {a['verdict']}")  # fmt: skip
-        written = [output, *([a["obj_file"]] if "obj_file" in a else []), *([plot_file] if plot_file else [])]
+            typer.echo(
+                f"tumbling: {a['tumbling_families']} solution families (SHAPE.nc tumbling_*)"
+            )
+        typer.echo(
+            f"period {a['period_h']:.7g} +- {a['period_std_h']:.2g} h, pole (lambda, "
+            f"beta) ({a['pole_lambda_deg']:.1f}, {a['pole_beta_deg']:.1f}) +- "
+            f"{a['pole_std_deg']:.2g} deg ecliptic J2000; {a['verdict']}"
+        )
+        written = [
+            output,
+            *([a["obj_file"]] if "obj_file" in a else []),
+            *([plot_file] if plot_file else []),
+        ]
         typer.echo(f"wrote {', '.join(written)}")
 
     _guarded(run)

@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 from speclight.cli import app
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "estimate" / "shape"))
-from synthetic import apparitions, lambert_mesh_brightness, to_body  # noqa: E402
+from synthetic import apparitions, lambert_mesh_brightness, to_body
 
 FAST = ["--nside", "2", "--pole-step-deg", "90"]
 
@@ -30,8 +30,10 @@ def _lc(tmp_path: Path) -> Path:
     for k in range(curve.max() + 1):
         sel = curve == k
         lines.append(f"{sel.sum()} 0")
-        lines += [" ".join(repr(float(x)) for x in (t[i], y[i], *sun[i], *obs[i]))
-                  for i in np.flatnonzero(sel)]  # fmt: skip
+        lines += [
+            " ".join(repr(float(x)) for x in (t[i], y[i], *sun[i], *obs[i]))
+            for i in np.flatnonzero(sel)
+        ]
     path = tmp_path / "ell.lc"
     path.write_text("\n".join(lines) + "\n")
     return path
@@ -40,8 +42,20 @@ def _lc(tmp_path: Path) -> Path:
 def test_shape_writes_dataset_obj_and_figure(tmp_path):
     lc = _lc(tmp_path)
     out = tmp_path / "shape.nc"
-    args = ["shape", str(lc), "--format", "damit", "--period-range-h", "6.298", "6.302",
-            "-o", str(out), "--plot", str(tmp_path / "shape.png"), *FAST]  # fmt: skip
+    args = [
+        "shape",
+        str(lc),
+        "--format",
+        "damit",
+        "--period-range-h",
+        "6.298",
+        "6.302",
+        "-o",
+        str(out),
+        "--plot",
+        str(tmp_path / "shape.png"),
+        *FAST,
+    ]
     result = CliRunner().invoke(app, args)
     assert result.exit_code == 0, result.output
     assert "wrote" in result.output and "shape.obj" in result.output
@@ -61,13 +75,17 @@ def test_shape_writes_dataset_obj_and_figure(tmp_path):
 def test_shape_bad_input_exits_2(tmp_path):
     lc = _lc(tmp_path)
     base = ["shape", str(lc), "--period-range-h", "6.2", "6.4", "-o", str(tmp_path / "s.nc")]
-    for extra, word in ((["--format", "damlt"], "damit"), (["--format", "damit", "--law", "lamb"],
-                        "lambert"), (["--format", "damit", "--nside", "3"], "nside")):  # fmt: skip
+    for extra, word in (
+        (["--format", "damlt"], "damit"),
+        (["--format", "damit", "--law", "lamb"], "lambert"),
+        (["--format", "damit", "--nside", "3"], "nside"),
+    ):
         result = CliRunner().invoke(app, [*base, *extra])
         assert result.exit_code == 2, result.output
         assert word in result.output
     csv = tmp_path / "rates.csv"
     csv.write_text("time,V\n2020-01-01T00:00:00Z,1.0\n")
-    result = CliRunner().invoke(app, ["shape", str(csv), "--period-range-h", "1", "2",
-                                      "-o", str(tmp_path / "c.nc")])  # fmt: skip
+    result = CliRunner().invoke(
+        app, ["shape", str(csv), "--period-range-h", "1", "2", "-o", str(tmp_path / "c.nc")]
+    )
     assert result.exit_code == 2 and "--scenario" in result.output

@@ -29,8 +29,15 @@ def _shape_views(fig: Any, grid: Any, poly: Polyhedron | None) -> None:
         ax.set_aspect("equal")
         ax.set_title(f"seen along {axis}", fontsize="small")
         if poly is None:
-            ax.text(0.5, 0.5, "no shape (data do not constrain one)", ha="center",
-                    va="center", transform=ax.transAxes, fontsize="small")  # fmt: skip
+            ax.text(
+                0.5,
+                0.5,
+                "no shape (data do not constrain one)",
+                ha="center",
+                va="center",
+                transform=ax.transAxes,
+                fontsize="small",
+            )
             continue
         tri = poly.vertices[poly.faces]
         normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
@@ -39,8 +46,11 @@ def _shape_views(fig: Any, grid: Any, poly: Polyhedron | None) -> None:
         view[3 - i - j] = 1.0
         facing = normal @ view > 0
         shade = np.clip(normal[facing] @ view, 0.0, 1.0)
-        col = PolyCollection(tri[facing][:, :, [i, j]], facecolors=[(s, s, s) for s in 0.2 + 0.7 * shade],
-                             edgecolors="none")  # fmt: skip
+        col = PolyCollection(
+            list(tri[facing][:, :, [i, j]]),
+            facecolors=[(s, s, s) for s in 0.2 + 0.7 * shade],
+            edgecolors="none",
+        )
         ax.add_collection(col)
         lim = 1.05 * np.max(np.abs(poly.vertices))
         ax.set_xlim(-lim, lim)
@@ -65,8 +75,9 @@ def shape_figure(ds: xr.Dataset, poly: Polyhedron | None = None) -> Any:
     grid = fig.add_gridspec(2 + rows, CURVES_PER_ROW, height_ratios=[1.3, 1.3] + [1.0] * rows)
     ax = fig.add_subplot(grid[0, :2])
     ax.plot(ds["period"].values, ds["chi2_period"].values, ".-", lw=0.6, ms=2, color="k")
-    ax.axvline(ds.attrs["period_h"], color="tab:red", lw=0.8,
-               label=f"P = {ds.attrs['period_h']:.6f} h")  # fmt: skip
+    ax.axvline(
+        ds.attrs["period_h"], color="tab:red", lw=0.8, label=f"P = {ds.attrs['period_h']:.6f} h"
+    )
     ax.set_xlabel("trial period [h]")
     ax.set_ylabel("chi-square")
     ax.legend(fontsize="small")
@@ -74,11 +85,23 @@ def shape_figure(ds: xr.Dataset, poly: Polyhedron | None = None) -> Any:
     lam, bet = ds["lambda"].values, ds["beta"].values
     mesh = ax.pcolormesh(lam, bet, ds["chi2_pole"].values, shading="nearest", cmap="viridis_r")
     fig.colorbar(mesh, ax=ax, label="chi-square")
-    ax.plot(ds.attrs["pole_lambda_deg"], ds.attrs["pole_beta_deg"], "*", ms=12, color="tab:red",
-            label="best")  # fmt: skip
+    ax.plot(
+        ds.attrs["pole_lambda_deg"],
+        ds.attrs["pole_beta_deg"],
+        "*",
+        ms=12,
+        color="tab:red",
+        label="best",
+    )
     if "mirror_lambda_deg" in ds.attrs:
-        ax.plot(ds.attrs["mirror_lambda_deg"], ds.attrs["mirror_beta_deg"], "*", ms=10,
-                color="tab:orange", label="mirror (fits as well)")  # fmt: skip
+        ax.plot(
+            ds.attrs["mirror_lambda_deg"],
+            ds.attrs["mirror_beta_deg"],
+            "*",
+            ms=10,
+            color="tab:orange",
+            label="mirror (fits as well)",
+        )
     ax.set_xlabel("pole ecliptic longitude [deg]")
     ax.set_ylabel("pole ecliptic latitude [deg]")
     ax.legend(fontsize="small")
@@ -92,8 +115,15 @@ def shape_figure(ds: xr.Dataset, poly: Polyhedron | None = None) -> Any:
         ax = fig.add_subplot(grid[2 + k // CURVES_PER_ROW, k % CURVES_PER_ROW])
         m = ds["light_curve"].values == c
         hours = (t[m] - t[m][0]) * 24.0
-        ax.errorbar(hours, ds["brightness"].values[m], ds["brightness_sigma"].values[m], fmt=".",
-                    ms=2, lw=0.4, color="0.4")  # fmt: skip
+        ax.errorbar(
+            hours,
+            ds["brightness"].values[m],
+            ds["brightness_sigma"].values[m],
+            fmt=".",
+            ms=2,
+            lw=0.4,
+            color="0.4",
+        )
         ax.plot(hours, ds["brightness_fit"].values[m], "-", lw=0.8, color="tab:red")
         ax.set_title(f"curve {c}: JD {t[m][0]:.3f}", fontsize="x-small")
         ax.tick_params(labelsize="x-small")
@@ -103,8 +133,10 @@ def shape_figure(ds: xr.Dataset, poly: Polyhedron | None = None) -> Any:
 
 def _summary(ds: xr.Dataset) -> str:
     a = ds.attrs
-    return (f"P = {a['period_h']:.6f} +- {a['period_std_h']:.2g} h\n"
-            f"pole (lambda, beta) = ({a['pole_lambda_deg']:.1f}, {a['pole_beta_deg']:.1f}) deg\n"
-            f"  +- {a['pole_std_deg']:.2g} deg\n"
-            f"law {a['law']}, {ds.sizes['facet']} facets\n"
-            f"{a['n_points']} points in {a['n_curves']} curves")  # fmt: skip
+    return (
+        f"P = {a['period_h']:.6f} +- {a['period_std_h']:.2g} h\n"
+        f"pole (lambda, beta) = ({a['pole_lambda_deg']:.1f}, {a['pole_beta_deg']:.1f}) deg\n"
+        f"  +- {a['pole_std_deg']:.2g} deg\n"
+        f"law {a['law']}, {ds.sizes['facet']} facets\n"
+        f"{a['n_points']} points in {a['n_curves']} curves"
+    )

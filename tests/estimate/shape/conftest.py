@@ -21,8 +21,9 @@ def render_mesh(vertices, faces, sun_body, obs_body, resolution_px=128):
     [m2 sr-1] (a ray-cast image, independent of the convex model under test)."""
     target = Target(parts=(Part("body", np.asarray(vertices, float), np.asarray(faces), WHITE),))
     n = len(sun_body)
-    res = render_intensity(target, sun_body, obs_body, np.ones((n, 1)), np.array([550.0]),
-                           resolution_px=resolution_px)  # fmt: skip
+    res = render_intensity(
+        target, sun_body, obs_body, np.ones((n, 1)), np.array([550.0]), resolution_px=resolution_px
+    )
     return res.intensity_W_sr_nm[:, 0]
 
 
@@ -46,7 +47,11 @@ def box_wing_hull_mesh():
     return np.asarray(hull.vertices), np.asarray(hull.faces)
 
 
-BODIES = {"ellipsoid": ellipsoid_mesh, "cylinder": cylinder_mesh, "box_wing_hull": box_wing_hull_mesh}
+BODIES = {
+    "ellipsoid": ellipsoid_mesh,
+    "cylinder": cylinder_mesh,
+    "box_wing_hull": box_wing_hull_mesh,
+}
 
 
 @pytest.fixture(scope="session")

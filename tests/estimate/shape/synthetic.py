@@ -21,14 +21,22 @@ def radec(lon_deg, lat_deg):
     return np.stack([np.cos(la) * np.cos(lo), np.cos(la) * np.sin(lo), np.sin(la)], axis=-1)
 
 
-def apparitions(rng, n_apparitions=6, nights=2, hours=6.0, step_h=0.2, years=4.0,
-                max_phase_deg=25.0, max_lat_deg=20.0):
+def apparitions(
+    rng,
+    n_apparitions=6,
+    nights=2,
+    hours=6.0,
+    step_h=0.2,
+    years=4.0,
+    max_phase_deg=25.0,
+    max_lat_deg=20.0,
+):
     """Epochs [JD], target->Sun and target->observer unit vectors (ecliptic), curve index."""
     t, s, o, c = [], [], [], []
     k = 0
     t_app = 2455000.5 + np.sort(rng.uniform(0, 365.25 * years, n_apparitions))
     lons = rng.uniform(0, 360, n_apparitions)
-    for t0, lon in zip(t_app, lons):
+    for t0, lon in zip(t_app, lons, strict=True):
         lat = rng.uniform(-max_lat_deg, max_lat_deg)
         for night in range(nights):
             tt = t0 + 3.0 * night + np.arange(0, hours, step_h) / 24.0

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import render_mesh
 from synthetic import apparitions, to_body
 
+from conftest import render_mesh
 from speclight.estimate.shape import ShapeOptions, read_shape_input, run_shape
 from speclight.estimate.shape.ecliptic import angular_distance_deg, pole_vector
 from speclight.estimate.shape.egi import egi_difference, mesh_egi
@@ -60,8 +60,16 @@ def rendered_lc(tmp_path, vertices, faces, seed):
 def test_convex_body_recovered(tmp_path, bodies, body):
     vertices, faces = bodies[body]
     inputs = read_shape_input(rendered_lc(tmp_path, vertices, faces, seed=3), "damit")
-    run = run_shape(inputs, ShapeOptions(TRUE_PERIOD_H - 0.002, TRUE_PERIOD_H + 0.002,
-                                         law="lambert", pole_step_deg=60.0, n_start_poles=2))  # fmt: skip
+    run = run_shape(
+        inputs,
+        ShapeOptions(
+            TRUE_PERIOD_H - 0.002,
+            TRUE_PERIOD_H + 0.002,
+            law="lambert",
+            pole_step_deg=60.0,
+            n_start_poles=2,
+        ),
+    )
     baseline_h = inputs.data.baseline_d * 24.0
     resolution_h = TRUE_PERIOD_H**2 / baseline_h  # one turn of phase drift over the baseline
     assert abs(run.best.period_h - TRUE_PERIOD_H) < 0.1 * resolution_h
@@ -69,8 +77,9 @@ def test_convex_body_recovered(tmp_path, bodies, body):
     found = pole_vector(run.best.lambda_deg, run.best.beta_deg)
     mirror = pole_vector(TRUE_LAMBDA + 180.0, TRUE_BETA)
     near_truth = angular_distance_deg(found, truth) < POLE_TOLERANCE_DEG
-    assert near_truth or (angular_distance_deg(found, mirror) < POLE_TOLERANCE_DEG
-                          and run.mirror_reported)  # fmt: skip
+    assert near_truth or (
+        angular_distance_deg(found, mirror) < POLE_TOLERANCE_DEG and run.mirror_reported
+    )
     assert run.shape_constrained and run.pole_constrained
     if near_truth:  # the mirror solution's shape is the mirror image
         normals = run.model.normals

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import trimesh
-from conftest import ellipsoid_mesh, render_mesh
 
+from conftest import ellipsoid_mesh, render_mesh
 from speclight.estimate.shape.convex_model import ConvexModel, facet_brightness
-from speclight.estimate.shape.ecliptic import gcrs_to_ecliptic, ecliptic_to_gcrs
+from speclight.estimate.shape.ecliptic import ecliptic_to_gcrs, gcrs_to_ecliptic
 from speclight.estimate.shape.egi import close_egi, closure_vector, facet_normals, mesh_facets
 from speclight.estimate.shape.inversion_data import build_inversion_data
 from speclight.estimate.shape.minkowski import format_obj, minkowski_polyhedron, polyhedron
@@ -46,8 +46,16 @@ def test_jacobian_against_central_differences(law):
     n = 60
     t = 2450000 + np.sort(rng.uniform(0, 30, n))
     s, o = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
-    d = build_inversion_data(t, rng.uniform(1, 2, n), None, s, s + 0.4 * o,
-                             np.repeat([0, 1, 2], 20), np.array([False, True, False]), "x")  # fmt: skip
+    d = build_inversion_data(
+        t,
+        rng.uniform(1, 2, n),
+        None,
+        s,
+        s + 0.4 * o,
+        np.repeat([0, 1, 2], 20),
+        np.array([False, True, False]),
+        "x",
+    )
     m = ConvexModel(d, facet_normals(2), scattering_law(law), t[0])
     theta = np.concatenate([[0.7, 0.3, 7.3], 0.3 * rng.normal(size=48)])
     _, jac = m.residuals(theta)
@@ -66,6 +74,7 @@ def test_material_law_is_the_render_models():
     law = scattering_law("material", material=mat)
     mu0, mu = np.array([[0.2, 0.7, 0.0]]), np.array([[0.5, 0.9, 0.4]])
     s, d0, d1 = law(mu0, mu, np.array([[0.9]]))
+    assert np.allclose(d1[:, :2], 0.3 * mu0[:, :2] / np.pi, rtol=1e-6)
     assert np.allclose(s, 0.3 * mu0 * mu / np.pi, rtol=1e-12)
     assert np.allclose(d0[:, :2], 0.3 * mu[:, :2] / np.pi, rtol=1e-6)
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import trimesh
-from conftest import render_mesh
 from synthetic import apparitions, to_body
 
+from conftest import render_mesh
 from speclight.estimate.shape import ShapeOptions, run_shape
 from speclight.estimate.shape.inversion_data import build_inversion_data
 from speclight.estimate.shape.shape_dataset import verdict
@@ -16,8 +16,16 @@ OPTIONS = ShapeOptions(6.298, 6.302, law="lambert", pole_step_deg=90.0, n_start_
 
 
 def _run(y, t, sun, obs, curve):
-    d = build_inversion_data(t, y, 0.01 * np.mean(y) * np.ones_like(y), sun, obs, curve,
-                             np.zeros(curve.max() + 1, bool), "null")  # fmt: skip
+    d = build_inversion_data(
+        t,
+        y,
+        0.01 * np.mean(y) * np.ones_like(y),
+        sun,
+        obs,
+        curve,
+        np.zeros(curve.max() + 1, bool),
+        "null",
+    )
     return run_shape(ShapeInput(d, [], None, None, "1", "null"), OPTIONS)
 
 

@@ -11,9 +11,9 @@ from astropy.coordinates import BarycentricMeanEcliptic, SkyCoord
 
 from speclight.estimate.shape import read_shape_input
 from speclight.estimate.shape.ecliptic import julian_date, pole_vector
+from speclight.io.netcdf import write_dataset
 from speclight.scenario import example_text, parse_scenario
 from speclight.simulate import simulate
-from speclight.io.netcdf import write_dataset
 
 
 def test_speclight_input_geometry(tmp_path):
@@ -40,7 +40,8 @@ def test_speclight_input_geometry(tmp_path):
         # the spin axis (RA, Dec in GCRS) in ecliptic J2000 by astropy: the Sun's component
         # along it is the body z component of the Sun's direction (spin about body z)
         axis = SkyCoord(ra=30.0 * u.deg, dec=45.0 * u.deg, frame="icrs").transform_to(
-            BarycentricMeanEcliptic(equinox="J2000"))
+            BarycentricMeanEcliptic(equinox="J2000")
+        )
         pole = pole_vector(axis.lon.deg, axis.lat.deg)
         body_z = ds["sun_direction_body"].values[ok][:, 2]
         assert np.allclose(d.sun_ecliptic @ pole, body_z, atol=1e-6)

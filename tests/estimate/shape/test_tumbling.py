@@ -4,9 +4,9 @@ through speclight's torque-free propagation (issue 27, "Tumbling")."""
 from __future__ import annotations
 
 import numpy as np
-from conftest import WHITE, render_mesh
 from scipy.spatial.transform import Rotation
 
+from conftest import WHITE, render_mesh
 from speclight.attitude import torque_free_attitude
 from speclight.attitude.quaternion import quat_conjugate, quat_rotate
 from speclight.estimate.shape.egi import mesh_facets
@@ -47,17 +47,38 @@ def test_torque_free_box_wing_state_recovered():
     rng = np.random.default_rng(0)
     sigma = 0.01 * np.mean(y)
     t_jd = 2459000.5 + t_s / 86400.0
-    data = build_inversion_data(t_jd, y + sigma * rng.normal(size=y.size), np.full(y.size, sigma),
-                                sun, obs, np.repeat([0, 1], 120), np.array([False, False]), "tf")  # fmt: skip
+    data = build_inversion_data(
+        t_jd,
+        y + sigma * rng.normal(size=y.size),
+        np.full(y.size, sigma),
+        sun,
+        obs,
+        np.repeat([0, 1], 120),
+        np.array([False, False]),
+        "tf",
+    )
     truth = TumblingState(Q0, W0, MOMENTS, 0.0)
     # a prior 25 deg off in attitude, 1 % in rate, 10 deg in the rates' direction
     off = Rotation.from_rotvec(np.deg2rad(25.0) * _unit(np.array([1.0, -1.0, 0.5])))
     w_off = Rotation.from_rotvec(np.deg2rad(10.0) * _unit(np.array([0.0, 1.0, 1.0]))).apply(W0)
-    prior = TumblingState((Rotation.from_quat(Q0, scalar_first=True) * off).as_quat(scalar_first=True),
-                          1.01 * w_off, np.array([0.5, 0.75, 1.0]), 0.0)  # fmt: skip
+    prior = TumblingState(
+        (Rotation.from_quat(Q0, scalar_first=True) * off).as_quat(scalar_first=True),
+        1.01 * w_off,
+        np.array([0.5, 0.75, 1.0]),
+        0.0,
+    )
     normals, areas = mesh_facets(parts)
-    fit = fit_tumbling(data, normals, areas, scattering_law("lambert"), min_period_h=0.03,
-                       max_period_h=0.1, n_starts=4, initial_states=[prior], t0_jd=t_jd[0])  # fmt: skip
+    fit = fit_tumbling(
+        data,
+        normals,
+        areas,
+        scattering_law("lambert"),
+        min_period_h=0.03,
+        max_period_h=0.1,
+        n_starts=4,
+        initial_states=[prior],
+        t0_jd=t_jd[0],
+    )
     assert fit.families
     assert any(same_family(fam[0], truth) for fam in fit.families)
 
@@ -69,8 +90,12 @@ def test_body_symmetry_keeps_the_family():
     tgt = shapes.box_wing(WHITE, dish=False)
     normals, areas = mesh_facets([(p.vertices_m, p.faces) for p in tgt.parts])
     half = Rotation.from_rotvec([np.pi, 0, 0])
-    other = TumblingState((Rotation.from_quat(Q0, scalar_first=True) * half).as_quat(scalar_first=True),
-                          half.inv().apply(W0), MOMENTS, 0.0)  # fmt: skip
+    other = TumblingState(
+        (Rotation.from_quat(Q0, scalar_first=True) * half).as_quat(scalar_first=True),
+        half.inv().apply(W0),
+        MOMENTS,
+        0.0,
+    )
     truth = TumblingState(Q0, W0, MOMENTS, 0.0)
     assert same_family(truth, other)
     t_s, sun, obs = _two_passes()
@@ -82,6 +107,7 @@ def test_body_symmetry_keeps_the_family():
     for s in (truth, other):
         q, _ = torque_free_attitude(t_s, s.moments, s.q0, s.omega0_body_rad_s)
         qc = quat_conjugate(q)
-        curves.append(facet_brightness(quat_rotate(qc, sun), quat_rotate(qc, obs), normals,
-                                       areas, law, chp))  # fmt: skip
+        curves.append(
+            facet_brightness(quat_rotate(qc, sun), quat_rotate(qc, obs), normals, areas, law, chp)
+        )
     assert np.allclose(curves[0], curves[1], rtol=1e-9, atol=1e-12 * np.max(curves[0]))

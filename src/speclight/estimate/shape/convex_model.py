@@ -167,9 +167,13 @@ class ConvexModel:
 
 
 def facet_brightness(
-    sun_body: F64, observer_body: F64, normals: F64, areas: F64, law: ScatteringLaw,
+    sun_body: F64,
+    observer_body: F64,
+    normals: F64,
+    areas: F64,
+    law: ScatteringLaw,
     cos_half_phase: F64,
-) -> F64:  # fmt: skip
+) -> F64:
     """``L`` (N,) of a convex EGI for body-frame unit vectors (N, 3) (module doc)."""
     mu0, mu = sun_body @ normals.T, observer_body @ normals.T
     seen = (mu0 > 0) & (mu > 0)

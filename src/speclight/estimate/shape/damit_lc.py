@@ -69,8 +69,9 @@ def _numbers(line: str, count: int, lineno: int, src: str, what: str) -> list[fl
             field=FIELD,
         ) from None
     if not all(np.isfinite(values)):
-        raise InputError(f"line {lineno}: non-finite number in '{line.strip()}'", source=src,
-                         field=FIELD)  # fmt: skip
+        raise InputError(
+            f"line {lineno}: non-finite number in '{line.strip()}'", source=src, field=FIELD
+        )
     return values
 
 
@@ -87,19 +88,27 @@ def read_damit_lc(path: str | Path) -> list[DamitLightCurve]:
     src = str(path)
     lines = [
         (k, line)
-        for k, line in enumerate(read_user_text(Path(path), FIELD, what="light curves").splitlines(), 1)
+        for k, line in enumerate(
+            read_user_text(Path(path), FIELD, what="light curves").splitlines(), 1
+        )
         if line.strip()
-    ]  # fmt: skip
+    ]
     if not lines:
-        raise InputError("the file is empty (a DAMIT .lc file starts with the number of "
-                         "light curves)", source=src, field=FIELD)  # fmt: skip
+        raise InputError(
+            "the file is empty (a DAMIT .lc file starts with the number of light curves)",
+            source=src,
+            field=FIELD,
+        )
     k0, first = lines[0]
     n_curves = _count(first, k0, src, "the number of light curves")
-    pos, curves = 1, []
+    pos, curves = 1, list[DamitLightCurve]()
     for _ in range(n_curves):
         if pos >= len(lines):
-            raise InputError(f"the file announces {n_curves} light curves and ends after "
-                             f"{len(curves)}", source=src, field=FIELD)  # fmt: skip
+            raise InputError(
+                f"the file announces {n_curves} light curves and ends after {len(curves)}",
+                source=src,
+                field=FIELD,
+            )
         kh, header = lines[pos]
         n, flag = _numbers(header, 2, kh, src, "a light-curve header 'N flag'")
         if n != int(n) or n < 1 or flag not in (0.0, 1.0):
@@ -111,23 +120,38 @@ def read_damit_lc(path: str | Path) -> list[DamitLightCurve]:
             )
         rows = lines[pos + 1 : pos + 1 + int(n)]
         if len(rows) < int(n):
-            raise InputError(f"line {kh}: the light curve announces {int(n)} points, the file "
-                             f"holds {len(rows)} more lines", source=src, field=FIELD)  # fmt: skip
-        data = np.array([_numbers(r, 8, k, src, "a point 'JD I sx sy sz ex ey ez'") for k, r in rows])
+            raise InputError(
+                f"line {kh}: the light curve announces {int(n)} points, the file "
+                f"holds {len(rows)} more lines",
+                source=src,
+                field=FIELD,
+            )
+        data = np.array(
+            [_numbers(r, 8, k, src, "a point 'JD I sx sy sz ex ey ez'") for k, r in rows]
+        )
         _check_points(data, [k for k, _ in rows], src)
-        curves.append(DamitLightCurve(data[:, 0], data[:, 1], data[:, 2:5], data[:, 5:8], flag == 1))
+        curves.append(
+            DamitLightCurve(data[:, 0], data[:, 1], data[:, 2:5], data[:, 5:8], flag == 1)
+        )
         pos += 1 + int(n)
     if pos != len(lines):
-        raise InputError(f"line {lines[pos][0]}: {len(lines) - pos} lines after the "
-                         f"{n_curves} announced light curves", source=src, field=FIELD)  # fmt: skip
+        raise InputError(
+            f"line {lines[pos][0]}: {len(lines) - pos} lines after the "
+            f"{n_curves} announced light curves",
+            source=src,
+            field=FIELD,
+        )
     return curves
 
 
 def _count(line: str, lineno: int, src: str, what: str) -> int:
     (value,) = _numbers(line, 1, lineno, src, what)
     if value != int(value) or value < 1:
-        raise InputError(f"line {lineno}: {what} must be a whole number >= 1, got "
-                         f"'{line.strip()}'", source=src, field=FIELD)  # fmt: skip
+        raise InputError(
+            f"line {lineno}: {what} must be a whole number >= 1, got '{line.strip()}'",
+            source=src,
+            field=FIELD,
+        )
     return int(value)
 
 
@@ -135,13 +159,18 @@ def _check_points(data: F64, linenos: list[int], src: str) -> None:
     for col, what in ((1, "brightness"),):
         bad = np.flatnonzero(data[:, col] < 0.0)
         if bad.size:
-            raise InputError(f"line {linenos[bad[0]]}: {what} {data[bad[0], col]} must be >= 0 "
-                             "(intensities, not magnitudes)", source=src, field=FIELD)  # fmt: skip
+            raise InputError(
+                f"line {linenos[bad[0]]}: {what} {data[bad[0], col]} must be >= 0 "
+                "(intensities, not magnitudes)",
+                source=src,
+                field=FIELD,
+            )
     for cols, what in ((slice(2, 5), "Sun"), (slice(5, 8), "observer")):
         zero = np.flatnonzero(np.linalg.norm(data[:, cols], axis=1) == 0.0)
         if zero.size:
-            raise InputError(f"line {linenos[zero[0]]}: the {what} vector is zero",
-                             source=src, field=FIELD)  # fmt: skip
+            raise InputError(
+                f"line {linenos[zero[0]]}: the {what} vector is zero", source=src, field=FIELD
+            )
 
 
 def format_damit_lc(curves: list[DamitLightCurve]) -> str:
@@ -149,8 +178,9 @@ def format_damit_lc(curves: list[DamitLightCurve]) -> str:
     out = [f"{len(curves)}"]
     for c in curves:
         out.append(f"{c.time_jd.size} {1 if c.calibrated else 0}")
-        for t, b, s, e in zip(c.time_jd, c.brightness, c.sun_ecliptic_au,
-                              c.observer_ecliptic_au, strict=True):  # fmt: skip
+        for t, b, s, e in zip(
+            c.time_jd, c.brightness, c.sun_ecliptic_au, c.observer_ecliptic_au, strict=True
+        ):
             out.append(" ".join(f"{x:.17g}" for x in (t, b, *s, *e)))
     return "\n".join(out) + "\n"
 

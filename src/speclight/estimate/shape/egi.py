@@ -23,10 +23,10 @@ def facet_normals(nside: int) -> F64:
     """(12 nside^2, 3) unit normals at the HEALPix pixel centres (RING order)."""
     from astropy_healpix import healpix_to_lonlat
 
-    if not (isinstance(nside, int | np.integer) and 1 <= nside <= MAX_NSIDE
-            and nside & (nside - 1) == 0):  # fmt: skip
-        raise InputError(f"nside = {nside} must be a power of 2 in [1, {MAX_NSIDE}]",
-                         field="nside")  # fmt: skip
+    if not (
+        isinstance(nside, int | np.integer) and 1 <= nside <= MAX_NSIDE and nside & (nside - 1) == 0
+    ):
+        raise InputError(f"nside = {nside} must be a power of 2 in [1, {MAX_NSIDE}]", field="nside")
     lon, lat = healpix_to_lonlat(np.arange(12 * nside * nside), nside, order="ring")
     lon_r, lat_r = np.asarray(lon.to_value("rad")), np.asarray(lat.to_value("rad"))
     return np.stack(

@@ -75,8 +75,11 @@ class InversionData:
     @property
     def cos_half_phase(self) -> F64:
         """(N,) cosine of half the phase angle."""
-        return np.sqrt(np.clip(0.5 * (1.0 + np.sum(self.sun_ecliptic * self.observer_ecliptic,
-                                                    axis=1)), 0.0, 1.0))  # fmt: skip
+        return np.sqrt(
+            np.clip(
+                0.5 * (1.0 + np.sum(self.sun_ecliptic * self.observer_ecliptic, axis=1)), 0.0, 1.0
+            )
+        )
 
     @property
     def phase_angle_deg(self) -> F64:
@@ -87,16 +90,26 @@ class InversionData:
         """The points ``index`` (curves renumbered, empty ones dropped)."""
         kept, curve = np.unique(self.curve[index], return_inverse=True)
         return InversionData(
-            self.time_jd[index], self.brightness[index], self.sigma[index],
-            self.sun_ecliptic[index], self.observer_ecliptic[index], curve.astype(np.int64),
+            self.time_jd[index],
+            self.brightness[index],
+            self.sigma[index],
+            self.sun_ecliptic[index],
+            self.observer_ecliptic[index],
+            curve.astype(np.int64),
             self.calibrated[kept],
-        )  # fmt: skip
+        )
 
     def with_brightness(self, brightness: F64) -> InversionData:
         """The same points and geometry with other brightness values."""
-        return InversionData(self.time_jd, np.asarray(brightness, float), self.sigma,
-                             self.sun_ecliptic, self.observer_ecliptic, self.curve,
-                             self.calibrated)  # fmt: skip
+        return InversionData(
+            self.time_jd,
+            np.asarray(brightness, float),
+            self.sigma,
+            self.sun_ecliptic,
+            self.observer_ecliptic,
+            self.curve,
+            self.calibrated,
+        )
 
 
 def _unit(v: F64) -> F64:
@@ -104,9 +117,15 @@ def _unit(v: F64) -> F64:
 
 
 def build_inversion_data(
-    time_jd: F64, brightness: F64, sigma: F64 | None, sun: F64, observer: F64,
-    curve: I64, calibrated: NDArray[np.bool_], source: str,
-) -> InversionData:  # fmt: skip
+    time_jd: F64,
+    brightness: F64,
+    sigma: F64 | None,
+    sun: F64,
+    observer: F64,
+    curve: I64,
+    calibrated: NDArray[np.bool_],
+    source: str,
+) -> InversionData:
     """Check and assemble :class:`InversionData` (vectors normalised; sigma 1 where None).
 
     Points with a non-finite brightness or geometry are dropped; light curves left with
@@ -118,8 +137,13 @@ def build_inversion_data(
         When nothing is left to fit, or a sigma is not > 0.
     """
     sig = np.ones_like(brightness) if sigma is None else np.asarray(sigma, float)
-    ok = (np.isfinite(brightness) & np.isfinite(sig) & np.all(np.isfinite(sun), axis=1)
-          & np.all(np.isfinite(observer), axis=1) & np.isfinite(time_jd))  # fmt: skip
+    ok = (
+        np.isfinite(brightness)
+        & np.isfinite(sig)
+        & np.all(np.isfinite(sun), axis=1)
+        & np.all(np.isfinite(observer), axis=1)
+        & np.isfinite(time_jd)
+    )
     if np.any(ok & ~(sig > 0)):
         raise InputError("every brightness sigma must be > 0", source=source, field="sigma")
     counts = np.bincount(curve[ok], minlength=calibrated.size)
@@ -135,10 +159,14 @@ def build_inversion_data(
     order = np.flatnonzero(ok)[np.lexsort((time_jd[ok], curve[ok]))]
     kept, new_curve = np.unique(curve[order], return_inverse=True)
     return InversionData(
-        np.asarray(time_jd[order], float), np.asarray(brightness[order], float), sig[order],
-        _unit(sun[order]), _unit(observer[order]), new_curve.astype(np.int64),
+        np.asarray(time_jd[order], float),
+        np.asarray(brightness[order], float),
+        sig[order],
+        _unit(sun[order]),
+        _unit(observer[order]),
+        new_curve.astype(np.int64),
         np.asarray(calibrated, bool)[kept],
-    )  # fmt: skip
+    )
 
 
 def from_damit(curves: list[DamitLightCurve], source: str) -> InversionData:
@@ -149,7 +177,9 @@ def from_damit(curves: list[DamitLightCurve], source: str) -> InversionData:
     return build_inversion_data(
         np.concatenate([c.time_jd for c in curves]),
         np.concatenate([c.brightness for c in curves]),
-        np.concatenate([np.full(c.time_jd.size, NOMINAL_SIGMA * np.mean(c.brightness)) for c in curves]),
+        np.concatenate(
+            [np.full(c.time_jd.size, NOMINAL_SIGMA * np.mean(c.brightness)) for c in curves]
+        ),
         np.concatenate([c.sun_ecliptic_au for c in curves]),
         np.concatenate([c.observer_ecliptic_au for c in curves]),
         np.concatenate([np.full(c.time_jd.size, k) for k, c in enumerate(curves)]),

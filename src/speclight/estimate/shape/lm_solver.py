@@ -79,7 +79,7 @@ def levenberg_marquardt(
     converged = False
     it = 0
     idx = np.flatnonzero(free)
-    for it in range(1, max_iterations + 1):  # noqa: B007 (reported as iterations)
+    for it in range(1, max_iterations + 1):
         j = jac[:, idx]
         jtj = j.T @ j
         grad = j.T @ r

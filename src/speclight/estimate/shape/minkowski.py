@@ -79,13 +79,19 @@ def minkowski_polyhedron(normals: F64, areas: F64) -> Polyhedron:
         return f, grad
 
     h0 = np.ones(len(normals))
-    res = minimize(objective, h0, jac=True, method="L-BFGS-B",
-                   bounds=[(1e-6, None)] * len(normals),
-                   options={"maxiter": MAX_ITERATIONS, "gtol": 1e-9, "ftol": 1e-11})  # fmt: skip
+    res = minimize(
+        objective,
+        h0,
+        jac=True,
+        method="L-BFGS-B",
+        bounds=[(1e-6, None)] * len(normals),
+        options={"maxiter": MAX_ITERATIONS, "gtol": 1e-9, "ftol": 1e-11},
+    )
     poly = polyhedron(normals, res.x)
     scale = np.sqrt(np.sum(areas) / np.sum(poly.facet_area))
-    return Polyhedron(poly.vertices * scale, poly.faces, poly.facet_area * scale**2,
-                      poly.support * scale)  # fmt: skip
+    return Polyhedron(
+        poly.vertices * scale, poly.faces, poly.facet_area * scale**2, poly.support * scale
+    )
 
 
 def format_obj(poly: Polyhedron, comment: str = "") -> str:

@@ -52,8 +52,10 @@ def period_grid_h(
         For a range that is not ``0 < min < max``, or more than :data:`MAX_TRIALS` trials.
     """
     if not (0 < min_period_h < max_period_h < np.inf):
-        raise InputError(f"period range [{min_period_h}, {max_period_h}] h must satisfy "
-                         "0 < min < max", field="period_range_h")  # fmt: skip
+        raise InputError(
+            f"period range [{min_period_h}, {max_period_h}] h must satisfy 0 < min < max",
+            field="period_range_h",
+        )
     if not baseline_d > 0:
         return np.array([min_period_h, max_period_h])
     t_h = baseline_d * HOURS_PER_DAY
@@ -115,6 +117,8 @@ def scan_periods(
                         best = sol
             tick(1)
     if best is None:
-        raise InputError("no trial period's fit stayed within its step; widen the period "
-                         "range", field="period_range_h")  # fmt: skip
+        raise InputError(
+            "no trial period's fit stayed within its step; widen the period range",
+            field="period_range_h",
+        )
     return PeriodScan(periods, chi2, fitted, best)

@@ -39,8 +39,7 @@ def pole_grid(step_deg: float) -> tuple[F64, F64]:
         For a step outside (0, 90] (field ``pole_step_deg``).
     """
     if not (0 < step_deg <= 90):
-        raise InputError(f"pole_step_deg = {step_deg} must be in (0, 90]",
-                         field="pole_step_deg")  # fmt: skip
+        raise InputError(f"pole_step_deg = {step_deg} must be in (0, 90]", field="pole_step_deg")
     n_lat = int(np.ceil(180.0 / step_deg))
     n_lon = int(np.ceil(360.0 / step_deg))
     beta = -90.0 + (np.arange(n_lat) + 0.5) * 180.0 / n_lat
@@ -86,8 +85,9 @@ def search_poles(
     with stage("pole map", total=chi2.size, enabled=progress) as tick:
         for i, b in enumerate(bet):
             for j, la in enumerate(lam):
-                sol = fit_convex(model, la, b, period_h, free_pole=False,
-                                 max_iterations=max_iterations)  # fmt: skip
+                sol = fit_convex(
+                    model, la, b, period_h, free_pole=False, max_iterations=max_iterations
+                )
                 chi2[i, j], period[i, j] = sol.chi2, sol.period_h
                 tick(1)
     starts = _distinct_minima(lam, bet, chi2, N_REFINE)
@@ -98,9 +98,7 @@ def search_poles(
     return PoleSearch(lam, bet, chi2, refined, mirror)
 
 
-def _distinct_minima(
-    lam: F64, bet: F64, chi2: F64, n: int
-) -> list[tuple[float, float, int, int]]:
+def _distinct_minima(lam: F64, bet: F64, chi2: F64, n: int) -> list[tuple[float, float, int, int]]:
     """Up to ``n`` grid cells of lowest chi-square, each at least :data:`DISTINCT_DEG` from
     those taken before."""
     order = np.argsort(chi2, axis=None)

@@ -46,7 +46,10 @@ DEFAULT_LAMBERT_WEIGHT = 0.1
 class ScatteringLaw(Protocol):
     """A facet law: ``law(mu0, mu, cos_half_phase) -> (S, dS/dmu0, dS/dmu)`` (module doc)."""
 
-    name: str
+    @property
+    def name(self) -> str:
+        """The law's name."""
+        ...
 
     def __call__(self, mu0: F64, mu: F64, cos_half_phase: F64) -> tuple[F64, F64, F64]: ...
 
@@ -95,7 +98,9 @@ class MaterialLaw:
         chp_safe = np.where(chp > 1e-9, chp, 1e-9)
         cos_h = np.clip((mu0 + mu) / (2.0 * chp_safe), -1.0, 1.0)
         flat = [np.ravel(x) for x in (mu0, mu, cos_h, chp)]
-        weight = main_weight(self.material, flat[0], flat[1], flat[2], flat[3], np.zeros_like(flat[0]))
+        weight = main_weight(
+            self.material, flat[0], flat[1], flat[2], flat[3], np.zeros_like(flat[0])
+        )
         factor = main_factor(self.material, flat[3], np.array([self.wavelength_nm]))[:, 0]
         lit = (flat[0] > 0) & (flat[1] > 0)
         return np.where(lit, flat[1] * weight * factor, 0.0).reshape(mu0.shape)
@@ -103,8 +108,12 @@ class MaterialLaw:
     def __call__(self, mu0: F64, mu: F64, cos_half_phase: F64) -> tuple[F64, F64, F64]:
         h = MATERIAL_STEP
         s = self.value(mu0, mu, cos_half_phase)
-        d0 = (self.value(mu0 + h, mu, cos_half_phase) - self.value(mu0 - h, mu, cos_half_phase)) / (2 * h)
-        d1 = (self.value(mu0, mu + h, cos_half_phase) - self.value(mu0, mu - h, cos_half_phase)) / (2 * h)
+        d0 = (self.value(mu0 + h, mu, cos_half_phase) - self.value(mu0 - h, mu, cos_half_phase)) / (
+            2 * h
+        )
+        d1 = (self.value(mu0, mu + h, cos_half_phase) - self.value(mu0, mu - h, cos_half_phase)) / (
+            2 * h
+        )
         return s, d0, d1
 
 
@@ -127,14 +136,16 @@ def scattering_law(
         return Lambert()
     if name in ("lommel-seeliger", "ls-lambert"):
         if not (np.isfinite(lambert_weight) and lambert_weight >= 0):
-            raise InputError(f"lambert_weight = {lambert_weight} must be >= 0",
-                             field="lambert_weight")  # fmt: skip
-        return LommelSeeligerLambert(0.0 if name == "lommel-seeliger" else lambert_weight,
-                                     name=name)  # fmt: skip
+            raise InputError(
+                f"lambert_weight = {lambert_weight} must be >= 0", field="lambert_weight"
+            )
+        return LommelSeeligerLambert(
+            0.0 if name == "lommel-seeliger" else lambert_weight, name=name
+        )
     if name == "material" and material is not None:
-        if material.bsdf not in MATERIAL_BSDFS or material.brdf_table is not None and str(
-            material.brdf_table
-        ).endswith(".bsdf"):
+        if material.bsdf not in MATERIAL_BSDFS or (
+            material.brdf_table is not None and str(material.brdf_table).endswith(".bsdf")
+        ):
             raise InputError(
                 f"material '{material.name}' has bsdf '{material.bsdf}', which has no facet "
                 f"law here (accepted: {', '.join(MATERIAL_BSDFS)}; RGL .bsdf files excluded)",

@@ -64,8 +64,9 @@ def shape_files(
     inputs = {"light curves": lc, **({"scenario file": scenario} if scenario else {})}
     obj = obj_path(output)
     with claim_outputs(output, plot, force, inputs) as (claim, figure), ExitStack() as stack:
-        obj_claim = stack.enter_context(OutputClaim(obj, force=force,
-                                                    inputs={**inputs, "output": output}))  # fmt: skip
+        obj_claim = stack.enter_context(
+            OutputClaim(obj, force=force, inputs={**inputs, "output": output})
+        )
         loaded = None
         if scenario is not None:
             from speclight.scenario import load_scenario
@@ -77,9 +78,17 @@ def shape_files(
         if tumbling_starts > 0:
             from speclight.estimate.shape.tumbling_run import add_tumbling, tumbling_fit
 
-            ds = add_tumbling(ds, tumbling_fit(
-                data, run.law, min_period_h=options.min_period_h,
-                max_period_h=options.max_period_h, n_starts=tumbling_starts, seed=options.seed))  # fmt: skip
+            ds = add_tumbling(
+                ds,
+                tumbling_fit(
+                    data,
+                    run.law,
+                    min_period_h=options.min_period_h,
+                    max_period_h=options.max_period_h,
+                    n_starts=tumbling_starts,
+                    seed=options.seed,
+                ),
+            )
         claim.write(dataset_bytes(ds))
         if run.polyhedron is not None:
             obj_claim.write(format_obj(run.polyhedron, f"speclight shape: EGI of {lc}").encode())

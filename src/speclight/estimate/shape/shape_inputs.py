@@ -77,8 +77,11 @@ class ShapeInput:
 def check_format(fmt: str) -> None:
     """Raise an InputError naming ``fmt`` unless it is one of :data:`FORMATS`."""
     if fmt not in FORMATS:
-        raise InputError(f"format '{fmt}'{did_you_mean(fmt, FORMATS)} is not known "
-                         f"(choices: {', '.join(FORMATS)})", field="fmt")  # fmt: skip
+        raise InputError(
+            f"format '{fmt}'{did_you_mean(fmt, FORMATS)} is not known "
+            f"(choices: {', '.join(FORMATS)})",
+            field="fmt",
+        )
 
 
 def read_shape_input(
@@ -109,8 +112,11 @@ def _speclight_input(
     is_nc = path.suffix.lower() in (".nc", ".nc4", ".netcdf", ".h5")
     if loaded is None:
         if not is_nc:
-            raise InputError(f"{src} is a CSV of count rates: give --scenario SCENARIO.yaml "
-                             "(the geometry and the instrument)", field="--scenario")  # fmt: skip
+            raise InputError(
+                f"{src} is a CSV of count rates: give --scenario SCENARIO.yaml "
+                "(the geometry and the instrument)",
+                field="--scenario",
+            )
         with xr.open_dataset(path, engine="h5netcdf") as ds:
             loaded = dataset_scenario(ds, src)
     lc = read_measured(path)
@@ -119,8 +125,10 @@ def _speclight_input(
     chosen = names if not bands else bands
     for b in chosen:
         if b not in names:
-            raise InputError(f"band '{b}'{did_you_mean(b, names)} is not measured (bands: "
-                             f"{', '.join(names)})", field="--bands")  # fmt: skip
+            raise InputError(
+                f"band '{b}'{did_you_mean(b, names)} is not measured (bands: {', '.join(names)})",
+                field="--bands",
+            )
     idx = [names.index(b) for b in chosen]
     factor = factors.factor[:, idx]
     sigma = None
@@ -143,14 +151,28 @@ def _speclight_input(
     curve = np.concatenate([[0], np.cumsum(np.diff(t_s) > PASS_GAP_S)]).astype(np.int64)
     if mean_sigma is None:
         # no sigmas: the same relative weight for every point (as a DAMIT file)
-        means = np.array([np.nanmean(brightness[curve == c]) if np.any(np.isfinite(
-            brightness[curve == c])) else 1.0 for c in range(curve.max() + 1)])  # fmt: skip
+        means = np.array(
+            [
+                np.nanmean(brightness[curve == c])
+                if np.any(np.isfinite(brightness[curve == c]))
+                else 1.0
+                for c in range(curve.max() + 1)
+            ]
+        )
         mean_sigma = NOMINAL_SIGMA * means[curve]
-    data = build_inversion_data(emitted_jd, brightness, mean_sigma, sun, obs, curve,
-                                np.ones(curve.max() + 1, bool), src)  # fmt: skip
+    data = build_inversion_data(
+        emitted_jd, brightness, mean_sigma, sun, obs, curve, np.ones(curve.max() + 1, bool), src
+    )
     keep = np.isin(emitted_jd, data.time_jd)
     order = np.argsort(emitted_jd[keep], kind="stable")
     band_factor = factor[keep][order]
     band_sigma = None if sigma is None else sigma[keep][order]
-    return ShapeInput(data, chosen, band_factor, band_sigma, "m2 sr-1",
-                      f"{src}: band reflectance factors ({', '.join(chosen)})", loaded)  # fmt: skip
+    return ShapeInput(
+        data,
+        chosen,
+        band_factor,
+        band_sigma,
+        "m2 sr-1",
+        f"{src}: band reflectance factors ({', '.join(chosen)})",
+        loaded,
+    )

@@ -41,6 +41,7 @@ from speclight.estimate.shape.uncertainty import (
 
 F64 = NDArray[np.float64]
 NULL_P_VALUE = 1e-3
+BLAS_THREADS = 1
 
 
 @dataclass(frozen=True)
@@ -124,14 +125,17 @@ def resolve_law(options: ShapeOptions, inputs: ShapeInput) -> ScatteringLaw:
         name = "lambert" if inputs.unit == "m2 sr-1" else "ls-lambert"
     if name.startswith("material:"):
         material = name.split(":", 1)[1]
-        if inputs.loaded is None:
+        if inputs.loaded is None or inputs.loaded.scenario.target is None:
             raise InputError(f"law '{name}' needs a scenario with that material", field="law")
         from speclight.target.from_values import material_from_spec
 
         mats = inputs.loaded.scenario.target.model_dump()["materials"]
         if material not in mats:
-            raise InputError(f"law '{name}': no material '{material}' in the scenario "
-                             f"(materials: {', '.join(mats)})", field="law")  # fmt: skip
+            raise InputError(
+                f"law '{name}': no material '{material}' in the scenario "
+                f"(materials: {', '.join(mats)})",
+                field="law",
+            )
         m = material_from_spec(material, mats[material], base_dir=inputs.loaded.base_dir)
         return scattering_law("material", material=m, wavelength_nm=options.wavelength_nm)
     return scattering_law(name, lambert_weight=options.lambert_weight)
@@ -147,7 +151,19 @@ def _refine_fine(model: ConvexModel, coarse: ConvexModel, sol: ConvexSolution) -
 
 
 def run_shape(inputs: ShapeInput, options: ShapeOptions) -> ShapeRun:
-    """Convex inversion of ``inputs`` (module doc)."""
+    """Convex inversion of ``inputs`` (module doc).
+
+    BLAS runs on one thread here (:data:`BLAS_THREADS`): the matrices are small (points x
+    at most a few hundred facets), and threads on a busy 2-core machine made one trial
+    period 25 times slower (BENCHMARKS.md, "Shape inversion").
+    """
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+        return _run_shape(inputs, options)
+
+
+def _run_shape(inputs: ShapeInput, options: ShapeOptions) -> ShapeRun:
     start = time.perf_counter()
     d = inputs.data
     law = resolve_law(options, inputs)
@@ -155,17 +171,21 @@ def run_shape(inputs: ShapeInput, options: ShapeOptions) -> ShapeRun:
     coarse = ConvexModel(d, facet_normals(options.search_nside), law, t0)
     fine = ConvexModel(d, facet_normals(options.nside), law, t0)
     grid = period_grid_h(options.min_period_h, options.max_period_h, d.baseline_d)
-    scan = scan_periods(coarse, grid, n_start_poles=options.n_start_poles,
-                        progress=options.progress)  # fmt: skip
-    poles = search_poles(coarse, scan.best.period_h, step_deg=options.pole_step_deg,
-                         progress=options.progress)  # fmt: skip
-    refined = sorted((_refine_fine(fine, coarse, s) for s in poles.solutions),
-                     key=lambda s: s.chi2)  # fmt: skip
+    scan = scan_periods(
+        coarse, grid, n_start_poles=options.n_start_poles, progress=options.progress
+    )
+    poles = search_poles(
+        coarse, scan.best.period_h, step_deg=options.pole_step_deg, progress=options.progress
+    )
+    refined = sorted((_refine_fine(fine, coarse, s) for s in poles.solutions), key=lambda s: s.chi2)
     best = refined[0]
     mirror = _refine_fine(fine, coarse, poles.mirror)
     cov, mirror_cov = covariance(fine, best), covariance(fine, mirror)
-    samples = (bootstrap(fine, best, options.bootstrap_draws, options.seed)
-               if options.bootstrap_draws > 0 else np.zeros((0, 3)))  # fmt: skip
+    samples = (
+        bootstrap(fine, best, options.bootstrap_draws, options.seed)
+        if options.bootstrap_draws > 0
+        else np.zeros((0, 3))
+    )
     s = cov.residual_scale
     p_shape = shape_p_value(fine, best)
     constrained = p_shape < NULL_P_VALUE
@@ -174,11 +194,23 @@ def run_shape(inputs: ShapeInput, options: ShapeOptions) -> ShapeRun:
     if inputs.band_factor is not None and inputs.band_factor.shape[1] > 1:
         band = facet_band_factors(fine, best, inputs.band_factor, inputs.band_sigma)
     return ShapeRun(
-        inputs=inputs, options=options, law=law, model=fine, scan=scan, poles=poles,
-        best=best, mirror=mirror, others=refined[1:], cov=cov, mirror_cov=mirror_cov,
-        samples=samples, shape_p=p_shape,
+        inputs=inputs,
+        options=options,
+        law=law,
+        model=fine,
+        scan=scan,
+        poles=poles,
+        best=best,
+        mirror=mirror,
+        others=refined[1:],
+        cov=cov,
+        mirror_cov=mirror_cov,
+        samples=samples,
+        shape_p=p_shape,
         mirror_reported=mirror_ambiguous(best, mirror, s),
         pole_constrained=constrained and spans(poles.chi2, s),
         period_constrained=constrained and spans(scan.chi2, s, "median"),
-        polyhedron=poly, band_factor=band, seconds=time.perf_counter() - start,
-    )  # fmt: skip
+        polyhedron=poly,
+        band_factor=band,
+        seconds=time.perf_counter() - start,
+    )

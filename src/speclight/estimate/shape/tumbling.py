@@ -114,8 +114,9 @@ def _moments(u: F64) -> F64:
 
 
 class _Problem:
-    def __init__(self, data: InversionData, normals: F64, areas: F64, law: ScatteringLaw,
-                 t0_jd: float) -> None:  # fmt: skip
+    def __init__(
+        self, data: InversionData, normals: F64, areas: F64, law: ScatteringLaw, t0_jd: float
+    ) -> None:
         self.data, self.normals, self.areas, self.law = data, normals, areas, law
         self.t_s = (data.time_jd - t0_jd) * SECONDS_PER_DAY
         self.calibrated = bool(np.any(data.calibrated))
@@ -131,8 +132,9 @@ class _Problem:
         qc = quat_conjugate(q)
         s_b = quat_rotate(qc, self.data.sun_ecliptic)
         o_b = quat_rotate(qc, self.data.observer_ecliptic)
-        lum = scale * facet_brightness(s_b, o_b, self.normals, self.areas, self.law,
-                                       self.data.cos_half_phase)  # fmt: skip
+        lum = scale * facet_brightness(
+            s_b, o_b, self.normals, self.areas, self.law, self.data.cos_half_phase
+        )
         return relative_residuals(self.data, lum)
 
 
@@ -164,6 +166,35 @@ def fit_tumbling(
     random starts: a prior (e.g. the scenario's attitude) narrows a search that random
     starts alone rarely win (docs/shape.md, "Limits").
     """
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):  # small matrices (shape_run.py)
+        return _fit_tumbling(
+            data,
+            normals,
+            areas,
+            law,
+            min_period_h,
+            max_period_h,
+            n_starts,
+            seed,
+            initial_states,
+            t0_jd,
+        )
+
+
+def _fit_tumbling(
+    data: InversionData,
+    normals: F64,
+    areas: F64,
+    law: ScatteringLaw,
+    min_period_h: float,
+    max_period_h: float,
+    n_starts: int,
+    seed: int,
+    initial_states: list[TumblingState] | None,
+    t0_jd: float | None,
+) -> TumblingFit:
     counts = np.bincount(data.curve)
     seed_curve = int(np.argmax(counts))
     in_seed = np.flatnonzero(data.curve == seed_curve)
@@ -193,16 +224,27 @@ def fit_tumbling(
 
 def _random_start(rng: np.random.Generator, min_period_h: float, max_period_h: float) -> F64:
     period_s = 3600.0 * np.exp(rng.uniform(np.log(min_period_h), np.log(max_period_h)))
-    return np.concatenate([Rotation.random(rng=rng).as_rotvec(),
-                           2 * np.pi / period_s * _unit(rng.normal(size=3)),
-                           rng.uniform(-MOMENT_SPREAD, MOMENT_SPREAD, 2), [0.0]])  # fmt: skip
+    return np.concatenate(
+        [
+            Rotation.random(rng=rng).as_rotvec(),
+            2 * np.pi / period_s * _unit(rng.normal(size=3)),
+            rng.uniform(-MOMENT_SPREAD, MOMENT_SPREAD, 2),
+            [0.0],
+        ]
+    )
 
 
 def _state_vector(s: TumblingState, rate_scale: float) -> F64:
     m = 0.5 * np.sum(s.moments) - s.moments  # second moments of I = tr(M) 1 - M
     u = np.log(np.clip(m[:2] / m[2], np.exp(-MOMENT_BOUND), np.exp(MOMENT_BOUND)))
-    return np.concatenate([Rotation.from_quat(s.q0, scalar_first=True).as_rotvec(),
-                           s.omega0_body_rad_s * rate_scale, u, [np.log(s.scale)]])  # fmt: skip
+    return np.concatenate(
+        [
+            Rotation.from_quat(s.q0, scalar_first=True).as_rotvec(),
+            s.omega0_body_rad_s * rate_scale,
+            u,
+            [np.log(s.scale)],
+        ]
+    )
 
 
 def _fit_all(prob: _Problem, starts: list[F64]) -> list[TumblingState]:
@@ -213,8 +255,14 @@ def _fit_all(prob: _Problem, starts: list[F64]) -> list[TumblingState]:
     for x0 in starts:
         x = x0[:n_par].copy()
         x[6:8] = np.clip(x[6:8], -MOMENT_BOUND, MOMENT_BOUND)
-        res = least_squares(prob.residuals, x, bounds=(lower, upper), method="trf",
-                            x_scale="jac", max_nfev=MAX_EVALUATIONS)  # fmt: skip
+        res = least_squares(
+            prob.residuals,
+            x,
+            bounds=(lower, upper),
+            method="trf",
+            x_scale="jac",
+            max_nfev=MAX_EVALUATIONS,
+        )
         q0, w0, moments, scale = prob.state(np.append(res.x, 0.0)[:9])
         out.append(TumblingState(q0, w0, moments, float(2.0 * res.cost), scale))
     out.sort(key=lambda s: s.chi2)

@@ -3,7 +3,8 @@
 * Covariance: ``s^2 (J^T J)^-1`` at the solution (Laplace approximation of the posterior
   for Gaussian noise; Press et al., Numerical Recipes, 3rd ed., sec. 15.5), with the
   penalty rows included and ``s^2 = chi2 / (N - p)`` (the residuals' own scale: DAMIT files
-  carry no sigmas, and a model error is absorbed the same way). The pole's ``sigma_pole``
+  carry no sigmas, and a model error is absorbed the same way; ``p`` the effective number of
+  parameters, :func:`effective_dof`). The pole's ``sigma_pole``
   is ``sqrt(sigma_beta^2 + cos^2 beta sigma_lambda^2)`` [deg].
 * Bootstrap: each draw resamples the points of every light curve with replacement
   (Efron & Tibshirani 1993, ch. 6) and refits from the solution; the spread of the draws.
@@ -59,16 +60,35 @@ class Covariance:
     residual_scale: float
 
 
+def _unscaled_covariance(model: ConvexModel, sol: ConvexSolution) -> tuple[F64, float]:
+    """``(J^T J)^-1`` (penalty rows included) and the effective number of parameters the
+    data fit, ``tr(J_d (J^T J)^-1 J_d^T)`` over the data rows ``J_d`` (the trace of the hat
+    matrix; Hastie, Tibshirani & Friedman 2009, sec. 7.6): below the nominal count where
+    the penalties hold some directions (the closure, the scale)."""
+    _, jac = model.residuals(sol.theta)
+    cov = np.linalg.pinv(jac.T @ jac)
+    data_rows = jac[: model.data.n_points]
+    return cov, float(np.sum((data_rows @ cov) * data_rows))
+
+
+def effective_dof(model: ConvexModel, sol: ConvexSolution) -> tuple[float, float]:
+    """``(p_eff, N - p_eff)``: the fit's effective parameters and residual degrees of
+    freedom."""
+    _, p_eff = _unscaled_covariance(model, sol)
+    return p_eff, max(model.data.n_points - p_eff, 1.0)
+
+
 def covariance(model: ConvexModel, sol: ConvexSolution) -> Covariance:
     """Laplace covariance at ``sol`` (module doc)."""
-    _, jac = model.residuals(sol.theta)
-    n, p = model.data.n_points, jac.shape[1]
-    s2 = sol.chi2 / max(n - p, 1)
-    cov = np.linalg.pinv(jac.T @ jac) * s2
+    cov, p_eff = _unscaled_covariance(model, sol)
+    s2 = sol.chi2 / max(model.data.n_points - p_eff, 1.0)
+    cov = cov * s2
     sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     lam, bet = np.rad2deg(sd[0]), np.rad2deg(sd[1])
     pole = float(np.hypot(bet, np.cos(sol.theta[1]) * lam))
-    return Covariance(float(lam), float(bet), float(sd[2]), pole, sd[N_ROTATION:], float(np.sqrt(s2)))
+    return Covariance(
+        float(lam), float(bet), float(sd[2]), pole, sd[N_ROTATION:], float(np.sqrt(s2))
+    )
 
 
 def bootstrap(model: ConvexModel, sol: ConvexSolution, draws: int, seed: int) -> F64:
@@ -80,12 +100,21 @@ def bootstrap(model: ConvexModel, sol: ConvexSolution, draws: int, seed: int) ->
     for k in range(draws):
         idx = np.sort(np.concatenate([rng.choice(r, r.size) for r in runs]))
         sub = ConvexModel(d.subset(idx), model.normals, model.law, model.t0_jd)
-        fit = fit_convex(sub, sol.lambda_deg, sol.beta_deg, sol.period_h,
-                         log_areas=sol.theta[N_ROTATION:], max_iterations=BOOTSTRAP_ITERATIONS)  # fmt: skip
+        fit = fit_convex(
+            sub,
+            sol.lambda_deg,
+            sol.beta_deg,
+            sol.period_h,
+            log_areas=sol.theta[N_ROTATION:],
+            max_iterations=BOOTSTRAP_ITERATIONS,
+        )
         lam = fit.lambda_deg
         # keep the longitude on the same branch as the solution's
-        out[k] = (sol.lambda_deg + ((lam - sol.lambda_deg + 180.0) % 360.0 - 180.0),
-                  fit.beta_deg, fit.period_h)  # fmt: skip
+        out[k] = (
+            sol.lambda_deg + ((lam - sol.lambda_deg + 180.0) % 360.0 - 180.0),
+            fit.beta_deg,
+            fit.period_h,
+        )
     return out
 
 
@@ -106,8 +135,7 @@ def sphere_chi2(model: ConvexModel) -> float:
 
 def shape_p_value(model: ConvexModel, sol: ConvexSolution) -> float:
     """F-test p-value of the fit against the sphere (small: the data constrain a shape)."""
-    n, p = model.data.n_points, model.n_parameters
-    dof = max(n - p, 1)
+    p, dof = effective_dof(model, sol)
     chi0 = sphere_chi2(model)
     f = ((chi0 - sol.chi2) / p) / (sol.chi2 / dof)
     return float(stats.f.sf(f, p, dof)) if np.isfinite(f) else 1.0
