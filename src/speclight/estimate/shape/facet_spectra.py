@@ -8,15 +8,29 @@ found by Tikhonov-regularised least squares towards grey (``r = 1``; Tikhonov & 
 :data:`RIDGE` times the mean diagonal of the normal matrix (a facet the data do not see
 stays grey). The result is ``a_k r_kb`` [the brightness unit times sr]: a facet's area
 times its albedo in each band, the spectrum of each facet.
+
+Per-facet unmixing (:func:`facet_materials`): each facet's band spectrum split into the
+scenario's materials by non-negative least squares against their band signatures
+(:func:`speclight.estimate.endmember_spectra.endmembers_from_scenario`, the unmixing of
+``speclight unmix``, :func:`speclight.estimate.unmixing.unmix`): with the Lambert law the
+band spectrum is the facet's area times its band albedos, so the result is each
+material's area on the facet [m2].
 """
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import NDArray
 
+from speclight.errors import InputError
 from speclight.estimate.shape.convex_fit import ConvexSolution
 from speclight.estimate.shape.convex_model import N_ROTATION, ConvexModel
+
+if TYPE_CHECKING:
+    from speclight.estimate.scenario_bands import BandResponses
+    from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
 RIDGE = 0.01
@@ -51,3 +65,20 @@ def facet_band_factors(
         r = np.linalg.solve(ata + mu * np.eye(ata.shape[0]), rhs)
         out[:, b] = sol.areas * np.clip(r, 0.0, None)
     return out
+
+
+def facet_materials(
+    facet_band_area: F64, loaded: LoadedScenario, bands: BandResponses
+) -> tuple[list[str], F64]:
+    """Material names (M,) and each facet's area of each material (K, M) (module doc)."""
+    from speclight.estimate.endmember_spectra import endmembers_from_scenario
+    from speclight.estimate.unmixing import unmix
+
+    ends = endmembers_from_scenario(loaded, bands)
+    if len(ends.names) > facet_band_area.shape[1]:
+        raise InputError(
+            f"{len(ends.names)} distinct materials cannot be unmixed from "
+            f"{facet_band_area.shape[1]} bands (give at least as many bands as materials)",
+            field="--bands",
+        )
+    return ends.names, unmix(facet_band_area, ends.signatures, "nnls").abundance

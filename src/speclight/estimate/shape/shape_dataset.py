@@ -150,6 +150,14 @@ def shape_dataset(run: ShapeRun, obj_file: str | None = None) -> xr.Dataset:
             "facet area times its albedo in each band",
         )
         coords["band"] = ("band", run.inputs.band_names)
+    if run.materials is not None:
+        v["facet_material_area"] = _var(
+            ("facet", "material"),
+            run.materials[1],
+            "m2",
+            "each material's area on the facet (NNLS of the facet's band spectrum)",
+        )
+        coords["material"] = ("material", run.materials[0])
     ds = xr.Dataset(v, coords=coords)
     ds.attrs.update(_attrs(run, obj_file))
     return ds

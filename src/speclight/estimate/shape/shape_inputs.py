@@ -16,7 +16,7 @@ chosen bands, the per-band factors kept for the facet spectra.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -35,6 +35,7 @@ from speclight.estimate.shape.inversion_data import (
 )
 
 if TYPE_CHECKING:
+    from speclight.estimate.scenario_bands import BandResponses
     from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
@@ -63,6 +64,8 @@ class ShapeInput:
         What was read, in words.
     loaded
         The scenario (speclight input), else None.
+    bands
+        The chosen bands' responses (speclight input), else None.
     """
 
     data: InversionData
@@ -72,6 +75,7 @@ class ShapeInput:
     unit: str
     source: str
     loaded: LoadedScenario | None = None
+    bands: BandResponses | None = None
 
 
 def check_format(fmt: str) -> None:
@@ -167,6 +171,7 @@ def _speclight_input(
     order = np.argsort(emitted_jd[keep], kind="stable")
     band_factor = factor[keep][order]
     band_sigma = None if sigma is None else sigma[keep][order]
+    chosen_bands = replace(factors.bands, band_names=chosen, response=factors.bands.response[idx])
     return ShapeInput(
         data,
         chosen,
@@ -175,4 +180,5 @@ def _speclight_input(
         "m2 sr-1",
         f"{src}: band reflectance factors ({', '.join(chosen)})",
         loaded,
+        chosen_bands,
     )

@@ -9,7 +9,8 @@ Steps (docs/shape.md):
 4. the best and the mirror refined on the fine facets (``nside``), everything free;
 5. uncertainties (:mod:`.uncertainty`): covariance, optional bootstrap, mirror, null tests;
 6. the polyhedron of the best EGI (:mod:`.minkowski`);
-7. with several bands: the facets' band factors with the geometry held (:mod:`.facet_spectra`).
+7. with several bands: the facets' band factors with the geometry held, and with a scenario
+   and the Lambert law their split into its materials (:mod:`.facet_spectra`).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from speclight.errors import InputError
 from speclight.estimate.shape.convex_fit import ConvexSolution, fit_convex
 from speclight.estimate.shape.convex_model import N_ROTATION, ConvexModel
 from speclight.estimate.shape.egi import facet_normals
-from speclight.estimate.shape.facet_spectra import facet_band_factors
+from speclight.estimate.shape.facet_spectra import facet_band_factors, facet_materials
 from speclight.estimate.shape.minkowski import Polyhedron, minkowski_polyhedron
 from speclight.estimate.shape.period_scan import PeriodScan, period_grid_h, scan_periods
 from speclight.estimate.shape.pole_search import PoleSearch, search_poles
@@ -111,6 +112,7 @@ class ShapeRun:
     polyhedron: Polyhedron | None
     band_factor: F64 | None
     seconds: float
+    materials: tuple[list[str], F64] | None = None
 
     @property
     def shape_constrained(self) -> bool:
@@ -190,9 +192,11 @@ def _run_shape(inputs: ShapeInput, options: ShapeOptions) -> ShapeRun:
     p_shape = shape_p_value(fine, best)
     constrained = p_shape < NULL_P_VALUE
     poly = minkowski_polyhedron(fine.normals, best.areas) if constrained else None
-    band = None
+    band, materials = None, None
     if inputs.band_factor is not None and inputs.band_factor.shape[1] > 1:
         band = facet_band_factors(fine, best, inputs.band_factor, inputs.band_sigma)
+        if inputs.loaded is not None and inputs.bands is not None and law.name == "lambert":
+            materials = facet_materials(band, inputs.loaded, inputs.bands)
     return ShapeRun(
         inputs=inputs,
         options=options,
@@ -213,4 +217,5 @@ def _run_shape(inputs: ShapeInput, options: ShapeOptions) -> ShapeRun:
         polyhedron=poly,
         band_factor=band,
         seconds=time.perf_counter() - start,
+        materials=materials,
     )

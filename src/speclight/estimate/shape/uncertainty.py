@@ -66,7 +66,7 @@ def _unscaled_covariance(model: ConvexModel, sol: ConvexSolution) -> tuple[F64, 
     matrix; Hastie, Tibshirani & Friedman 2009, sec. 7.6): below the nominal count where
     the penalties hold some directions (the closure, the scale)."""
     _, jac = model.residuals(sol.theta)
-    cov = np.linalg.pinv(jac.T @ jac)
+    cov = np.asarray(np.linalg.pinv(jac.T @ jac), dtype=np.float64)
     data_rows = jac[: model.data.n_points]
     return cov, float(np.sum((data_rows @ cov) * data_rows))
 
