@@ -75,7 +75,7 @@ def test_torque_free_box_wing_state_recovered():
         scattering_law("lambert"),
         min_period_h=0.03,
         max_period_h=0.1,
-        n_starts=4,
+        n_starts=2,
         initial_states=[prior],
         t0_jd=t_jd[0],
     )

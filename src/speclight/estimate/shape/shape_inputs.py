@@ -151,8 +151,12 @@ def _speclight_input(
     with np.errstate(invalid="ignore"):
         brightness = np.where(ok, np.mean(factor, axis=1), np.nan)
         mean_sigma = None if sigma is None else np.sqrt(np.sum(sigma**2, axis=1)) / len(idx)
+    # passes: a gap of PASS_GAP_S between usable points starts a new light curve
     t_s = (factors.time_utc - factors.time_utc[0]) / np.timedelta64(1, "s")
-    curve = np.concatenate([[0], np.cumsum(np.diff(t_s) > PASS_GAP_S)]).astype(np.int64)
+    usable = np.flatnonzero(np.isfinite(brightness))
+    gap = np.zeros(t_s.size, bool)
+    gap[usable[1:]] = np.diff(t_s[usable]) > PASS_GAP_S
+    curve = np.cumsum(gap).astype(np.int64)
     if mean_sigma is None:
         # no sigmas: the same relative weight for every point (as a DAMIT file)
         means = np.array(
