@@ -84,6 +84,11 @@ def calibration(draws: int) -> None:
         if angular_distance_deg(pole_vector(b.lambda_deg, b.beta_deg), pole_vector(lam, bet)) > 20:
             mirrors += 1
             reported += int(run.mirror_reported)
+            at_truth = fit_convex(run.model, lam, bet, period, log_areas=b.theta[3:])
+            print(
+                f"draw {k}: chi2 {b.chi2:.1f} at the pole found, {at_truth.chi2:.1f} refitted "
+                f"from the truth; pole constrained: {run.pole_constrained}"
+            )
             print(
                 f"draw {k}: pole ({b.lambda_deg:.1f}, {b.beta_deg:.1f}) not the truth "
                 f"({lam:.1f}, {bet:.1f}); mirror reported: {run.mirror_reported}"
