@@ -1,5 +1,5 @@
 """DAMIT .lc files: the reader against text written here from the format description
-(Durech et al. 2010, A&A 513, A46; SPEC.md section 5.1), its errors, and the writer."""
+(Durech et al. 2010, A&A 513, A46), its errors, and the writer."""
 
 from __future__ import annotations
 

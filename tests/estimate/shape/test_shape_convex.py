@@ -3,7 +3,7 @@
 The light curves come from another route than the model under test: speclight's ray-cast
 render of a white Lambertian mesh (conftest.render_mesh) at asteroid-like apparitions
 (synthetic.apparitions), written as a DAMIT .lc file by the writer below (built from the
-format description: Durech et al. 2010, A&A 513, A46; SPEC.md section 5.1), read back by the
+format description: Durech et al. 2010, A&A 513, A46), read back by the
 reader under test. Checks (issue 27): the period to its resolution, the pole within 5 deg (or
 the mirror, flagged), the EGI within 10 % of the true body's.
 """

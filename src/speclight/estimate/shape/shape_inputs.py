@@ -4,7 +4,7 @@ geometry of their scenario.
 speclight input (``fmt="speclight"``): MEASURED (a speclight NetCDF or a CSV of count rates,
 :func:`speclight.estimate.measured.read_measured`) becomes band reflectance factors [m2 sr-1]
 (:func:`speclight.estimate.unmix_inputs.read_reflectance_factors`: the rates over the
-aperture, the range squared, the Sun and the atmosphere; SPEC.md section 5), calibrated
+aperture, the range squared, the Sun and the atmosphere: eq. 5 of Nussbaum et al. 2022), calibrated
 photometry that no longer depends on the distance. The geometry at the measured epochs comes
 from the scenario (the one given, else the one a NetCDF carries) through the pipeline's own
 :func:`speclight.simulate.geometry_stage.scenario_geometry`: the Sun's and the observer's
