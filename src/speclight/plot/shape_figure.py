@@ -78,6 +78,8 @@ def shape_figure(ds: xr.Dataset, poly: Polyhedron | None = None) -> Any:
     ax.axvline(
         ds.attrs["period_h"], color="tab:red", lw=0.8, label=f"P = {ds.attrs['period_h']:.6f} h"
     )
+    ax.locator_params(axis="x", nbins=5)
+    ax.ticklabel_format(axis="x", useOffset=True, style="plain")
     ax.set_xlabel("trial period [h]")
     ax.set_ylabel("chi-square")
     ax.legend(fontsize="small")
