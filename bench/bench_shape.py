@@ -77,7 +77,7 @@ def calibration(draws: int) -> None:
         t = time.perf_counter()
         run = run_shape(
             ShapeInput(d, [], None, None, "1", "draw"),
-            ShapeOptions(lo, hi, law="lambert", n_start_poles=4),
+            ShapeOptions(lo, hi, law="lambert"),
         )
         seconds.append(time.perf_counter() - t)
         b, c = run.best, run.cov

@@ -30,7 +30,7 @@ from speclight.progress import stage
 
 F64 = NDArray[np.float64]
 PHASE_DRIFT = 0.4
-N_START_POLES = 6
+N_START_POLES = 8
 SCAN_ITERATIONS = 30
 MAX_TRIALS = 200_000
 

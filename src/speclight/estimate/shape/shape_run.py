@@ -27,7 +27,12 @@ from speclight.estimate.shape.convex_model import N_ROTATION, ConvexModel
 from speclight.estimate.shape.egi import facet_normals
 from speclight.estimate.shape.facet_spectra import facet_band_factors, facet_materials
 from speclight.estimate.shape.minkowski import Polyhedron, minkowski_polyhedron
-from speclight.estimate.shape.period_scan import PeriodScan, period_grid_h, scan_periods
+from speclight.estimate.shape.period_scan import (
+    N_START_POLES,
+    PeriodScan,
+    period_grid_h,
+    scan_periods,
+)
 from speclight.estimate.shape.pole_search import PoleSearch, search_poles
 from speclight.estimate.shape.scattering import ScatteringLaw, scattering_law
 from speclight.estimate.shape.shape_inputs import ShapeInput
@@ -82,7 +87,7 @@ class ShapeOptions:
     nside: int = 4
     search_nside: int = 2
     pole_step_deg: float = 30.0
-    n_start_poles: int = 6
+    n_start_poles: int = N_START_POLES
     bootstrap_draws: int = 0
     seed: int = 0
     wavelength_nm: float = 550.0
