@@ -150,6 +150,7 @@ def fit_tumbling(
     seed: int = 0,
     initial_states: list[TumblingState] | None = None,
     t0_jd: float | None = None,
+    rate_span: float = RATE_SPAN,
 ) -> TumblingFit:
     """Multi-start fit of the torque-free state and its families (module doc).
 
@@ -162,6 +163,7 @@ def fit_tumbling(
     :data:`RATE_SPAN` (a torque-free motion with its rates scaled by ``c`` is the same
     motion ``c`` times faster), and the lowest of all is kept as in stage 1.
 
+    ``rate_span``: the relative rate error covered in stage 2 (default :data:`RATE_SPAN`).
     ``initial_states`` (at ``t0_jd``, default the seed curve's middle) are tried before the
     random starts: a prior (e.g. the scenario's attitude) narrows a search that random
     starts alone rarely win (docs/shape.md, "Limits").
@@ -180,6 +182,7 @@ def fit_tumbling(
             seed,
             initial_states,
             t0_jd,
+            rate_span,
         )
 
 
@@ -194,6 +197,7 @@ def _fit_tumbling(
     seed: int,
     initial_states: list[TumblingState] | None,
     t0_jd: float | None,
+    rate_span: float,
 ) -> TumblingFit:
     counts = np.bincount(data.curve)
     seed_curve = int(np.argmax(counts))
@@ -215,7 +219,7 @@ def _fit_tumbling(
         for sol in seeds:
             period_s = 2 * np.pi / sol.rate_rad_s
             dc = PHASE_DRIFT * period_s / gap_s
-            for j in np.arange(-np.floor(RATE_SPAN / dc), np.floor(RATE_SPAN / dc) + 1):
+            for j in np.arange(-np.floor(rate_span / dc), np.floor(rate_span / dc) + 1):
                 x_next.append(_state_vector(sol, 1.0 + j * dc))
         final = _fit_all(prob, x_next)
     kept = _within(final, prob)
