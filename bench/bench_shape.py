@@ -87,7 +87,8 @@ def calibration(draws: int) -> None:
             at_truth = fit_convex(run.model, lam, bet, period, log_areas=b.theta[3:])
             print(
                 f"draw {k}: chi2 {b.chi2:.1f} at the pole found, {at_truth.chi2:.1f} refitted "
-                f"from the truth; pole constrained: {run.pole_constrained}"
+                f"from the truth; pole constrained: {run.pole_constrained}; other poles "
+                f"reported as fitting as well: {len(run.equivalent_minima)}"
             )
             print(
                 f"draw {k}: pole ({b.lambda_deg:.1f}, {b.beta_deg:.1f}) not the truth "

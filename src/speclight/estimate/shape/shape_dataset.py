@@ -44,6 +44,8 @@ def verdict(run: ShapeRun) -> str:
     )
     if run.mirror_reported:
         parts.append("the mirror pole fits as well")
+    for m in run.equivalent_minima:
+        parts.append(f"the pole ({m.lambda_deg:.0f}, {m.beta_deg:.0f}) fits as well")
     return "; ".join(parts)
 
 
@@ -195,6 +197,7 @@ def _attrs(run: ShapeRun, obj_file: str | None) -> dict[str, Any]:
     if run.mirror_reported:
         a["mirror_lambda_deg"] = run.mirror.lambda_deg
         a["mirror_beta_deg"] = run.mirror.beta_deg
+    a["poles_fitting_as_well"] = len(run.equivalent_minima)
     if run.samples.size:
         a["bootstrap_period_std_h"] = float(np.std(run.samples[:, 2], ddof=1))
         a["bootstrap_lambda_std_deg"] = float(np.std(run.samples[:, 0], ddof=1))

@@ -120,6 +120,14 @@ class ShapeRun:
     materials: tuple[list[str], F64] | None = None
 
     @property
+    def equivalent_minima(self) -> list[ConvexSolution]:
+        """Other refined pole minima (not the mirror) whose chi-square is within the mirror's
+        bound of the best (:func:`.uncertainty.mirror_ambiguous`): poles the data do not
+        separate from the best either."""
+        s = self.cov.residual_scale
+        return [m for m in self.others if mirror_ambiguous(self.best, m, s)]
+
+    @property
     def shape_constrained(self) -> bool:
         """True when the fit beats a sphere at p < :data:`NULL_P_VALUE`."""
         return self.shape_p < NULL_P_VALUE
