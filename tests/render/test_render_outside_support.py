@@ -82,3 +82,22 @@ def test_the_output_records_the_fraction_and_its_flag():
     np.testing.assert_array_equal(flagged, lit & (fraction > schema.OUTSIDE_SUPPORT_FLAG_FRACTION))
     assert flagged.any() and (lit & ~flagged).any()
     assert "outside_measured_support" in ds["flags"].attrs["flag_meanings"].split()
+
+
+def test_the_shape_inversion_sees_the_extension_too():
+    # speclight shape's material law (estimate/shape/scattering.py) sums every channel: at the
+    # forward-scattering case, all of the material's light is its extension's
+    from speclight.estimate.shape.scattering import scattering_law
+    from speclight.target.brdf_table import load_brdf_table
+
+    m = Material("chassis", "measured", Reflectance.constant(1.0),
+                 brdf_table="starlink_v1p5_chassis_532nm")  # fmt: skip
+    s, o, _ = CASES[2]
+    h = (s + o) / np.linalg.norm(s + o)
+    law = scattering_law("material", material=m, wavelength_nm=532.0)
+    got = law.value(np.array([s[2]]), np.array([o[2]]), np.array([s @ h]))
+    table = load_brdf_table("starlink_v1p5_chassis_532nm")
+    cos = (np.array([s[2]]), np.array([o[2]]), np.array([h[2]]), np.array([s @ h]))
+    assert table.table_part(cos[2], cos[3])[0] == 0.0
+    want = s[2] * o[2] * table.extension_part(*cos)  # S = mu0 mu f
+    np.testing.assert_allclose(got, want, rtol=1e-12)
