@@ -1195,6 +1195,75 @@ def compare(
     _guarded(run)
 
 
+@app.command("brdf-fit")
+def brdf_fit(
+    table: Annotated[
+        str,
+        typer.Argument(
+            help="Measured in-plane BRDF table: a CSV (phi_i theta_i phi_o theta_o brdf, deg "
+            "and sr-1) or a shipped table name."
+        ),
+    ],
+    model: Annotated[
+        str, typer.Option("--model", help="Analytic model: phong, abg, binomial or microfacet.")
+    ],
+    output: Annotated[
+        str, typer.Option("--output", "-o", metavar="FILE", help="Material YAML.")
+    ] = "material.yaml",
+    distribution: Annotated[
+        str, typer.Option("--distribution", help="microfacet: ggx or beckmann.")
+    ] = "ggx",
+    fresnel: Annotated[
+        str, typer.Option("--fresnel", help="microfacet: schlick or exact (a dielectric).")
+    ] = "schlick",
+    min_brdf: Annotated[
+        float,
+        typer.Option("--min-brdf", help="Leave out samples at or below this BRDF [sr-1]."),
+    ] = 0.0,
+    plot_file: Annotated[
+        str | None, typer.Option("--plot", metavar="FIG", help="Figure (.png, .pdf, .svg).")
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite existing outputs.")] = False,
+) -> None:
+    """Fit an analytic BRDF model to a measured table in log space, print the residual per
+    incidence angle and write the model as a material for a scenario's target.materials
+    (its directional albedo held at most 1). See docs/brdf-models.md.
+
+    Example: speclight brdf-fit starlink_v1p5_chassis_532nm --model binomial -o chassis.yaml
+    """
+
+    def run() -> None:
+        from speclight.plot.figure_output import claim_outputs, write_outputs
+        from speclight.target.brdf_fit.log_fit import fit_table_samples
+        from speclight.target.brdf_fit.material_yaml import material_yaml, report_lines
+        from speclight.target.brdf_samples import read_table_samples
+
+        inputs = {"table": table} if Path(table).exists() else {}
+        with claim_outputs(output, plot_file, force, inputs) as (claim, figure):
+            samples = read_table_samples(table)
+            flags = {
+                "model": "--model",
+                "distribution": "--distribution",
+                "fresnel": "--fresnel",
+                "min_brdf": "--min-brdf",
+            }
+            with _flag_names(**flags):
+                fit = fit_table_samples(samples, model, distribution, fresnel, min_brdf)
+            _raise_if_signalled()
+
+            def draw() -> Any:
+                from speclight.plot.brdf_fit_figure import brdf_fit_figure
+
+                return brdf_fit_figure(samples, fit)
+
+            write_outputs(claim, material_yaml(fit).encode(), figure, draw)
+        for line in report_lines(fit):
+            typer.echo(line)
+        typer.echo(f"wrote {output}" + (f" and {plot_file}" if plot_file else ""))
+
+    _guarded(run)
+
+
 @app.command()
 def passes(
     scenario: Annotated[Path, typer.Argument(help="Scenario YAML: its orbit and observer.")],

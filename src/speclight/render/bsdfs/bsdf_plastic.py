@@ -95,7 +95,7 @@ class PlasticBsdf(MaterialBsdf):
     ) -> int:
         return PLASTIC_NODES**2
 
-    def block_weights(self, cos_i: F64, cos_o: F64, cos_d: F64) -> tuple[I64, I64, F64]:
+    def block_weights(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64) -> tuple[I64, I64, F64]:
         idx, bw = bilinear_nodes(cos_i, cos_o)
         rows = np.repeat(np.arange(len(cos_i)), 4)
         return rows, idx.ravel(), (bw * (cos_i / np.pi)[:, None]).ravel()
