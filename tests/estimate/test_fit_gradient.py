@@ -24,7 +24,6 @@ from speclight.estimate import fit_scenario
 from speclight.estimate.fitting.gradient_fit import fit_roughness_gradient, projected_residuals
 from speclight.estimate.fitting.roughness_gradient import RoughnessRates
 from speclight.estimate.inputs.measured import MeasuredLightCurve
-from speclight.render.brdf import microfacet_d, microfacet_weight, smith_g1
 from speclight.render.brdf_gradient import (
     microfacet_d_dalpha,
     microfacet_weight_dalpha,
@@ -33,6 +32,7 @@ from speclight.render.brdf_gradient import (
 from speclight.scenario import example_text, parse_scenario
 from speclight.scenario.overrides import replace_fields
 from speclight.simulation import simulate
+from speclight.target.microfacet_terms import microfacet_d, microfacet_weight, smith_g1
 
 DATA = Path(__file__).parent / "data"
 ONE = '"*": {bsdf: beckmann, roughness: 0.12, reflectance: 0.6}'

@@ -114,11 +114,13 @@ def files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     (folder / "observed.csv").write_text("\n".join(obs) + "\n")
     (folder / "fit.json").write_text(json.dumps({"bands": {b: {"albedo": 0.5} for b in bands}}))
     (folder / "finals2000A.all").write_bytes(iers_files.shipped_finals_path().read_bytes())
+    (folder / "imaging.yaml").write_text(IMAGING)
     names = ("pass.yaml", "pass.nc", "pass.csv", "map.zarr", "observed.csv", "fit.json")
     keys = ("scenario", "nc", "csv", "map", "observed", "fit")
     return {
         **{k: folder / n for k, n in zip(keys, names, strict=True)},
         "finals": folder / "finals2000A.all",
+        "imaging": folder / "imaging.yaml",
     }
 
 
@@ -154,6 +156,11 @@ def _some_finite(name: str) -> Callable[[Path], bool]:
 def _spectrum_ok(out: Path) -> bool:
     rows = [ln for ln in out.read_text().splitlines() if ln and ln[0].isdigit()]
     return bool(rows) and _finite(*(float(r.split(",")[1]) for r in rows))
+
+
+def _frames_ok(out: Path) -> bool:
+    frames = _json(out / "truth.json")["frames"]
+    return bool(frames) and all(_finite(f["ra_deg"], f["dec_deg"]) for f in frames)
 
 
 def _compare_ok(out: Path) -> bool:
@@ -232,9 +239,28 @@ OTHERS = {
         lambda out: out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n",
     ),
     "update-data": Command(("update-data", "--from", "{IN}"), None, lambda out: True),
+    "frames": Command(
+        ("frames", "{IN}", "-o", "{OUT}", "--imaging", "{imaging}"), "frames", _frames_ok
+    ),
 }
 #: The valid file of each command's slot (a fixture name) and the families that spoil it.
-SLOTS = {"upsample": "fit", "compare": "observed", "plot": "nc", "update-data": "finals"}
+SLOTS = {
+    "upsample": "fit",
+    "compare": "observed",
+    "plot": "nc",
+    "update-data": "finals",
+    "frames": "nc",
+}
+#: A small camera for ``speclight frames`` (docs/frames.md): no stars, no sky, no noise.
+IMAGING = """\
+detector: {width_px: 32, height_px: 32, plate_scale_arcsec: 20.0}
+exposure_s: 1.0
+cadence_s: 30
+psf: {seeing: {profile: gaussian, fwhm_arcsec: 40.0}, diffraction: false}
+sky: {model: none}
+stars: {catalogue: none}
+noise: false
+"""
 
 
 def _answer(command: Command, args: list[str], out: Path) -> str:
@@ -313,7 +339,8 @@ def test_measured_netcdf_families(files: dict[str, Path], tmp_path: Path, name: 
 
 
 def test_other_file_families(files: dict[str, Path], tmp_path: Path) -> None:
-    """upsample's FIT.json, compare's OBSERVATIONS, plot's DATASET, update-data's table."""
+    """upsample's FIT.json, compare's OBSERVATIONS, plot's and frames' DATASET, update-data's
+    table."""
     raw = files["nc"].read_bytes()
     ds = xr.load_dataset(files["nc"], engine="h5netcdf")
     plots = {f: NETCDF[f](ds) for f in ("renamed time", "float time", "2-vectors", "inf rates")}
@@ -328,6 +355,7 @@ def test_other_file_families(files: dict[str, Path], tmp_path: Path) -> None:
             ".csv",
         ),
         "plot": (plots, ".nc"),
+        "frames": (plots, ".nc"),
         "update-data": (
             {f: s(files["finals"].read_text()).encode() for f, s in IERS_TABLE.items()},
             ".all",
@@ -431,4 +459,14 @@ def test_random_bytes_in_a_measured_netcdf(
     given = folder / "m.nc"
     given.write_bytes(damaged(files["nc"].read_bytes(), seed))
     problem = _answer(MEASURED[name], MEASURED[name].args(files, given, folder), folder)
+    assert not problem, problem
+
+
+@pytest.mark.parametrize("name", sorted(OTHERS))
+def test_the_valid_files_give_an_answer(files: dict[str, Path], tmp_path: Path, name: str) -> None:
+    """The unspoiled file of each slot: exit 0 and a finite answer (the families above are
+    then the only difference)."""
+    command = OTHERS[name]
+    with _user_data(tmp_path):
+        problem = _answer(command, command.args(files, files[SLOTS[name]], tmp_path), tmp_path)
     assert not problem, problem

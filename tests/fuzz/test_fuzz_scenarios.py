@@ -338,3 +338,19 @@ def test_cli_exits_0_or_2_without_traceback(
     event(f"exit {result.exit_code}")
     assert result.exit_code in (0, 2), result.output
     assert "Traceback" not in result.output
+
+
+@CLI_FUZZ
+@given(mutated())
+def test_passes_exits_0_or_2_without_traceback(
+    case: tuple[dict[str, Any], list[tuple[str, bytes]]],
+) -> None:
+    """``speclight passes`` reads the same scenario file (its window, site and orbit)."""
+    data, files = case
+    data.pop("target", None)
+    with tempfile.TemporaryDirectory() as folder:
+        scenario = _write(Path(folder), data, files)
+        result = runner.invoke(app, ["passes", str(scenario), "-o", f"{folder}/passes.csv"])
+    event(f"exit {result.exit_code}")
+    assert result.exit_code in (0, 2), result.output
+    assert "Traceback" not in result.output

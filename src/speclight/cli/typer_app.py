@@ -14,12 +14,14 @@ from typing import Annotated, Any
 import typer
 
 from speclight.cli import (
+    brdf_commands,
     dataset_commands,
     fitting_commands,
     info_commands,
     map_commands,
     rotation_commands,
     scale_commands,
+    shape_commands,
     simulation_commands,
     spectra_commands,
 )
@@ -70,8 +72,10 @@ COMMANDS: list[tuple[str, Callable[..., None]]] = [
     ("period", rotation_commands.period),
     ("sweep", scale_commands.sweep),
     ("compare", fitting_commands.compare),
+    ("brdf-fit", brdf_commands.brdf_fit),
     ("passes", simulation_commands.passes),
     ("frames", dataset_commands.frames),
+    ("shape", shape_commands.shape),
     ("info", info_commands.info),
     ("update-data", info_commands.update_data),
 ]

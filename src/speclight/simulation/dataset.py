@@ -18,7 +18,7 @@ from speclight.simulation.geometry_stage import Geometry
 from speclight.simulation.input_hashes import input_files_attribute
 
 
-def geometry_dataset(geo: Geometry, flags: NDArray[np.uint8] | None = None) -> xr.Dataset:
+def geometry_dataset(geo: Geometry, flags: NDArray[np.uint16] | None = None) -> xr.Dataset:
     """The geometry variables on the ``time`` and ``xyz`` dimensions.
 
     ``flags``: the run's flag bits (geometry and later stages), default ``geo.flags``.
@@ -49,12 +49,8 @@ def geometry_dataset(geo: Geometry, flags: NDArray[np.uint8] | None = None) -> x
     )
     ds["attitude_quaternion"] = schema.variable("attitude_quaternion", geo.quaternion_body_to_gcrs)
     ds.coords["wxyz"] = ("wxyz", np.array(["w", "x", "y", "z"]))
-    masks = np.array(sorted(schema.FLAG_MEANINGS), dtype=np.uint8)
     ds["flags"] = schema.variable(
-        "flags",
-        geo.flags if flags is None else flags,
-        flag_masks=masks,
-        flag_meanings=" ".join(schema.FLAG_MEANINGS[int(m)] for m in masks),
+        "flags", geo.flags if flags is None else flags, **schema.flag_attributes()
     )
     ds["time"].attrs.update(schema.COORDINATES["time"])
     return ds

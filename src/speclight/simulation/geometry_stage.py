@@ -55,7 +55,7 @@ class Geometry:
     sun_direction_body: NDArray[np.float64]
     observer_direction_body: NDArray[np.float64]
     phase_vector_body: NDArray[np.float64]
-    flags: NDArray[np.uint8]
+    flags: NDArray[np.uint16]
     #: The Sun's elevation at the site [deg] (geometric, of its centre).
     sun_elevation_deg: NDArray[np.float64]
     #: Where to point: topocentric RA/Dec and the angular rate on the sky.
@@ -176,7 +176,7 @@ def scenario_geometry(
     sun_b, obs_b, phase_b = att.body_directions(
         q, geo.sun_direction_gcrs, geo.observer_direction_gcrs
     )
-    flags = np.zeros(t_s.size, dtype=np.uint8)
+    flags = np.zeros(t_s.size, dtype=v.FLAG_DTYPE)
     flags[~ok] |= v.FLAG_ORBIT_FAILED
     flags[ok & np.any(np.isnan(q), axis=1)] |= v.FLAG_ATTITUDE_UNDEFINED
     with np.errstate(invalid="ignore"):

@@ -7,6 +7,7 @@ import warnings
 import numpy as np
 from numpy.typing import NDArray
 
+from speclight import schema
 from speclight.constants import AU_M
 from speclight.illumination import solar_irradiance_W_m2_nm
 from speclight.maps.map_lookup import load_map
@@ -51,7 +52,7 @@ def map_reflection(loaded: LoadedScenario, geo: Geometry, wavelength_nm: F64) ->
         intensity_W_sr_nm=intensity,
         intensity_std_W_sr_nm=std,
         variant="map",
-        flags=np.zeros(n, dtype=np.uint8),
+        flags=np.zeros(n, dtype=schema.FLAG_DTYPE),
     )
 
 

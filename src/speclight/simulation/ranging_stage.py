@@ -87,7 +87,7 @@ class RangingSetup:
     lasers: list[LaserSetup]
     accumulator: LaserReturnAccumulator | None
     session: RenderSession | None
-    flags: NDArray[np.uint8]
+    flags: NDArray[np.uint16]
     wavelength_nm: F64
     map_returns: Callable[[], LaserReturns] | None = None
 
@@ -183,7 +183,7 @@ def prepare_ranging(
         return None
     t = time_from_utc(geo.time_utc)
     lasers = [_laser(loaded, geo, wavelength_nm, k, t) for k in range(len(sc.illumination.lasers))]
-    flags = np.zeros(geo.t_s.size, dtype=np.uint8)
+    flags = np.zeros(geo.t_s.size, dtype=schema.FLAG_DTYPE)
     for laser in lasers:
         flags[geo.orbit_ok & ~laser.above_horizon] |= schema.FLAG_LASER_BELOW_HORIZON
     obs = np.where(geo.observable[:, None], geo.observer_direction_body, np.nan)

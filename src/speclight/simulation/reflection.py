@@ -40,6 +40,7 @@ from speclight.target.bsdf_models import bsdf_file_parameters
 from speclight.target.from_values import BUILTIN_SHAPES
 from speclight.target.material_tables import material_table_path
 from speclight.target.mesh_io import load_mesh
+from speclight.wavelength_grid import bin_widths_nm
 
 F64 = NDArray[np.float64]
 
@@ -127,6 +128,8 @@ def _material(loaded: LoadedScenario, name: str, m: MaterialModel) -> Material:
         diffuse_reflectance=None
         if diffuse is None
         else _reflectance(loaded, diffuse, f"{field}.diffuse_reflectance"),
+        extension=m.extension,
+        coefficients=m.coefficients,
         **files,
     )
 
@@ -142,9 +145,14 @@ class Reflection:
     images: dict[int, RenderImage] = field(default_factory=dict)
     part_names: list[str] = field(default_factory=list)
     #: (N,) flag bits set by this stage (:data:`~speclight.schema.FLAG_RENDER_FAILED`).
-    flags: NDArray[np.uint8] | None = None
+    flags: NDArray[np.uint16] | None = None
     #: (N, L) the part of the intensity from Earthshine (``illumination.earthshine``).
     earthshine_W_sr_nm: F64 | None = None
+    #: (N,) fraction of the reflected sunlight from outside measured tables' support
+    #: (``outside_support_fraction``); None where not rendered (a reflectivity map).
+    outside_support_fraction: F64 | None = None
+    #: (N, L) the part of the Sun's reflection from outside measured tables' support.
+    outside_support_W_sr_nm: F64 | None = None
     #: (N, L, 3) Stokes Q, U, V of the intensity in the sky's north-east frame, and their
     #: standard errors (``render.polarization``; :mod:`speclight.render.polarization`).
     stokes_W_sr_nm: F64 | None = None
@@ -173,7 +181,7 @@ def render_reflection(
         return Reflection(
             solar_irradiance_W_m2_nm=solar,
             intensity_W_sr_nm=None,
-            flags=np.zeros(geo.t_s.size, dtype=np.uint8),
+            flags=np.zeros(geo.t_s.size, dtype=schema.FLAG_DTYPE),
         )
     sunlit = _sunlit_fraction(loaded, geo)
     lit = geo.observable & (sunlit > 0)
@@ -181,6 +189,7 @@ def render_reflection(
     idx = np.flatnonzero(lit)
     earthshine_on = _earthshine_on(loaded, geo)
     if not (idx.size or earthshine_on):
+        _flag_outside_support(out, wavelength_nm)
         return out
     target = build_target(loaded) if target is None else target
     session = _session(loaded, target) if session is None else session
@@ -190,6 +199,7 @@ def render_reflection(
         )
         _store_lit(out, result, idx, sunlit)
         out.part_names = [part.name for part in target.parts]
+    _flag_outside_support(out, wavelength_nm)  # of the sunlight (Earthshine not counted)
     if earthshine_on:
         _add_earthshine(out, loaded, geo, wavelength_nm, target, session)
     return out
@@ -226,7 +236,7 @@ def _unrendered(
         solar_irradiance_W_m2_nm=solar,
         intensity_W_sr_nm=arrays[0],
         intensity_std_W_sr_nm=arrays[1],
-        flags=np.zeros(n, dtype=np.uint8),
+        flags=np.zeros(n, dtype=schema.FLAG_DTYPE),
         stokes_W_sr_nm=stokes[0],
         stokes_std_W_sr_nm=stokes[1],
     )
@@ -310,10 +320,29 @@ def _store_lit(out: Reflection, result: RenderResult, idx: NDArray[np.int64], su
         assert result.stokes_W_sr_nm is not None and result.stokes_std_W_sr_nm is not None
         out.stokes_W_sr_nm[idx] = result.stokes_W_sr_nm * scale[:, :, None]
         out.stokes_std_W_sr_nm[idx] = result.stokes_std_W_sr_nm * scale[:, :, None]
+    if result.outside_support_W_sr_nm is not None:
+        if out.outside_support_W_sr_nm is None:
+            out.outside_support_W_sr_nm = np.zeros_like(out.intensity_W_sr_nm)
+        out.outside_support_W_sr_nm[idx] = result.outside_support_W_sr_nm * scale
     out.variant = result.variant
     out.images = {int(idx[k]): image for k, image in result.images.items()}
     for epoch, image in out.images.items():  # penumbra: as the intensity
         image.radiance_W_m2_sr_nm = image.radiance_W_m2_sr_nm * sunlit[epoch]
+
+
+def _flag_outside_support(out: Reflection, wavelength_nm: F64) -> None:
+    """Set ``outside_support_fraction`` (the intensity from outside measured tables'
+    support over all, integrated over the grid's bins) and its flag bit."""
+    assert out.intensity_W_sr_nm is not None and out.flags is not None
+    widths = bin_widths_nm(wavelength_nm)
+    total = out.intensity_W_sr_nm @ widths
+    outside = np.zeros_like(total)
+    if out.outside_support_W_sr_nm is not None:
+        outside = np.nan_to_num(out.outside_support_W_sr_nm) @ widths
+    with np.errstate(invalid="ignore", divide="ignore"):
+        fraction = np.where(total > 0, outside / total, np.where(np.isfinite(total), 0.0, np.nan))
+    out.outside_support_fraction = fraction
+    out.flags[fraction > schema.OUTSIDE_SUPPORT_FLAG_FRACTION] |= schema.FLAG_OUTSIDE_SUPPORT
 
 
 def _add_earthshine(

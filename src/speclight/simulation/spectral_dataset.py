@@ -33,6 +33,10 @@ def add_spectral(
             ds["earthshine_intensity"] = schema.variable(
                 "earthshine_intensity", reflection.earthshine_W_sr_nm
             )
+        if reflection.outside_support_fraction is not None:
+            ds["outside_support_fraction"] = schema.variable(
+                "outside_support_fraction", reflection.outside_support_fraction
+            )
     if radiometry is None:
         return ds
     ds = ds.assign_coords(band=("band", np.array(radiometry.band_names, dtype=str)))

@@ -21,7 +21,7 @@ import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
-from speclight import orbit
+from speclight import orbit, schema
 from speclight.constants import C_M_S
 from speclight.errors import InputError
 from speclight.estimate.comparison.compare_stats import residual_statistics
@@ -160,7 +160,7 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
         )
     n = obs.time_utc.size
     sim = np.full(n, np.nan)
-    flags = np.zeros(n, dtype=np.uint8)
+    flags = np.zeros(n, dtype=schema.FLAG_DTYPE)
     geo: dict[str, F64] = {k: np.full(n, np.nan) for k in GEOMETRY}
     for name in ("sun_direction_body", "observer_direction_body"):
         geo[name] = np.full((n, 3), np.nan)
@@ -212,7 +212,7 @@ def _dataset(
     loaded: LoadedScenario,
     obs: Observations,
     sim: F64,
-    flags: NDArray[np.uint8],
+    flags: NDArray[np.uint16],
     geo: dict[str, F64],
 ) -> xr.Dataset:
     from speclight import schema
@@ -252,10 +252,4 @@ def _dataset(
 
 
 def _flag_attrs() -> dict[str, Any]:
-    from speclight import schema
-
-    bits = sorted(schema.FLAG_MEANINGS)
-    return {
-        "flag_masks": np.array(bits, dtype=np.uint8),
-        "flag_meanings": " ".join(schema.FLAG_MEANINGS[b] for b in bits),
-    }
+    return schema.flag_attributes()

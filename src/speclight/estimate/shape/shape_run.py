@@ -1,0 +1,234 @@
+"""``speclight shape``: from light curves to the convex shape, sidereal period and pole.
+
+Steps (docs/shape.md):
+
+1. the light curves in (:mod:`.shape_inputs`): DAMIT ``.lc``, or speclight's with the
+   scenario's geometry;
+2. the period scan (:mod:`.period_scan`) on the coarse facet set (``search_nside``);
+3. the pole map and its refined minima and mirror (:mod:`.pole_search`), coarse facets;
+4. the best and the mirror refined on the fine facets (``nside``), everything free;
+5. uncertainties (:mod:`.uncertainty`): covariance, optional bootstrap, mirror, null tests;
+6. the polyhedron of the best EGI (:mod:`.minkowski`);
+7. with several bands: the facets' band factors with the geometry held, and with a scenario
+   and the Lambert law their split into its materials (:mod:`.facet_spectra`).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from speclight.errors import InputError
+from speclight.estimate.shape.convex_fit import ConvexSolution, fit_convex
+from speclight.estimate.shape.convex_model import N_ROTATION, ConvexModel
+from speclight.estimate.shape.egi import facet_normals
+from speclight.estimate.shape.facet_spectra import facet_band_factors, facet_materials
+from speclight.estimate.shape.minkowski import Polyhedron, minkowski_polyhedron
+from speclight.estimate.shape.period_scan import (
+    N_START_POLES,
+    PeriodScan,
+    period_grid_h,
+    scan_periods,
+)
+from speclight.estimate.shape.pole_search import PoleSearch, search_poles
+from speclight.estimate.shape.scattering import ScatteringLaw, scattering_law
+from speclight.estimate.shape.shape_inputs import ShapeInput
+from speclight.estimate.shape.uncertainty import (
+    Covariance,
+    bootstrap,
+    covariance,
+    mirror_ambiguous,
+    shape_p_value,
+    spans,
+)
+
+F64 = NDArray[np.float64]
+NULL_P_VALUE = 1e-3
+BLAS_THREADS = 1
+
+
+@dataclass(frozen=True)
+class ShapeOptions:
+    """Options of :func:`run_shape` (the plain-array names of the CLI's flags).
+
+    Attributes
+    ----------
+    min_period_h, max_period_h
+        Period range scanned [h].
+    law
+        Scattering law name (:data:`.scattering.LAW_NAMES`) or ``material:NAME`` (a
+        material of the scenario); ``"auto"``: ``ls-lambert`` for DAMIT files, ``lambert``
+        for speclight's.
+    lambert_weight
+        Lambert weight ``c`` of ``ls-lambert``.
+    nside, search_nside
+        HEALPix resolution of the final EGI and of the scan and pole map.
+    pole_step_deg
+        Pole-map grid step [deg].
+    n_start_poles
+        Poles each trial period starts from.
+    bootstrap_draws
+        Bootstrap refits (0: none).
+    seed
+        Seed of the bootstrap.
+    wavelength_nm
+        Wavelength of a material law [nm].
+    progress
+        Show progress bars.
+    """
+
+    min_period_h: float
+    max_period_h: float
+    law: str = "auto"
+    lambert_weight: float = 0.1
+    nside: int = 4
+    search_nside: int = 2
+    pole_step_deg: float = 30.0
+    n_start_poles: int = N_START_POLES
+    bootstrap_draws: int = 0
+    seed: int = 0
+    wavelength_nm: float = 550.0
+    progress: bool = False
+
+
+@dataclass(frozen=True)
+class ShapeRun:
+    """Everything :func:`run_shape` found (fields as named; ``model`` is the fine one)."""
+
+    inputs: ShapeInput
+    options: ShapeOptions
+    law: ScatteringLaw
+    model: ConvexModel
+    scan: PeriodScan
+    poles: PoleSearch
+    best: ConvexSolution
+    mirror: ConvexSolution
+    others: list[ConvexSolution]
+    cov: Covariance
+    mirror_cov: Covariance
+    samples: F64
+    shape_p: float
+    mirror_reported: bool
+    pole_constrained: bool
+    period_constrained: bool
+    polyhedron: Polyhedron | None
+    band_factor: F64 | None
+    seconds: float
+    materials: tuple[list[str], F64] | None = None
+
+    @property
+    def equivalent_minima(self) -> list[ConvexSolution]:
+        """Other refined pole minima (not the mirror) whose chi-square is within the mirror's
+        bound of the best (:func:`.uncertainty.mirror_ambiguous`): poles the data do not
+        separate from the best either."""
+        s = self.cov.residual_scale
+        return [m for m in self.others if mirror_ambiguous(self.best, m, s)]
+
+    @property
+    def shape_constrained(self) -> bool:
+        """True when the fit beats a sphere at p < :data:`NULL_P_VALUE`."""
+        return self.shape_p < NULL_P_VALUE
+
+
+def resolve_law(options: ShapeOptions, inputs: ShapeInput) -> ScatteringLaw:
+    """The scattering law of ``options.law`` (``auto`` and ``material:NAME`` resolved)."""
+    name = options.law
+    if name == "auto":
+        name = "lambert" if inputs.unit == "m2 sr-1" else "ls-lambert"
+    if name.startswith("material:"):
+        material = name.split(":", 1)[1]
+        if inputs.loaded is None or inputs.loaded.scenario.target is None:
+            raise InputError(f"law '{name}' needs a scenario with that material", field="law")
+        from speclight.target.from_values import material_from_spec
+
+        mats = inputs.loaded.scenario.target.model_dump()["materials"]
+        if material not in mats:
+            raise InputError(
+                f"law '{name}': no material '{material}' in the scenario "
+                f"(materials: {', '.join(mats)})",
+                field="law",
+            )
+        m = material_from_spec(material, mats[material], base_dir=inputs.loaded.base_dir)
+        return scattering_law("material", material=m, wavelength_nm=options.wavelength_nm)
+    return scattering_law(name, lambert_weight=options.lambert_weight)
+
+
+def _refine_fine(model: ConvexModel, coarse: ConvexModel, sol: ConvexSolution) -> ConvexSolution:
+    """Refit ``sol`` on the fine facets, each starting from its nearest coarse facet's area
+    divided by the number of fine facets per coarse one."""
+    nearest = np.argmax(model.normals @ coarse.normals.T, axis=1)
+    ratio = len(model.normals) / len(coarse.normals)
+    g = sol.theta[N_ROTATION:][nearest] - np.log(ratio)
+    return fit_convex(model, sol.lambda_deg, sol.beta_deg, sol.period_h, log_areas=g)
+
+
+def run_shape(inputs: ShapeInput, options: ShapeOptions) -> ShapeRun:
+    """Convex inversion of ``inputs`` (module doc).
+
+    BLAS runs on one thread here (:data:`BLAS_THREADS`): the matrices are small (points x
+    at most a few hundred facets), and threads on a busy 2-core machine made one trial
+    period 25 times slower (BENCHMARKS.md, "Shape inversion").
+    """
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+        return _run_shape(inputs, options)
+
+
+def _run_shape(inputs: ShapeInput, options: ShapeOptions) -> ShapeRun:
+    start = time.perf_counter()
+    d = inputs.data
+    law = resolve_law(options, inputs)
+    t0 = float(np.floor(d.time_jd[0]))
+    coarse = ConvexModel(d, facet_normals(options.search_nside), law, t0)
+    fine = ConvexModel(d, facet_normals(options.nside), law, t0)
+    grid = period_grid_h(options.min_period_h, options.max_period_h, d.baseline_d)
+    scan = scan_periods(
+        coarse, grid, n_start_poles=options.n_start_poles, progress=options.progress
+    )
+    poles = search_poles(
+        coarse, scan.best.period_h, step_deg=options.pole_step_deg, progress=options.progress
+    )
+    refined = sorted((_refine_fine(fine, coarse, s) for s in poles.solutions), key=lambda s: s.chi2)
+    best = refined[0]
+    mirror = _refine_fine(fine, coarse, poles.mirror)
+    cov, mirror_cov = covariance(fine, best), covariance(fine, mirror)
+    samples = (
+        bootstrap(fine, best, options.bootstrap_draws, options.seed)
+        if options.bootstrap_draws > 0
+        else np.zeros((0, 3))
+    )
+    s = cov.residual_scale
+    p_shape = shape_p_value(fine, best)
+    constrained = p_shape < NULL_P_VALUE
+    poly = minkowski_polyhedron(fine.normals, best.areas) if constrained else None
+    band, materials = None, None
+    if inputs.band_factor is not None and inputs.band_factor.shape[1] > 1:
+        band = facet_band_factors(fine, best, inputs.band_factor, inputs.band_sigma)
+        if inputs.loaded is not None and inputs.bands is not None and law.name == "lambert":
+            materials = facet_materials(band, inputs.loaded, inputs.bands)
+    return ShapeRun(
+        inputs=inputs,
+        options=options,
+        law=law,
+        model=fine,
+        scan=scan,
+        poles=poles,
+        best=best,
+        mirror=mirror,
+        others=refined[1:],
+        cov=cov,
+        mirror_cov=mirror_cov,
+        samples=samples,
+        shape_p=p_shape,
+        mirror_reported=mirror_ambiguous(best, mirror, s),
+        pole_constrained=constrained and spans(poles.chi2, s),
+        period_constrained=constrained and spans(scan.chi2, s, "median"),
+        polyhedron=poly,
+        band_factor=band,
+        seconds=time.perf_counter() - start,
+        materials=materials,
+    )

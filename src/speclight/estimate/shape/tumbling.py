@@ -1,0 +1,306 @@
+"""Tumbling (non-principal-axis) rotation: the torque-free state fitted to light curves.
+
+The body's EGI (``normals``, ``areas``: e.g. the scenario's mesh, :func:`.egi.mesh_egi`) and
+scattering law are given; the state at ``t0`` is fitted: the attitude ``q0`` (body to
+ecliptic J2000, as a rotation vector), the body rates ``omega0`` [rad/s] and the principal
+moments (body axes principal) as ``I = tr(M) 1 - M`` of second moments
+``M = diag(exp(u1), exp(u2), 1)`` (any ``u`` gives moments that satisfy the triangle
+inequality of a real body), and for calibrated data a log-scale of the areas. The attitude at
+each epoch comes from speclight's torque-free propagation
+(:func:`speclight.attitude.torque_free_attitude`, closed form), the brightness from the
+convex model (:func:`.convex_model.facet_brightness`).
+
+Light curves do not fix the state uniquely (Kaasalainen 2001, A&A 376, 302; Pravec et al.
+2005, Icarus 173, 108): a body symmetry maps a state onto another with the same light
+curve, and different precession/rotation combinations fit nearly as well. So the fit is
+multi-start (:data:`N_STARTS` random states: uniform attitudes, rates from the period range,
+second moments log-uniform), each run by trust-region least squares
+(:func:`scipy.optimize.least_squares`, gradient from 2-point differences), and every
+solution within ``chi2_min + delta s^2`` (``delta`` the 99 % point of chi-square with as many
+degrees of freedom as parameters) is kept. Solutions are grouped into families by what
+a body symmetry does not change: the direction of the angular momentum in the ecliptic
+frame (within :data:`FAMILY_ANGLE_DEG`), the rotation rate ``|H| / I_max`` and the sorted
+moment ratios (within :data:`FAMILY_RELATIVE`); every family is reported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import stats
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+
+from speclight.attitude import torque_free_attitude
+from speclight.attitude.quaternion import quat_conjugate, quat_rotate
+from speclight.estimate.shape.convex_model import facet_brightness, relative_residuals
+from speclight.estimate.shape.ecliptic import angular_distance_deg
+from speclight.estimate.shape.inversion_data import InversionData
+from speclight.estimate.shape.scattering import ScatteringLaw
+
+F64 = NDArray[np.float64]
+N_STARTS = 32
+FAMILY_ANGLE_DEG = 10.0
+FAMILY_RELATIVE = 0.05
+SECONDS_PER_DAY = 86400.0
+MOMENT_SPREAD = 2.0  # second moments drawn log-uniform within e^(+-2)
+MOMENT_BOUND = 6.0  # and kept within e^(+-6) (a needle or a disk: moment ratios to 5e-3)
+MAX_EVALUATIONS = 200
+N_SEEDS = 6
+PHASE_DRIFT = 0.2  # turns of phase drift over the gap between rate-scale trials
+RATE_SPAN = 0.03  # relative rate error of a seed curve's solution covered by the trials
+
+
+@dataclass(frozen=True)
+class TumblingState:
+    """One fitted torque-free state (module doc).
+
+    Attributes
+    ----------
+    q0
+        (4,) body-to-ecliptic quaternion at ``t0`` (scalar first).
+    omega0_body_rad_s
+        (3,) body rates at ``t0`` [rad/s].
+    moments
+        (3,) principal moments along the body axes, the largest 1 [1].
+    chi2
+        Sum of squared residuals.
+    scale
+        Factor on the areas (calibrated data; 1 for relative).
+    """
+
+    q0: F64
+    omega0_body_rad_s: F64
+    moments: F64
+    chi2: float
+    scale: float = 1.0
+
+    @property
+    def momentum_direction(self) -> F64:
+        """Unit angular momentum in ecliptic J2000."""
+        h = quat_rotate(self.q0, self.moments * self.omega0_body_rad_s)
+        return np.asarray(h / np.linalg.norm(h))
+
+    @property
+    def rate_rad_s(self) -> float:
+        """``|H| / I_max`` [rad/s]."""
+        return float(np.linalg.norm(self.moments * self.omega0_body_rad_s) / np.max(self.moments))
+
+    @property
+    def moment_ratios(self) -> F64:
+        """(2,) the smaller moments over the largest, sorted."""
+        m = np.sort(self.moments)
+        return np.asarray(m[:2] / m[2])
+
+
+@dataclass(frozen=True)
+class TumblingFit:
+    """Result of :func:`fit_tumbling`: ``families`` (each a list of states, lowest chi-square
+    first; families ordered by their best), ``worst_kept_chi2`` (the largest chi-square kept),
+    ``solutions`` (every final fit) and ``t0_jd`` (the states' epoch [d])."""
+
+    families: list[list[TumblingState]]
+    worst_kept_chi2: float
+    solutions: list[TumblingState]
+    t0_jd: float
+
+
+def _moments(u: F64) -> F64:
+    m = np.array([np.exp(u[0]), np.exp(u[1]), 1.0])
+    inertia = np.sum(m) - m
+    return np.asarray(inertia / np.max(inertia))
+
+
+class _Problem:
+    def __init__(
+        self, data: InversionData, normals: F64, areas: F64, law: ScatteringLaw, t0_jd: float
+    ) -> None:
+        self.data, self.normals, self.areas, self.law = data, normals, areas, law
+        self.t_s = (data.time_jd - t0_jd) * SECONDS_PER_DAY
+        self.calibrated = bool(np.any(data.calibrated))
+
+    def state(self, x: F64) -> tuple[F64, F64, F64, float]:
+        q = Rotation.from_rotvec(x[:3]).as_quat(scalar_first=True)
+        scale = float(np.exp(x[8])) if self.calibrated else 1.0
+        return q, x[3:6], _moments(x[6:8]), scale
+
+    def residuals(self, x: F64) -> F64:
+        q0, w0, moments, scale = self.state(x)
+        q, _ = torque_free_attitude(self.t_s, moments, q0, w0)
+        qc = quat_conjugate(q)
+        s_b = quat_rotate(qc, self.data.sun_ecliptic)
+        o_b = quat_rotate(qc, self.data.observer_ecliptic)
+        lum = scale * facet_brightness(
+            s_b, o_b, self.normals, self.areas, self.law, self.data.cos_half_phase
+        )
+        return relative_residuals(self.data, lum)
+
+
+def fit_tumbling(
+    data: InversionData,
+    normals: F64,
+    areas: F64,
+    law: ScatteringLaw,
+    *,
+    min_period_h: float,
+    max_period_h: float,
+    n_starts: int = N_STARTS,
+    seed: int = 0,
+    initial_states: list[TumblingState] | None = None,
+    t0_jd: float | None = None,
+    rate_span: float = RATE_SPAN,
+) -> TumblingFit:
+    """Multi-start fit of the torque-free state and its families (module doc).
+
+    The state's epoch ``t0`` is the middle of the longest light curve (the seed). Stage 1:
+    ``n_starts`` random starts fitted to the seed curve alone (a few rotations: a smoother
+    misfit). Stage 2: the seed's solutions within its threshold (at most
+    :data:`N_SEEDS`, one per family) are carried to all curves; over a gap of ``T`` the
+    rotation phase drifts by ``T / P`` turns per unit of relative rate error, so each starts
+    at rate scales ``1 + j dc``, ``dc =`` :data:`PHASE_DRIFT` ``P / T``, ``|j dc| <=``
+    :data:`RATE_SPAN` (a torque-free motion with its rates scaled by ``c`` is the same
+    motion ``c`` times faster), and the lowest of all is kept as in stage 1.
+
+    ``rate_span``: the relative rate error covered in stage 2 (default :data:`RATE_SPAN`).
+    ``initial_states`` (at ``t0_jd``, default the seed curve's middle) are tried before the
+    random starts: a prior (e.g. the scenario's attitude) narrows a search that random
+    starts alone rarely win (docs/shape.md, "Limits").
+    """
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):  # small matrices (shape_run.py)
+        return _fit_tumbling(
+            data,
+            normals,
+            areas,
+            law,
+            min_period_h,
+            max_period_h,
+            n_starts,
+            seed,
+            initial_states,
+            t0_jd,
+            rate_span,
+        )
+
+
+def _fit_tumbling(
+    data: InversionData,
+    normals: F64,
+    areas: F64,
+    law: ScatteringLaw,
+    min_period_h: float,
+    max_period_h: float,
+    n_starts: int,
+    seed: int,
+    initial_states: list[TumblingState] | None,
+    t0_jd: float | None,
+    rate_span: float,
+) -> TumblingFit:
+    counts = np.bincount(data.curve)
+    seed_curve = int(np.argmax(counts))
+    in_seed = np.flatnonzero(data.curve == seed_curve)
+    if t0_jd is None:
+        t0_jd = float(np.mean(data.time_jd[in_seed][[0, -1]]))
+    rng = np.random.default_rng(seed)
+    seed_prob = _Problem(data.subset(in_seed), normals, areas, law, t0_jd)
+    x_starts = [_state_vector(s, 1.0) for s in initial_states or []]
+    x_starts += [_random_start(rng, min_period_h, max_period_h) for _ in range(n_starts)]
+    first = _fit_all(seed_prob, x_starts)
+    seeds = [fam[0] for fam in _families(_within(first, seed_prob))][:N_SEEDS]
+    prob = _Problem(data, normals, areas, law, t0_jd)
+    if data.n_curves == 1:
+        final = first
+    else:
+        gap_s = float(np.ptp(data.time_jd)) * SECONDS_PER_DAY
+        x_next = []
+        for sol in seeds:
+            period_s = 2 * np.pi / sol.rate_rad_s
+            dc = PHASE_DRIFT * period_s / gap_s
+            for j in np.arange(-np.floor(rate_span / dc), np.floor(rate_span / dc) + 1):
+                x_next.append(_state_vector(sol, 1.0 + j * dc))
+        final = _fit_all(prob, x_next)
+    kept = _within(final, prob)
+    return TumblingFit(_families(kept), kept[-1].chi2, final, t0_jd)
+
+
+def _random_start(rng: np.random.Generator, min_period_h: float, max_period_h: float) -> F64:
+    period_s = 3600.0 * np.exp(rng.uniform(np.log(min_period_h), np.log(max_period_h)))
+    return np.concatenate(
+        [
+            Rotation.random(rng=rng).as_rotvec(),
+            2 * np.pi / period_s * _unit(rng.normal(size=3)),
+            rng.uniform(-MOMENT_SPREAD, MOMENT_SPREAD, 2),
+            [0.0],
+        ]
+    )
+
+
+def _state_vector(s: TumblingState, rate_scale: float) -> F64:
+    m = 0.5 * np.sum(s.moments) - s.moments  # second moments of I = tr(M) 1 - M
+    u = np.log(np.clip(m[:2] / m[2], np.exp(-MOMENT_BOUND), np.exp(MOMENT_BOUND)))
+    return np.concatenate(
+        [
+            Rotation.from_quat(s.q0, scalar_first=True).as_rotvec(),
+            s.omega0_body_rad_s * rate_scale,
+            u,
+            [np.log(s.scale)],
+        ]
+    )
+
+
+def _fit_all(prob: _Problem, starts: list[F64]) -> list[TumblingState]:
+    n_par = 9 if prob.calibrated else 8
+    lower, upper = np.full(n_par, -np.inf), np.full(n_par, np.inf)
+    lower[6:8], upper[6:8] = -MOMENT_BOUND, MOMENT_BOUND
+    out = []
+    for x0 in starts:
+        x = x0[:n_par].copy()
+        x[6:8] = np.clip(x[6:8], -MOMENT_BOUND, MOMENT_BOUND)
+        res = least_squares(
+            prob.residuals,
+            x,
+            bounds=(lower, upper),
+            method="trf",
+            x_scale="jac",
+            max_nfev=MAX_EVALUATIONS,
+        )
+        q0, w0, moments, scale = prob.state(np.append(res.x, 0.0)[:9])
+        out.append(TumblingState(q0, w0, moments, float(2.0 * res.cost), scale))
+    out.sort(key=lambda s: s.chi2)
+    return out
+
+
+def _within(states: list[TumblingState], prob: _Problem) -> list[TumblingState]:
+    """The states within ``chi2_min + delta s^2`` (module doc)."""
+    n_par = 9 if prob.calibrated else 8
+    s2 = states[0].chi2 / max(prob.data.n_points - n_par, 1)
+    threshold = states[0].chi2 + float(stats.chi2.ppf(0.99, n_par)) * s2
+    return [s for s in states if s.chi2 <= threshold]
+
+
+def _unit(v: F64) -> F64:
+    return np.asarray(v / np.linalg.norm(v))
+
+
+def same_family(a: TumblingState, b: TumblingState) -> bool:
+    """True when two states agree in what a body symmetry leaves (module doc)."""
+    return bool(
+        angular_distance_deg(a.momentum_direction, b.momentum_direction) <= FAMILY_ANGLE_DEG
+        and abs(a.rate_rad_s / b.rate_rad_s - 1.0) <= FAMILY_RELATIVE
+        and np.all(np.abs(a.moment_ratios - b.moment_ratios) <= FAMILY_RELATIVE)
+    )
+
+
+def _families(states: list[TumblingState]) -> list[list[TumblingState]]:
+    families: list[list[TumblingState]] = []
+    for s in states:
+        for fam in families:
+            if same_family(fam[0], s):
+                fam.append(s)
+                break
+        else:
+            families.append([s])
+    return families
