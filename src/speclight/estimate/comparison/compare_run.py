@@ -21,18 +21,12 @@ import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
-from speclight import orbit, schema
-from speclight.constants import C_M_S
+from speclight import schema
 from speclight.errors import InputError
+from speclight.estimate.comparison.compare_geometry import RowGroup, join_geometries, row_groups
 from speclight.estimate.comparison.compare_stats import residual_statistics
 from speclight.estimate.inputs.measured_checks import no_usable_epochs
 from speclight.estimate.inputs.observations import FIELD, Observations
-from speclight.orbit.observed_position import (
-    observed_trajectory,
-    place_target_gcrs_m,
-    range_from_height_m,
-)
-from speclight.orbit.timescale import time_from_utc
 from speclight.scenario import LoadedScenario
 from speclight.scenario.overrides import with_overrides
 
@@ -85,40 +79,6 @@ def _bands(loaded: LoadedScenario, obs: Observations) -> list[dict[str, Any]]:
     return bands
 
 
-def _placed(loaded: LoadedScenario, obs: Observations) -> Any:
-    """The trajectory through the observed positions of every row (all sites)."""
-    if not obs.has_positions:
-        bad = ~(
-            np.isfinite(obs.elevation_deg) & (np.isfinite(obs.range_m) | np.isfinite(obs.height_m))
-        )
-        line = int(obs.line[np.flatnonzero(bad)[0]])
-        raise InputError(
-            f"line {line}: the scenario has orbit: {{observed: true}}, so every row must give "
-            "where the target was seen: elevation_deg, azimuth_deg and range_m (or height_m)",
-            source=obs.source,
-            field=FIELD,
-        )
-    n = obs.time_utc.size
-    r = np.full((n, 3), np.nan)
-    rng = obs.range_m.copy()
-    for (lat, lon, alt), idx in obs.site_groups():
-        site = orbit.Site(lat, lon, alt)
-        need = idx[~np.isfinite(rng[idx])]
-        if need.size:
-            rng[need] = range_from_height_m(
-                site, obs.azimuth_deg[need], obs.elevation_deg[need], obs.height_m[need]
-            )
-        t = time_from_utc(obs.time_utc[idx])
-        r[idx] = place_target_gcrs_m(
-            site, t, obs.azimuth_deg[idx], obs.elevation_deg[idx], rng[idx]
-        )
-    emitted = obs.time_utc.copy()
-    if loaded.scenario.observer.light_time:
-        delay_ns = np.rint(np.nan_to_num(rng) / C_M_S * 1e9).astype("timedelta64[ns]")
-        emitted = obs.time_utc - delay_ns
-    return observed_trajectory(emitted, r)
-
-
 def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -> CompareResult:
     """Simulate ``loaded`` at every epoch and site of ``obs`` and compare the magnitudes.
 
@@ -151,22 +111,22 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
     base = loaded
     if len(bands) > len(sc.instrument.bands):  # speclite filters added
         base = with_overrides(loaded, {"instrument.bands": bands})  # a missing section is made
-    trajectory = _placed(loaded, obs) if sc.orbit.observed else None
+    groups = row_groups(loaded, obs)
     notes: list[str] = []
-    if trajectory is None and np.any(np.isfinite(obs.elevation_deg)):
+    if not sc.orbit.observed and np.any(np.isfinite(obs.elevation_deg)):
         notes.append(
             "the rows' elevation/azimuth/range are not used: the scenario has an orbit "
             "(orbit: {observed: true} places the target there instead)"
         )
     n = obs.time_utc.size
     sim = np.full(n, np.nan)
-    flags = np.zeros(n, dtype=schema.FLAG_DTYPE)
+    flags = np.full(n, schema.FLAG_ORBIT_FAILED, dtype=schema.FLAG_DTYPE)  # until simulated
     geo: dict[str, F64] = {k: np.full(n, np.nan) for k in GEOMETRY}
     for name in ("sun_direction_body", "observer_direction_body"):
         geo[name] = np.full((n, 3), np.nan)
-    groups = obs.site_groups()
-    _check_sites(len(groups), obs)
-    for (lat, lon, alt), idx in groups:
+    sites = obs.site_groups()
+    _check_sites(len(sites), obs)
+    for (lat, lon, alt), site_rows in sites:
         site_scenario = with_overrides(
             base,
             {
@@ -175,22 +135,42 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
                 "observer.altitude_m": alt,
             },
         )
-        epochs = np.unique(obs.time_utc[idx])
-        if trajectory is not None:
-            g = scenario_geometry(site_scenario, epochs, trajectory=trajectory)
-            ds = simulate(site_scenario, progress, geometry=g).dataset
+        parts = _site_parts(obs, site_rows, groups)
+        if not parts:  # every row's object without a placed position
+            continue
+        if parts[0][2] is None:  # the scenario's orbit: one group
+            ds = simulate(site_scenario, progress, time_utc=parts[0][1]).dataset
         else:
-            ds = simulate(site_scenario, progress, time_utc=epochs).dataset
-        k = np.searchsorted(epochs, obs.time_utc[idx])
+            g = join_geometries(
+                [scenario_geometry(site_scenario, epochs, trajectory=tr) for _, epochs, tr in parts]
+            )
+            ds = simulate(site_scenario, progress, geometry=g).dataset
         band_index = {str(b): col for col, b in enumerate(ds["band"].values)}
-        cols = np.array([band_index[obs.band[i]] for i in idx], dtype=np.intp)
-        sim[idx] = ds["ab_magnitude"].values[k, cols]
-        flags[idx] = ds["flags"].values[k]
-        for name, var in GEOMETRY.items():
-            geo[name][idx] = ds[var].values[k]
+        offset = 0
+        for idx, epochs, _ in parts:
+            k = offset + np.searchsorted(epochs, obs.time_utc[idx])
+            offset += epochs.size
+            cols = np.array([band_index[obs.band[i]] for i in idx], dtype=np.intp)
+            sim[idx] = ds["ab_magnitude"].values[k, cols]
+            flags[idx] = ds["flags"].values[k]
+            for name, var in GEOMETRY.items():
+                geo[name][idx] = ds[var].values[k]
     if not np.any(np.isfinite(sim) & np.isfinite(obs.magnitude)):
         raise no_usable_epochs(n, loaded.source, obs.source, FIELD, "observed")
     return CompareResult(dataset=_dataset(loaded, obs, sim, flags, geo), notes=notes)
+
+
+def _site_parts(
+    obs: Observations, site_rows: NDArray[np.intp], groups: list[RowGroup]
+) -> list[tuple[NDArray[np.intp], NDArray[np.datetime64], Any]]:
+    """Per group with rows at this site: those rows (ascending), their distinct epochs
+    (sorted) and the group's trajectory (None: the scenario's orbit)."""
+    parts = []
+    for group in groups:
+        idx = np.intersect1d(site_rows, group.rows)
+        if idx.size:
+            parts.append((idx, np.unique(obs.time_utc[idx]), group.trajectory))
+    return parts
 
 
 def _check_sites(n_sites: int, obs: Observations) -> None:
