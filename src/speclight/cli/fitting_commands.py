@@ -127,7 +127,7 @@ def compare(
             ),
             data=lambda r: dataset_file(r.dataset), figure=_compare_figure,
         )  # fmt: skip
-        for line in [*result.notes, *summary_lines(result.dataset.attrs)]:
+        for line in [*result.notes, *summary_lines(result.dataset)]:
             typer.echo(line)
         say_wrote(output, plot_file)
 

@@ -59,9 +59,7 @@ def row_groups(loaded: LoadedScenario, obs: Observations) -> list[RowGroup]:
     return [RowGroup(la.rows, la.trajectory) for la in object_layers(emitted, r, index, margin_s)]
 
 
-def _placed(
-    loaded: LoadedScenario, obs: Observations
-) -> tuple[NDArray[np.datetime64], F64, F64]:
+def _placed(loaded: LoadedScenario, obs: Observations) -> tuple[NDArray[np.datetime64], F64, F64]:
     """Each row's emission epoch (UTC), GCRS position [m] (NaN: not placed) and light
     time [s] (0 with ``observer.light_time: false``)."""
     if not obs.has_positions:

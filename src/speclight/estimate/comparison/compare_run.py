@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from speclight import schema
 from speclight.errors import InputError
 from speclight.estimate.comparison.compare_geometry import RowGroup, join_geometries, row_groups
-from speclight.estimate.comparison.compare_stats import residual_statistics
+from speclight.estimate.comparison.compare_stats import per_object, residual_statistics
 from speclight.estimate.inputs.measured_checks import no_usable_epochs
 from speclight.estimate.inputs.observations import FIELD, Observations
 from speclight.scenario import LoadedScenario
@@ -34,6 +34,10 @@ F64 = NDArray[np.float64]
 #: Least time of one site's simulation [s]: the target's build and one render launch, a lower
 #: bound of the 5.7 s per site of 100 observations each measured in BENCHMARKS.md ("Compare").
 SECONDS_PER_SITE = 1.0
+#: Least time of one geometry pass of a group of objects (``orbit: {observed: true}`` with an
+#: ``object`` column) [s]: a lower bound of the 0.016-0.020 s measured per pass of 3 epochs
+#: on 2 shared cores (BENCHMARKS.md, "Compare").
+SECONDS_PER_GROUP = 0.01
 #: Per-observation geometry copied from the simulation: output name -> simulate variable.
 GEOMETRY = {
     "phase_angle": "phase_angle",
@@ -118,15 +122,24 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
             "the rows' elevation/azimuth/range are not used: the scenario has an orbit "
             "(orbit: {observed: true} places the target there instead)"
         )
+    n_objects = len(obs.object_index()[0])
+    if not sc.orbit.observed and obs.object_name is not None and n_objects > 1:
+        notes.append(
+            f"the scenario's orbit is used for all {n_objects} objects: the object column "
+            "only groups the statistics (orbit: {observed: true} gives each object the "
+            "trajectory of its own rows)"
+        )
     n = obs.time_utc.size
     sim = np.full(n, np.nan)
     flags = np.full(n, schema.FLAG_ORBIT_FAILED, dtype=schema.FLAG_DTYPE)  # until simulated
     geo: dict[str, F64] = {k: np.full(n, np.nan) for k in GEOMETRY}
     for name in ("sun_direction_body", "observer_direction_body"):
         geo[name] = np.full((n, 3), np.nan)
-    sites = obs.site_groups()
-    _check_sites(len(sites), obs)
-    for (lat, lon, alt), site_rows in sites:
+    sites = [(key, _site_parts(obs, rows, groups)) for key, rows in obs.site_groups()]
+    _check_sites(len(sites), sum(len(parts) for _, parts in sites), obs)
+    for (lat, lon, alt), parts in sites:
+        if not parts:  # every row's object without a placed position
+            continue
         site_scenario = with_overrides(
             base,
             {
@@ -135,9 +148,6 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
                 "observer.altitude_m": alt,
             },
         )
-        parts = _site_parts(obs, site_rows, groups)
-        if not parts:  # every row's object without a placed position
-            continue
         if parts[0][2] is None:  # the scenario's orbit: one group
             ds = simulate(site_scenario, progress, time_utc=parts[0][1]).dataset
         else:
@@ -173,18 +183,26 @@ def _site_parts(
     return parts
 
 
-def _check_sites(n_sites: int, obs: Observations) -> None:
-    """Refuse observations from so many sites that one simulation each cannot finish in a
-    day (:mod:`speclight.estimate.inputs.cost_limits`), at :data:`SECONDS_PER_SITE` each at
-    least."""
+def _check_sites(n_sites: int, n_passes: int, obs: Observations) -> None:
+    """Refuse observations from so many sites (or objects seen at once) that one simulation
+    each (and one geometry pass per group of objects at each site) cannot finish in a day
+    (:mod:`speclight.estimate.inputs.cost_limits`), at :data:`SECONDS_PER_SITE` and
+    :data:`SECONDS_PER_GROUP` each at least."""
     from speclight.estimate.inputs.cost_limits import check_cost
 
-    check_cost(
-        FIELD, f"{obs.source} ({obs.time_utc.size} rows)",
+    what = (
         f"one simulation for each of its {n_sites} sites (at least {SECONDS_PER_SITE:g} s "
-        "each: the target's build and a render launch)",
-        0.0, n_sites * SECONDS_PER_SITE,
-        "group the observations by site into fewer files, or round the sites' coordinates",
+        "each: the target's build and a render launch)"
+    )
+    if n_passes > n_sites:
+        what += (
+            f" and {n_passes} geometry passes, one per site and group of objects seen at "
+            f"overlapping times (at least {SECONDS_PER_GROUP:g} s each)"
+        )
+    check_cost(
+        FIELD, f"{obs.source} ({obs.time_utc.size} rows)", what,
+        0.0, n_sites * SECONDS_PER_SITE + n_passes * SECONDS_PER_GROUP,
+        "split the file, group the observations by site, or round the sites' coordinates",
     )  # fmt: skip
 
 
@@ -218,7 +236,9 @@ def _dataset(
         dims = ("obs", "xyz") if geo[name].ndim == 2 else ("obs",)
         ds[name] = (dims, geo[name], schema.attrs(name))
     ds["flags"] = ("obs", flags, {**schema.attrs("flags"), **_flag_attrs()})
-    ds.attrs.update(residual_statistics(residual, geo["phase_angle"], geo["elevation"]))
+    ds.attrs.update(residual_statistics(obs.magnitude, sim, geo["phase_angle"], geo["elevation"]))
+    if obs.object_name is not None:
+        ds = _add_objects(ds, obs, sim)
     ds.attrs.update(
         {
             "title": "speclight compare: simulated against observed magnitudes",
@@ -228,6 +248,32 @@ def _dataset(
             "n_sites": len(obs.site_groups()),
         }
     )
+    return ds
+
+
+#: Per-object variables of CMP.nc: name -> (key of compare_stats.per_object, units, long name).
+PER_OBJECT = {
+    "n_per_object": ("n", "", "number of finite residuals of the object"),
+    "residual_mean_per_object": ("mean", "mag", "mean residual of the object"),
+    "residual_rms_per_object": ("rms", "mag", "RMS residual of the object"),
+    "residual_median_abs_per_object": ("median_abs", "mag", "median |residual| of the object"),
+    "pearson_r_per_object": ("pearson_r", "1", "Pearson R of observed and simulated magnitudes"),
+    "chi_square_per_object": ("chi_square", "1", "sum((simulated - observed)^2 / observed) / n"),
+}
+
+
+def _add_objects(ds: xr.Dataset, obs: Observations, sim: F64) -> xr.Dataset:
+    """The ``object_id(obs)`` of each row and the statistics per object (dimension
+    ``object``, first-seen order)."""
+    names, index = obs.object_index()
+    stats = per_object(obs.magnitude, sim, index, len(names))
+    ds["object_id"] = ("obs", np.array(obs.object_name, dtype=object), {"long_name": "object"})
+    ds = ds.assign_coords(object=("object", np.array(names, dtype=object)))
+    for name, (key, unit, long_name) in PER_OBJECT.items():
+        data = stats[key].astype(np.int64) if key == "n" else stats[key]
+        attrs = {"units": unit, "long_name": long_name} if unit else {"long_name": long_name}
+        ds[name] = ("object", data, attrs)
+    ds.attrs["n_objects"] = len(names)
     return ds
 
 
