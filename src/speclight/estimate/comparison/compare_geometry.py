@@ -59,6 +59,23 @@ def row_groups(loaded: LoadedScenario, obs: Observations) -> list[RowGroup]:
     return [RowGroup(la.rows, la.trajectory) for la in object_layers(emitted, r, index, margin_s)]
 
 
+def single_epoch_objects(loaded: LoadedScenario, obs: Observations) -> list[str]:
+    """With ``orbit: {observed: true}``, the objects seen at one epoch only: their
+    trajectory is one position without a velocity, so an attitude that needs the velocity
+    (``nadir``, a pointing profile with a ``velocity`` or ``orbit_normal`` constraint) is
+    undefined there (flag ``attitude_undefined``)."""
+    if not loaded.scenario.orbit.observed or obs.object_name is None:
+        return []
+    names, index = obs.object_index()
+    order = np.argsort(index, kind="stable")
+    bounds = np.searchsorted(index[order], np.arange(len(names) + 1))
+    return [
+        name
+        for j, name in enumerate(names)
+        if np.unique(obs.time_utc[order[bounds[j] : bounds[j + 1]]]).size == 1
+    ]
+
+
 def _placed(loaded: LoadedScenario, obs: Observations) -> tuple[NDArray[np.datetime64], F64, F64]:
     """Each row's emission epoch (UTC), GCRS position [m] (NaN: not placed) and light
     time [s] (0 with ``observer.light_time: false``)."""

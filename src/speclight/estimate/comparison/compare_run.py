@@ -23,7 +23,12 @@ from numpy.typing import NDArray
 
 from speclight import schema
 from speclight.errors import InputError
-from speclight.estimate.comparison.compare_geometry import RowGroup, join_geometries, row_groups
+from speclight.estimate.comparison.compare_geometry import (
+    RowGroup,
+    join_geometries,
+    row_groups,
+    single_epoch_objects,
+)
 from speclight.estimate.comparison.compare_stats import per_object, residual_statistics
 from speclight.estimate.inputs.measured_checks import no_usable_epochs
 from speclight.estimate.inputs.observations import FIELD, Observations
@@ -129,6 +134,9 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
             "only groups the statistics (orbit: {observed: true} gives each object the "
             "trajectory of its own rows)"
         )
+    lonely = single_epoch_objects(loaded, obs)
+    if lonely:
+        notes.append(_lonely_note(lonely))
     n = obs.time_utc.size
     sim = np.full(n, np.nan)
     flags = np.full(n, schema.FLAG_ORBIT_FAILED, dtype=schema.FLAG_DTYPE)  # until simulated
@@ -166,8 +174,23 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
             for name, var in GEOMETRY.items():
                 geo[name][idx] = ds[var].values[k]
     if not np.any(np.isfinite(sim) & np.isfinite(obs.magnitude)):
-        raise no_usable_epochs(n, loaded.source, obs.source, FIELD, "observed")
+        err = no_usable_epochs(n, loaded.source, obs.source, FIELD, "observed")
+        if lonely:  # the likelier cause
+            raise InputError(
+                f"{err.message}; {_lonely_note(lonely)}", source=obs.source, field=FIELD
+            ) from None
+        raise err
     return CompareResult(dataset=_dataset(loaded, obs, sim, flags, geo), notes=notes)
+
+
+def _lonely_note(names: list[str]) -> str:
+    shown = ", ".join(f"'{o}'" for o in names[:5]) + (", ..." if len(names) > 5 else "")
+    return (
+        f"{len(names)} object(s) seen at one epoch only ({shown}): one position gives no "
+        "velocity, so an attitude that needs it (nadir; a velocity or orbit_normal "
+        "constraint) is undefined there (flag attitude_undefined, left out of the "
+        "statistics); give each object at least two rows at most 30 s apart"
+    )
 
 
 def _site_parts(
@@ -251,28 +274,34 @@ def _dataset(
     return ds
 
 
-#: Per-object variables of CMP.nc: name -> (key of compare_stats.per_object, units, long name).
+#: Per-object variables of CMP.nc (described in :data:`speclight.schema.COMPARE_VARIABLES`)
+#: -> key of :func:`~speclight.estimate.comparison.compare_stats.per_object`.
 PER_OBJECT = {
-    "n_per_object": ("n", "", "number of finite residuals of the object"),
-    "residual_mean_per_object": ("mean", "mag", "mean residual of the object"),
-    "residual_rms_per_object": ("rms", "mag", "RMS residual of the object"),
-    "residual_median_abs_per_object": ("median_abs", "mag", "median |residual| of the object"),
-    "pearson_r_per_object": ("pearson_r", "1", "Pearson R of observed and simulated magnitudes"),
-    "chi_square_per_object": ("chi_square", "1", "sum((simulated - observed)^2 / observed) / n"),
+    "n_per_object": "n",
+    "residual_mean_per_object": "mean",
+    "residual_rms_per_object": "rms",
+    "residual_median_abs_per_object": "median_abs",
+    "pearson_r_per_object": "pearson_r",
+    "chi_square_per_object": "chi_square",
 }
 
 
 def _add_objects(ds: xr.Dataset, obs: Observations, sim: F64) -> xr.Dataset:
     """The ``object_id(obs)`` of each row and the statistics per object (dimension
     ``object``, first-seen order)."""
+    table = schema.COMPARE_VARIABLES
     names, index = obs.object_index()
     stats = per_object(obs.magnitude, sim, index, len(names))
-    ds["object_id"] = ("obs", np.array(obs.object_name, dtype=object), {"long_name": "object"})
+    ds["object_id"] = (
+        "obs",
+        np.array(obs.object_name, dtype=object),
+        schema.attrs("object_id", table),
+    )
     ds = ds.assign_coords(object=("object", np.array(names, dtype=object)))
-    for name, (key, unit, long_name) in PER_OBJECT.items():
+    ds["object"].attrs.update(schema.COMPARE_COORDINATES["object"])
+    for name, key in PER_OBJECT.items():
         data = stats[key].astype(np.int64) if key == "n" else stats[key]
-        attrs = {"units": unit, "long_name": long_name} if unit else {"long_name": long_name}
-        ds[name] = ("object", data, attrs)
+        ds[name] = (table[name].dims, data, schema.attrs(name, table))
     ds.attrs["n_objects"] = len(names)
     return ds
 
