@@ -391,8 +391,8 @@ COMPARE_VARIABLES: dict[str, VariableInfo] = {
         OBJECT,
         "1",
         "chi-square per pair: sum((simulated - observed)^2 / observed) / n",
-        comment="over the magnitudes themselves (SPEC 5.1); NaN where an observed magnitude "
-        "is <= 0",
+        comment="over the magnitudes themselves, as docs/compare.md defines it; NaN where "
+        "an observed magnitude is <= 0",
     ),
 }
 #: Coordinates of CMP.nc that an ``object`` column adds.
