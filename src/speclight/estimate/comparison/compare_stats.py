@@ -177,7 +177,9 @@ def _object_lines(ds: Any) -> list[str]:
     rms = ds["residual_rms_per_object"].values
     if len(names) <= LISTED_OBJECTS:
         return [
-            f"object {name}: n {int(n[j])}, mean "
+            f"object {name}: no residual (not observable at any of its rows)"
+            if n[j] == 0
+            else f"object {name}: n {int(n[j])}, mean "
             f"{ds['residual_mean_per_object'].values[j]:+.3f} mag, RMS {rms[j]:.3f} mag; "
             + _r_and_chi(
                 ds["pearson_r_per_object"].values[j], ds["chi_square_per_object"].values[j]
@@ -189,11 +191,12 @@ def _object_lines(ds: Any) -> list[str]:
         return [f"{len(names)} objects, none with a residual"]
     lo, mid, hi = np.percentile(rms[has], [10, 50, 90])
     r = ds["pearson_r_per_object"].values
+    r_median = f"{np.nanmedian(r):.3f}" if np.isfinite(r).any() else "n/a"
     worst = np.argsort(np.where(has, -rms, np.inf), kind="stable")[:WORST_OBJECTS]
     return [
         f"{len(names)} objects, {int(has.sum())} with residuals: RMS per object median "
         f"{mid:.3f} mag (10-90 %: {lo:.3f}-{hi:.3f}); Pearson R per object median "
-        f"{np.nanmedian(r) if np.isfinite(r).any() else np.nan:.3f} "
+        f"{r_median} "
         f"({int(np.isfinite(r).sum())} objects with >= 2 pairs)",
         "largest RMS: "
         + ", ".join(f"{names[j]} {rms[j]:.3f} mag (n {int(n[j])})" for j in worst if has[j]),
