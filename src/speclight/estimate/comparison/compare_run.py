@@ -40,9 +40,9 @@ F64 = NDArray[np.float64]
 #: bound of the 5.7 s per site of 100 observations each measured in BENCHMARKS.md ("Compare").
 SECONDS_PER_SITE = 1.0
 #: Least time of one geometry pass of a group of objects (``orbit: {observed: true}`` with an
-#: ``object`` column) [s]: a lower bound of the 0.016-0.020 s measured per pass of 3 epochs
-#: on 2 shared cores (BENCHMARKS.md, "Compare").
-SECONDS_PER_GROUP = 0.01
+#: ``object`` column) [s]: a lower bound of the 0.0034-0.037 s measured per pass of 3 epochs
+#: on 2 shared cores (``bench/bench_compare_objects.py``, BENCHMARKS.md, "Compare").
+SECONDS_PER_GROUP = 0.003
 #: Per-observation geometry copied from the simulation: output name -> simulate variable.
 GEOMETRY = {
     "phase_angle": "phase_angle",
