@@ -75,12 +75,15 @@ class EndmemberResult:
     volumes
         ``nfindr`` only: the simplex volume in the principal-component space at the ATGP start
         and after each replacement [(m2 sr-1)**(K-1)], non-decreasing; None otherwise.
+    notes
+        What the extraction found doubtful (e.g. fewer pure epochs than endmembers).
     """
 
     signatures: F64
     indices: NDArray[np.intp] | None
     method: str
     volumes: F64 | None = None
+    notes: tuple[str, ...] = ()
 
 
 def _checked_k(k: object, n_samples: int, n_bands: int, method: str) -> int:
