@@ -86,7 +86,11 @@ def unmix(
     ] = None,
     extract: Annotated[
         str | None,
-        typer.Option("--extract", help="Extract endmembers from the data: atgp, pca or nfindr."),
+        typer.Option(
+            "--extract",
+            help="Extract endmembers from the data: purest (the purest epochs above the "
+            "noise; recommended), atgp, pca or nfindr.",
+        ),
     ] = None,
     n: Annotated[int | None, typer.Option("--n", help="Number of endmembers to extract.")] = None,
     method: Annotated[str, method_option("ls, nnls, nnls-norm (default) or fcls.")] = "nnls-norm",

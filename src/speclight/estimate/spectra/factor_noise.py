@@ -44,7 +44,7 @@ def model_rate_sigma_per_s(
     sc = loaded.scenario
     t = float(sc.instrument.exposure_s)
     noise = sc.instrument.noise
-    sky = dark = read = 0.0
+    dark = read = 0.0
     background: F64 | float = 0.0
     if noise is not None and noise.enabled:
         tel = sc.telescope

@@ -99,7 +99,7 @@ def check_unmix_options(
     if bool(endmembers) == (extract is not None):
         raise InputError(
             "give endmembers=[E1.csv, E2.csv, ...] (or endmembers=['scenario']) or "
-            "extract=atgp|pca|nfindr with n=K, one of them",
+            "extract=purest|atgp|pca|nfindr with n=K, one of them",
             field="endmembers",
         )
     if extract is not None:
@@ -183,7 +183,8 @@ def unmix_measured(
                 f"n = {n} endmembers is more than the {n_bands} bands; ask for `n` <= {n_bands}",
                 field="n",
             )
-        found = extract_endmembers(data.factor, n, extract)  # type: ignore[arg-type]
+        sigma = factor_sigma(data.factor, data.rates, loaded or _carried(measured), data.bands)
+        found = extract_endmembers(data.factor, n, extract, sigma)  # type: ignore[arg-type]
         names = [f"{extract}-{k + 1}" for k in range(n)]
         members = Endmembers(names, np.full((n, 0), np.nan), found.signatures)
         origin = f"extracted by {extract} from the reflectance factors"
@@ -208,7 +209,8 @@ def unmix_measured(
     ds = _dataset(data, members, result.abundance, result.residual, method, extract, origin)
     if extract is not None:
         ds.attrs["extraction"] = "; ".join(found.notes) if found.notes else "ok"
-    sigma = factor_sigma(data.factor, data.rates, loaded or _carried(measured), data.bands)
+    if extract is None:
+        sigma = factor_sigma(data.factor, data.rates, loaded or _carried(measured), data.bands)
     ds = with_checks(ds, data.factor, result.abundance, sig, sigma, method)
     if data.material_contribution is not None and data.material_names is not None:
         ds = compare_with_truth(ds, data, members, result.abundance, by_name=extract is None)
