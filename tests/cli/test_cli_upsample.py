@@ -81,7 +81,11 @@ def test_spectrum_reproduces_the_albedos(tmp_path: Path, scenario: Path) -> None
     np.testing.assert_allclose(got, list(albedo.values()), atol=ALBEDO_TOLERANCE)
     assert np.all((table[:, 1] >= 0) & (table[:, 1] <= 1))
     assert any("fit: converged" in c for c in comments)
-    assert "notice" not in result.stdout
+    # issue 25 item 6: six albedos fix six numbers, the rest is said to be a smooth fill
+    assert "did not converge" not in result.stdout
+    assert "not a measurement" in result.stdout
+    assert any(c.startswith("# underdetermined: 6 band albedos") for c in comments)
+    assert any(c.startswith("# measured range:") for c in comments)
 
 
 def test_grey_albedos_give_a_flat_spectrum(tmp_path: Path, scenario: Path) -> None:

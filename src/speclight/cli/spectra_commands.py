@@ -65,6 +65,12 @@ def upsample(
             ),
             data=lambda r: spectrum_csv(r, str(scenario), str(fit)).encode(), figure=draw,
         )  # fmt: skip
+        n_bands = len(result.spectrum.albedo)
+        typer.echo(
+            f"notice: {n_bands} band albedos fix {n_bands} numbers of the spectrum: between "
+            "and outside the bands it is the smoothest fit, not a measurement (the CSV header "
+            "gives the measured range)"
+        )
         if not result.spectrum.converged:
             typer.echo(
                 "notice: the fit did not converge: the spectrum reproduces the albedos only to "
@@ -86,7 +92,11 @@ def unmix(
     ] = None,
     extract: Annotated[
         str | None,
-        typer.Option("--extract", help="Extract endmembers from the data: atgp, pca or nfindr."),
+        typer.Option(
+            "--extract",
+            help="Extract endmembers from the data: purest (the purest epochs above the "
+            "noise; recommended), atgp, pca or nfindr.",
+        ),
     ] = None,
     n: Annotated[int | None, typer.Option("--n", help="Number of endmembers to extract.")] = None,
     method: Annotated[str, method_option("ls, nnls, nnls-norm (default) or fcls.")] = "nnls-norm",

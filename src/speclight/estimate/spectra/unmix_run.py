@@ -25,6 +25,7 @@ estimated_class)``, ``confusion_count`` and the attribute ``mean_absolute_share_
 
 from __future__ import annotations
 
+import warnings
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -46,6 +47,13 @@ from speclight.estimate.spectra.endmember_spectra import (
     endmembers_from_scenario,
 )
 from speclight.estimate.spectra.endmembers import ENDMEMBER_METHODS, extract_endmembers
+from speclight.estimate.spectra.factor_noise import factor_sigma
+from speclight.estimate.spectra.unmix_checks import (
+    CONDITION_WARNING,
+    MISFIT_P_VALUE,
+    condition_number,
+    unmix_checks,
+)
 from speclight.estimate.spectra.unmix_truth import compare_with_truth
 from speclight.estimate.spectra.unmixing import UNMIX_METHODS
 from speclight.estimate.spectra.unmixing_epochs import unmix_per_epoch
@@ -91,7 +99,7 @@ def check_unmix_options(
     if bool(endmembers) == (extract is not None):
         raise InputError(
             "give endmembers=[E1.csv, E2.csv, ...] (or endmembers=['scenario']) or "
-            "extract=atgp|pca|nfindr with n=K, one of them",
+            "extract=purest|atgp|pca|nfindr with n=K, one of them",
             field="endmembers",
         )
     if extract is not None:
@@ -175,7 +183,8 @@ def unmix_measured(
                 f"n = {n} endmembers is more than the {n_bands} bands; ask for `n` <= {n_bands}",
                 field="n",
             )
-        found = extract_endmembers(data.factor, n, extract)  # type: ignore[arg-type]
+        sigma = factor_sigma(data.factor, data.rates, loaded or _carried(measured), data.bands)
+        found = extract_endmembers(data.factor, n, extract, sigma)  # type: ignore[arg-type]
         names = [f"{extract}-{k + 1}" for k in range(n)]
         members = Endmembers(names, np.full((n, 0), np.nan), found.signatures)
         origin = f"extracted by {extract} from the reflectance factors"
@@ -198,8 +207,73 @@ def unmix_measured(
     sig = members.signatures if members.signatures_epoch is None else members.signatures_epoch
     result = unmix_per_epoch(data.factor, sig, method)  # type: ignore[arg-type]
     ds = _dataset(data, members, result.abundance, result.residual, method, extract, origin)
+    if extract is not None:
+        ds.attrs["extraction"] = "; ".join(found.notes) if found.notes else "ok"
+    if extract is None:
+        sigma = factor_sigma(data.factor, data.rates, loaded or _carried(measured), data.bands)
+    ds = with_checks(ds, data.factor, result.abundance, sig, sigma, method)
     if data.material_contribution is not None and data.material_names is not None:
         ds = compare_with_truth(ds, data, members, result.abundance, by_name=extract is None)
+    return ds
+
+
+def _carried(measured: str | Path) -> LoadedScenario | None:
+    """The scenario a NetCDF carries (its noise model), or None."""
+    if Path(measured).suffix.lower() not in (".nc", ".nc4", ".netcdf", ".h5"):
+        return None
+    head = read_user_dataset(measured, "MEASURED", what="measurements", variables=())
+    return dataset_scenario(head, str(measured)) if "scenario_yaml" in head.attrs else None
+
+
+def with_checks(
+    ds: xr.Dataset,
+    x: np.ndarray,
+    abundance: np.ndarray,
+    signatures: np.ndarray,
+    sigma: np.ndarray | None,
+    method: str,
+) -> xr.Dataset:
+    """``ds`` with ``abundance_std``, ``chi2``, ``misfit`` (:mod:`.unmix_checks`) where the
+    noise is known, the attribute ``notes`` and a warning per note."""
+    notes: list[str] = []
+    if sigma is None:
+        notes.append(
+            "the noise of the factors is unknown (no sigma in the data, no scenario): no "
+            "uncertainties and no test of the residuals against the noise"
+        )
+        cond = condition_number(np.asarray(ds["endmember_signature"].values))
+        ds.attrs["condition_number"] = cond
+    else:
+        checks = unmix_checks(x, abundance, signatures, sigma, method)
+        ds["abundance_std"] = (
+            ("time", "endmember"),
+            checks.abundance_std,
+            {
+                "units": ds["abundance"].attrs["units"],
+                "long_name": "standard deviation of abundance (noise propagated, support fixed)",
+            },
+        )
+        ds["chi2"] = (
+            "time",
+            checks.chi2,
+            {"units": "1", "long_name": "chi-square of the misfit against the noise"},
+        )
+        ds["chi2_dof"] = ("time", checks.dof, {"units": "1", "long_name": "its degrees of freedom"})
+        ds["misfit"] = (
+            "time",
+            checks.misfit.astype(np.int8),
+            {"units": "1", "long_name": f"1 where P(chi2) < {MISFIT_P_VALUE:g}"},
+        )
+        ds.attrs["condition_number"] = checks.condition_number
+        notes += checks.notes()
+    if ds.attrs["condition_number"] > CONDITION_WARNING and sigma is None:
+        notes.append(
+            f"the endmember signatures are nearly dependent (condition number "
+            f"{ds.attrs['condition_number']:.3g})"
+        )
+    for note in notes:
+        warnings.warn(note, stacklevel=2)
+    ds.attrs["notes"] = "; ".join(notes) if notes else "ok"
     return ds
 
 

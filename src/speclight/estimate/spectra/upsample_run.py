@@ -167,10 +167,29 @@ def upsample_scenario(
     return ScenarioSpectrum(upsample(rho, bands.response, bands.wavelength_nm), bands)
 
 
+#: Wavelengths where the bands' summed photon weight is below this fraction of its peak
+#: are extrapolated (no band sees them).
+MEASURED_WEIGHT_FRACTION = 0.01
+
+
+def measured_range_nm(result: ScenarioSpectrum) -> tuple[float, float]:
+    """First and last wavelength [nm] where the bands' summed photon weight (each band's
+    normalised to one) reaches ``MEASURED_WEIGHT_FRACTION`` of its peak."""
+    wl = result.bands.wavelength_nm
+    total = photon_weights(result.bands.response, wl).sum(axis=0)
+    seen = np.flatnonzero(total >= MEASURED_WEIGHT_FRACTION * total.max())
+    return float(wl[seen[0]]), float(wl[seen[-1]])
+
+
 def spectrum_csv(result: ScenarioSpectrum, scenario_source: str, fit_source: str) -> str:
     """The CSV ``wavelength_nm,reflectance`` with ``#`` lines saying what it is."""
     s = result.spectrum
-    state = "converged" if s.converged else "NOT converged (the spectrum is the best found)"
+    state = (
+        "converged (the band albedos are reproduced)"
+        if s.converged
+        else "NOT converged (the spectrum is the best found)"
+    )
+    low, high = measured_range_nm(result)
     albedos = ", ".join(
         f"{n}={a:.6g}" for n, a in zip(result.bands.band_names, s.albedo, strict=True)
     )
@@ -181,6 +200,12 @@ def spectrum_csv(result: ScenarioSpectrum, scenario_source: str, fit_source: str
         f"# scenario: {scenario_source}",
         f"# albedos: {fit_source}: {albedos}",
         f"# fit: {state}; largest band error |fit - albedo| = {s.max_band_error:.3g}",
+        f"# underdetermined: {len(s.albedo)} band albedos fix {len(s.albedo)} numbers of the "
+        "spectrum; between them it is the smoothest sigmoid polynomial through them, not a "
+        "measurement (its shape error is not bounded by the albedos' errors)",
+        f"# measured range: {low:.6g}-{high:.6g} nm (where the bands' summed photon weight "
+        f"reaches {100 * MEASURED_WEIGHT_FRACTION:g} % of its peak); the spectrum outside it is "
+        "extrapolated",
         "wavelength_nm,reflectance",
     ]
     lines += [f"{w:.6g},{r:.9f}" for w, r in zip(s.wavelength_nm, s.reflectance, strict=True)]
