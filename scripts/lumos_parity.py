@@ -116,6 +116,10 @@ MIN_ELEVATION_DEG = 15.0
 #: the two plates is then lumos-sat's sum, with no shadowing to model.
 ARRAY_WIDTH_M = 8.1
 PLATE_GAP_M = 0.05
+#: The narrow band (a Gaussian, centre/sigma [nm]) and the grid of the parity runs.
+BAND = "G-532/3"
+BAND_CENTRE_NM, BAND_SIGMA_NM = 532.0, 3.0
+SPECTRUM = {"min_nm": 510.0, "max_nm": 555.0, "step_nm": 1.0}
 
 
 def _load_script(name: str) -> Any:
@@ -171,17 +175,16 @@ def plates_obj(path: Path) -> Path:
     return path
 
 
-def plates_scenario(
-    site: Site, index: int, mesh_path: Path, resolution_px: int
-) -> dict[str, Any]:
+def plates_scenario(site: Site, index: int, mesh_path: Path, resolution_px: int) -> dict[str, Any]:
     """speclight's scenario of lumos-sat's model on pass ``index`` of ``site``.
 
     The frame is lumos-sat's: ``nadir`` with ``geocentric`` nadir (lumos-sat's Earth is a
     sphere: its z axis is the satellite's radius vector) and yaw steering (the Sun in the
     body x-z plane on +x: lumos-sat's y axis, the Sun's azimuth, is body +x; its x axis is
     body y, its z axis body -z). The materials are lumos-sat's binomial fits; no atmosphere;
-    a narrow band at 532 nm (the reflectance factor, the quantity compared, is the same in
-    every band for these grey materials).
+    a narrow band at lumos-sat's 532 nm, :data:`BAND` on a 1 nm grid (the reflectance
+    factor is the same in every band for these grey materials; the band's AB magnitude
+    differs from lumos-sat's by the two Suns, :func:`sun_bridge_mag`).
     """
     return {
         "name": "lumos-parity",
@@ -198,9 +201,9 @@ def plates_scenario(
         },
         "illumination": {"sun": True},
         "atmosphere": {"model": "none"},
-        "spectrum": {"min_nm": 525.0, "max_nm": 540.0, "step_nm": 5.0},
+        "spectrum": dict(SPECTRUM),
         "render": {"mode": "single", "resolution_px": resolution_px},
-        "instrument": {"bands": [{"name": "G-532/3"}]},
+        "instrument": {"bands": [{"name": BAND}]},
     }
 
 
@@ -220,7 +223,9 @@ def lumos_surfaces(chassis: Any = None, array: Any = None) -> list[Any]:
         return BINOMIAL(np.array(c["b"]), np.array(c["c"]), c["d"], c["l1"])
 
     return [
-        Surface(CHASSIS_AREA_M2, np.array(CHASSIS_NORMAL_LUMOS), chassis or binomial(CHASSIS_BINOMIAL)),
+        Surface(
+            CHASSIS_AREA_M2, np.array(CHASSIS_NORMAL_LUMOS), chassis or binomial(CHASSIS_BINOMIAL)
+        ),
         Surface(ARRAY_AREA_M2, np.array(ARRAY_NORMAL_LUMOS), array or binomial(ARRAY_BINOMIAL)),
     ]
 
@@ -252,9 +257,7 @@ def astropy_positions_m(
     return sat, obs, sun
 
 
-def lumos_frame(
-    sat_m: F64, obs_m: F64, sun_m: F64
-) -> tuple[F64, F64, F64]:
+def lumos_frame(sat_m: F64, obs_m: F64, sun_m: F64) -> tuple[F64, F64, F64]:
     """The geometry in lumos-sat's satellite-centred frame, exactly.
 
     lumos-sat's frame (``lumos.calculator``): origin the Earth's centre, z through the
@@ -317,6 +320,37 @@ def lumos_convention_magnitude(reflectance_factor_m2_sr: ArrayLike, range_m: Arr
     lumos-sat's Sun, ``1360 F / d^2`` [W m-2], through lumos-sat's zero point."""
     rf = np.asarray(reflectance_factor_m2_sr, dtype=np.float64)
     return lumos_magnitude(LUMOS_SUN_W_M2 * rf / np.asarray(range_m, dtype=np.float64) ** 2)
+
+
+def sun_bridge_mag(time_utc: NDArray[np.datetime64]) -> F64:
+    """speclight's AB magnitude in :data:`BAND` minus the lumos-convention magnitude of the
+    same grey target [mag]: the two Suns.
+
+    speclight's band flux of a target of reflectance factor ``F`` is ``F / d^2`` times the
+    E490 spectrum at the Sun's distance ``r`` through the band; its AB magnitude (photon
+    weighted) is ``-2.5 log10(F / d^2 int E R lambda dlambda / (c 3631 Jy int R / lambda
+    dlambda))``; lumos-sat's is ``-2.5 log10(F / d^2 1360 W m-2 lambda_0 / (c 3631 Jy))``.
+    The difference is ``-2.5 log10(<E>_band (1 AU / r)^2 / (1360 W m-2 / 532 nm))`` with
+    ``<E>_band = int E R lambda / int R / lambda``. Computed here from the shipped table
+    (ASTM E490-00a, ``src/speclight/data/solar``) read with numpy, the band's Gaussian on a
+    0.01 nm grid and astropy's Sun distance: not from speclight's code.
+    """
+    import astropy.units as u
+    from astropy.coordinates import get_sun
+    from astropy.time import Time
+
+    path = ROOT / "src/speclight/data/solar/astm_e490_00a_am0.csv"
+    wavelength_nm, irradiance = np.loadtxt(path, delimiter=",", comments="#", skiprows=3).T
+    lo = SPECTRUM["min_nm"] - SPECTRUM["step_nm"] / 2
+    hi = SPECTRUM["max_nm"] + SPECTRUM["step_nm"] / 2
+    lam = np.arange(lo, hi, 0.01)
+    e = np.interp(lam, wavelength_nm, irradiance)  # [W m-2 nm-1] at 1 AU
+    r = np.exp(-0.5 * ((lam - BAND_CENTRE_NM) / BAND_SIGMA_NM) ** 2)
+    band_mean = np.trapezoid(e * r * lam, lam) / np.trapezoid(r / lam, lam)  # [W m-2 nm]
+    t = Time([str(x) for x in time_utc.astype("datetime64[ns]")], scale="utc")
+    r_au = get_sun(t).distance.to(u.au).value
+    lumos = LUMOS_SUN_W_M2 * LUMOS_WAVELENGTH_M * 1e9  # [W m-2 nm]
+    return -2.5 * np.log10(band_mean / r_au**2 / lumos)
 
 
 def array_width_px(observer_body: F64, radius_m: float, resolution_px: int) -> F64:

@@ -44,16 +44,20 @@ def _parity() -> Any:
 lp = _parity()
 Variant = Callable[[Any, int, Path, int], dict[str, Any]]
 BANDS = [{"name": "V", "filter": "bessell-V"}, {"name": "G-532/3"}]
+#: The examples' Earthshine: a grey Lambertian Earth of albedo 0.3, 32 cells.
+EARTHSHINE = {"albedo": 0.3, "samples": 32}
 SPECTRUM = {"min_nm": 400.0, "max_nm": 760.0, "step_nm": 5.0}
 
 
-def _plates(materials: dict[str, Any] | None = None) -> Variant:
+def _plates(materials: dict[str, Any] | None = None, earthshine: bool = False) -> Variant:
     def make(site: Any, index: int, mesh: Path, res: int) -> dict[str, Any]:
         d = lp.plates_scenario(site, index, mesh, res)
         d["instrument"]["bands"] = BANDS
         d["spectrum"] = SPECTRUM
         if materials is not None:
             d["target"]["materials"] = materials
+        if earthshine:
+            _earthshine(d)
         return d
 
     return make
@@ -103,13 +107,25 @@ def _materials(kind: str) -> dict[str, Any]:
 def _builtin_materials(kind: str) -> Callable[[dict[str, Any]], None]:
     def change(d: dict[str, Any]) -> None:
         m = _materials(kind)
-        d["target"]["materials"] = {"bus_nadir": m["chassis"], "bus": m["chassis"], "array": m["array"]}
+        d["target"]["materials"] = {
+            "bus_nadir": m["chassis"],
+            "bus": m["chassis"],
+            "array": m["array"],
+        }
 
     return change
 
 
 def _no_earthshine(d: dict[str, Any]) -> None:
     d["illumination"].pop("earthshine", None)
+
+
+def _earthshine(d: dict[str, Any]) -> None:
+    d["illumination"]["earthshine"] = dict(EARTHSHINE)
+
+
+def _black_sides(d: dict[str, Any]) -> None:
+    d["target"]["materials"]["bus"] = {"bsdf": "lambertian", "reflectance": 0.0}
 
 
 def _previous(d: dict[str, Any]) -> None:
@@ -139,8 +155,15 @@ def _previous(d: dict[str, Any]) -> None:
 
 VARIANTS: dict[str, Variant] = {
     "plates, binomial fits (lumos-sat's model)": _plates(),
+    "plates, binomial fits, Earthshine (against lumos-sat with Earthshine)": _plates(
+        earthshine=True
+    ),
     "plates, tables + microfacet extension": _plates(_materials("tables microfacet")),
     "plates, tables + binomial extension": _plates(_materials("tables binomial")),
+    "body, binomial fits, bus sides black, no Earthshine": _example(
+        "starlink-v1.5",
+        lambda d: (_builtin_materials("binomial fits")(d), _black_sides(d), _no_earthshine(d)),
+    ),
     "body, binomial fits, no Earthshine": _example(
         "starlink-v1.5",
         lambda d: (_builtin_materials("binomial fits")(d), _no_earthshine(d)),
@@ -166,11 +189,14 @@ def run(only: str | None, resolution_px: int) -> None:
     import speclight
     from speclight.simulate.pipeline import simulate
 
+    from lumos.brdf.library import LAMBERTIAN
+
     surfaces = lp.lumos_surfaces()
     with tempfile.TemporaryDirectory() as tmp:
         mesh = lp.plates_obj(Path(tmp) / "plates.obj")
         epochs: dict[tuple[str, int], Any] = {}
         lumos: dict[tuple[str, int], np.ndarray] = {}
+        lumos_earthshine: dict[tuple[str, int], np.ndarray] = {}
         for site, index in lp.passes():
             loaded = speclight.load(lp.plates_scenario(site, index, mesh, resolution_px))
             times = lp.grid_epochs(loaded)
@@ -178,7 +204,15 @@ def run(only: str | None, resolution_px: int) -> None:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)
                 flux = lp.lumos_flux_W_m2(surfaces, lp.pass_tle(site, index), site, times)
+                earth = lp.lumos_flux_W_m2(
+                    surfaces,
+                    lp.pass_tle(site, index),
+                    site,
+                    times,
+                    LAMBERTIAN(EARTHSHINE["albedo"]),
+                )
             lumos[site.name, index] = lp.lumos_magnitude(flux)
+            lumos_earthshine[site.name, index] = lp.lumos_magnitude(earth)
         print(f"grid: {sum(t.size for t in epochs.values())} epochs")
         for name, make in VARIANTS.items():
             if only and only not in name:
@@ -189,11 +223,15 @@ def run(only: str | None, resolution_px: int) -> None:
                 times = epochs[site.name, index]
                 if times.size == 0:
                     continue
-                ds = simulate(speclight.load(make(site, index, mesh, resolution_px)), time_utc=times).dataset
+                ds = simulate(
+                    speclight.load(make(site, index, mesh, resolution_px)), time_utc=times
+                ).dataset
                 rf = ds["reflectance_factor"].sel(band="G-532/3").values
                 m_conv = lp.lumos_convention_magnitude(rf, ds["range"].values)
                 m_v = ds["ab_magnitude"].sel(band="V").values
-                ref = lumos[site.name, index]
+                ref = (lumos_earthshine if "Earthshine (against" in name else lumos)[
+                    site.name, index
+                ]
                 with np.errstate(invalid="ignore"):
                     conv.append(m_conv - ref)
                     band_v.append(m_v - ref)

@@ -35,7 +35,9 @@ PARTS = {
     "boom": "boom",
     "chassis offset": "chassis_offset",
 }
-_ROW = re.compile(r"^(?P<name>\S.*?)\s{2,}(?P<area>\d+\.\d+)\s+\((?P<normal>[^)]*)\)\s+(?P<brdf>.+)$")
+_ROW = re.compile(
+    r"^(?P<name>\S.*?)\s{2,}(?P<area>\d+\.\d+)\s+\((?P<normal>[^)]*)\)\s+(?P<brdf>.+)$"
+)
 #: Float64 rounding of the mesh's triangle areas and normals (vertices from the areas).
 ROUNDING = 1e-9
 
