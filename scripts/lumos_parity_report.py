@@ -171,6 +171,9 @@ VARIANTS: dict[str, Variant] = {
     "body, example materials, no Earthshine": _example("starlink-v1.5", _no_earthshine),
     "body, example (Earthshine)": _example("starlink-v1.5"),
     "previous example (before issue 24)": _example("starlink-v1.5", _previous),
+    "previous example's body and attitude, binomial fits": _example(
+        "starlink-v1.5", lambda d: (_previous(d), _builtin_materials("binomial fits")(d))
+    ),
 }
 
 
