@@ -189,10 +189,10 @@ def _stats(d: np.ndarray) -> str:
 
 
 def run(only: str | None, resolution_px: int) -> None:
+    from lumos.brdf.library import LAMBERTIAN
+
     import speclight
     from speclight.simulate.pipeline import simulate
-
-    from lumos.brdf.library import LAMBERTIAN
 
     surfaces = lp.lumos_surfaces()
     with tempfile.TemporaryDirectory() as tmp:
