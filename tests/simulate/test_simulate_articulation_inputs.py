@@ -8,7 +8,6 @@ import yaml
 import speclight
 from speclight.errors import InputError
 
-
 #: The array turned toward the Sun about the nadir axis through its centre (the starlink-v1.5
 #: example before issue 24, whose bus now yaws instead): the array centred above the bus.
 SUN_TRACKING = {"axis": [0, 0, 1], "hinge_point_m": [0, 0, -1.75], "normal": [1, 0, 0]}
