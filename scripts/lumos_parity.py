@@ -96,7 +96,7 @@ SITES = (
 )
 #: Per site, (inclination, RAAN, mean anomaly) [deg] of 550 km circular orbits (epoch: noon
 #: UTC of the window's day) with a sunlit pass in the window: chosen by a grid search
-#: over RAAN and mean anomaly for passes that together span phase angles 25-145 deg.
+#: over RAAN and mean anomaly for passes that together span phase angles 27-147 deg.
 PASSES: dict[str, tuple[tuple[float, float, float], ...]] = {
     "Cerro Pachon": ((53, 255, 60), (53, 135, 90), (97.6, 105, 90), (70, 270, 0), (97.6, 90, 180)),
     "La Palma": ((53, 195, 270), (97.6, 210, 30), (97.6, 30, 120), (70, 210, 150), (53, 195, 180)),
