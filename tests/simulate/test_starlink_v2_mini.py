@@ -8,12 +8,15 @@ azimuth) and the lab table its BRDF comes from. The example's parts must have th
 and normals (lumos-sat's (x, y, z) is body (y, x, -z) in the yaw-steered nadir frame the
 example flies), and each part's analytic material must fit the table the file names for it
 better than it fits any other second-generation table (the material is that table's fit).
+docs/real-satellites.md's table of the parts is held to the example (not a reference test:
+it keeps the page true).
 """
 
 from __future__ import annotations
 
 import re
 from importlib import resources
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,6 +24,7 @@ import pytest
 from speclight.scenario import load_example
 from speclight.simulate.geometry_stage import scenario_geometry
 from speclight.simulate.reflection import build_target
+from speclight.target.brdf_fit.directional_albedo import max_albedo
 from speclight.target.brdf_fit.form_coefficients import evaluate
 from speclight.target.brdf_samples import read_table_samples
 
@@ -105,3 +109,31 @@ def test_each_material_is_the_fit_of_its_table():
     for part, table in tables.items():
         rms = {t: _log_rms(materials[part], t) for t in others}
         assert min(rms, key=rms.get) == table, (part, rms)
+
+
+def _docs_rows() -> dict[str, list[str]]:
+    page = Path(__file__).resolve().parents[2] / "docs" / "real-satellites.md"
+    text = page.read_text().split("## The Starlink V2 mini model", 1)[1].split("\n\n**", 1)[0]
+    rows = [[c.strip() for c in line.strip("|").split("|")] for line in text.splitlines()
+            if line.startswith("| `")]  # fmt: skip
+    return {re.match(r"`(\w+)`", r[0]).group(1): r for r in rows}
+
+
+def test_docs_table_is_the_examples_materials():
+    # docs/real-satellites.md's V2 mini table, to its printed precision (3 decimals in dex and
+    # albedo: half a unit of the last digit, and the albedo quadrature's 2e-5)
+    rows = _docs_rows()
+    assert set(rows) == set(PARTS.values())
+    target = build_target(load_example("starlink-v2-mini"))
+    materials = {p.name: p.material for p in target.parts}
+    surfaces = _surfaces()
+    for part, row in rows.items():
+        area, _, brdf = surfaces[part]
+        assert float(row[1]) == area
+        m = materials[part]
+        if row[5]:
+            table = "starlink_gen2_" + re.match(r"table starlink_gen2_(\w+)", brdf).group(1)
+            assert _log_rms(m, table) == pytest.approx(float(row[5]), abs=5e-4), part
+        c = dict(m.coefficients)
+        albedo, _ = max_albedo(lambda *cos, m=m, c=c: evaluate(m.bsdf, c, *cos))
+        assert albedo == pytest.approx(float(row[6]), abs=6e-4), part
