@@ -370,7 +370,7 @@ def grid_epochs(loaded: Any) -> NDArray[np.datetime64]:
     a dark sky: the Sun below -6 deg at the site), the satellite fully sunlit, and in
     sunlight by lumos-sat's own test too (its spherical Earth's shadow, with 0.5 deg to
     spare: it returns no light past ``arccos(R / (R + h))``)."""
-    from speclight.simulate.geometry_stage import scenario_geometry
+    from speclight.simulation.geometry_stage import scenario_geometry
 
     geo = scenario_geometry(loaded)
     keep = geo.observable & (geo.sunlit_fraction >= 1.0)

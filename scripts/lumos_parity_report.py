@@ -192,7 +192,7 @@ def run(only: str | None, resolution_px: int) -> None:
     from lumos.brdf.library import LAMBERTIAN
 
     import speclight
-    from speclight.simulate.pipeline import simulate
+    from speclight.simulation.pipeline import simulate
 
     surfaces = lp.lumos_surfaces()
     with tempfile.TemporaryDirectory() as tmp:

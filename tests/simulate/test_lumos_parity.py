@@ -24,8 +24,8 @@ import numpy as np
 import pytest
 
 import speclight
-from speclight.simulate.pipeline import simulate
-from speclight.simulate.reflection import build_target
+from speclight.simulation.pipeline import simulate
+from speclight.simulation.reflection import build_target
 
 pytest.importorskip("lumos.calculator")
 pytest.importorskip("astropy.coordinates")

@@ -22,8 +22,8 @@ import numpy as np
 import pytest
 
 from speclight.scenario import load_example
-from speclight.simulate.geometry_stage import scenario_geometry
-from speclight.simulate.reflection import build_target
+from speclight.simulation.geometry_stage import scenario_geometry
+from speclight.simulation.reflection import build_target
 from speclight.target.brdf_fit.directional_albedo import max_albedo
 from speclight.target.brdf_fit.form_coefficients import evaluate
 from speclight.target.brdf_samples import read_table_samples
