@@ -25,7 +25,12 @@ import numpy as np
 from speclight.errors import InputError, did_you_mean
 from speclight.estimate.inputs.band_albedo import scenario_mean_source_W_m2_nm
 from speclight.estimate.inputs.band_responses import BandResponses, scenario_band_responses
-from speclight.estimate.spectra.upsampling import UpsampledSpectrum, photon_weights, upsample
+from speclight.estimate.spectra.upsampling import (
+    NOISE_DRAWS,
+    UpsampledSpectrum,
+    photon_weights,
+    upsample,
+)
 from speclight.input_files import read_user_text
 
 if TYPE_CHECKING:
@@ -266,9 +271,10 @@ def spectrum_csv(result: ScenarioSpectrum, scenario_source: str, fit_source: str
         spread = "reflectance_std: none (the albedos came without albedo_std)"
     else:
         spread = (
-            "reflectance_std: the albedos' standard deviations propagated to first order "
-            "(inf where a band is not constrained); it is the spread over the albedos' noise, "
-            "not the error between the bands"
+            f"reflectance_std: the spread of the spectra upsampled from {NOISE_DRAWS} albedo "
+            "sets drawn with the albedos' standard deviations (inf where a band is not "
+            "constrained); it is the spread over the albedos' noise, not the error between "
+            "the bands"
         )
     lines = [
         "# reflectance spectrum upsampled from band albedos by speclight upsample",
