@@ -13,6 +13,16 @@ mixtures (Dirichlet shares times a brightness 0.2-1), a noise level (SNR 30-300 
 * ``purest`` against ``atgp`` extraction: the largest spectral angle to the true signatures
   when every material has 10 pure epochs among bright mixtures.
 
+**upsample** (issue 25 item 6): each draw mixes the four material spectra (Dirichlet
+weights) into a truth spectrum, keeps 2-10 of the cube-materials example's ten bands, takes
+their band albedos weighted by the example's mean Sun over its pass (the definition fit and
+upsample share), adds noise (SNR 20-200) and upsamples with ``albedo_std``. It reports the
+standard deviation of ``(spectrum - noise-free spectrum) / reflectance_std`` at the band
+centres (the propagation; goal 0.8-1.25), the same against the true spectrum (what the
+sigma does not cover: the model's error between the bands), the fraction of draws that
+converge, and how far the band albedos of the spectrum upsampled with the flat-source
+weights of eq. 3 (the old reading) fall from the truth's.
+
 Run: ``.venv/bin/python bench/bench_calibration_spectra.py [--draws 60]``.
 """
 
@@ -23,23 +33,95 @@ import time
 
 import numpy as np
 
+from speclight.estimate.inputs.band_albedo import band_albedo, scenario_mean_source_W_m2_nm
 from speclight.estimate.inputs.band_responses import scenario_band_responses
 from speclight.estimate.spectra.endmembers import extract_endmembers
 from speclight.estimate.spectra.ground_truth import matched_angles_deg, material_signatures
 from speclight.estimate.spectra.unmix_checks import unmix_checks
 from speclight.estimate.spectra.unmixing import unmix
+from speclight.estimate.spectra.upsampling import photon_weights, upsample
 from speclight.scenario import example_text, parse_scenario
 from speclight.target import Reflectance
 from speclight.target.material_tables import MATERIAL_TABLES, material_table_path
 
 
+def materials() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+    """The four material spectra (4, L), the cube-materials bands (B, L), grid, mean Sun."""
+    loaded = parse_scenario(example_text("cube-materials"))
+    bands = scenario_band_responses(loaded)
+    spectra = np.array(
+        [
+            Reflectance.table_file(material_table_path(n)).evaluate(bands.wavelength_nm)
+            for n in MATERIAL_TABLES
+        ]
+    )
+    return spectra, bands.response, bands.wavelength_nm, scenario_mean_source_W_m2_nm(loaded)
+
+
 def signatures() -> np.ndarray:
-    bands = scenario_band_responses(parse_scenario(example_text("cube-materials")))
-    spectra = [
-        Reflectance.table_file(material_table_path(n)).evaluate(bands.wavelength_nm)
-        for n in MATERIAL_TABLES
-    ]
-    return material_signatures(np.array(spectra), bands.response, bands.wavelength_nm)
+    spectra, response, wl, _ = materials()
+    return material_signatures(spectra, response, wl)
+
+
+def upsample_draw(seed: int, spectra: np.ndarray, response: np.ndarray, wl: np.ndarray,
+                  sun: np.ndarray | None) -> dict[str, float]:  # fmt: skip
+    rng = np.random.default_rng(seed)
+    truth = rng.dirichlet(np.ones(len(spectra))) @ spectra
+    keep = np.sort(rng.choice(len(response), size=int(rng.integers(2, 11)), replace=False))
+    r = response[keep]
+    rho = band_albedo(truth, r, wl, sun)
+    std = rho / rng.uniform(20, 200)
+    noisy = np.clip(rho + rng.normal(0.0, std), 1e-3, 1.0)
+    est = upsample(noisy, r, wl, source_W_m2_nm=sun, albedo_std=std)
+    clean = upsample(rho, r, wl, source_W_m2_nm=sun).reflectance
+    w = photon_weights(r, wl, sun)
+    centre = np.searchsorted(wl, w @ wl)
+    seen = w.sum(axis=0) >= 0.01 * w.sum(axis=0).max()  # upsample_run's measured range
+    sigma = est.reflectance_std
+    assert sigma is not None
+    flat = upsample(rho, r, wl).reflectance  # the truth's albedos read with eq. 3's weights
+    return {
+        "n_bands": float(len(keep)),
+        "converged": float(est.converged),
+        "z_noise": list((est.reflectance - clean)[centre] / sigma[centre]),  # type: ignore[dict-item]
+        "z_truth": list((est.reflectance - truth)[centre] / sigma[centre]),  # type: ignore[dict-item]
+        "rms_truth": float(np.sqrt(np.mean(((est.reflectance - truth) ** 2)[seen]))),
+        "band_error_flat": float(np.max(np.abs(w @ flat - rho))),
+        "band_error_new": float(np.max(np.abs(w @ clean - rho))),
+    }
+
+
+def upsample_report(draws: int) -> None:
+    spectra, response, wl, sun = materials()
+    rows = [upsample_draw(5000 + i, spectra, response, wl, sun) for i in range(draws)]
+    z_noise = np.concatenate([r["z_noise"] for r in rows])
+    z_truth = np.concatenate([r["z_truth"] for r in rows])
+    print(f"upsample, {draws} draws ({len(z_noise)} band centres):")
+    print(f"  converged: {np.mean([r['converged'] for r in rows]):.0%}")
+    ok = [r for r in rows if r["converged"]]
+    z_ok = np.concatenate([r["z_noise"] for r in ok])
+    print(
+        f"  converged draws only: std {np.std(z_ok):.3f}, |z| < 3: {np.mean(np.abs(z_ok) < 3):.3f}"
+    )
+    print(
+        f"  (spectrum - noise-free spectrum)/reflectance_std std: {np.std(z_noise):.3f}, "
+        f"|z| < 3: {np.mean(np.abs(z_noise) < 3):.3f}"
+    )
+    print(f"  (spectrum - truth)/reflectance_std std: {np.std(z_truth):.3f}, "
+          f"|z| < 2: {np.mean(np.abs(z_truth) < 2):.0%}")  # fmt: skip
+    for low, high in ((2, 3), (4, 6), (7, 10)):
+        pick = [r for r in rows if low <= r["n_bands"] <= high]
+        if pick:
+            rms = np.median([r["rms_truth"] for r in pick])
+            print(
+                f"  {low}-{high} bands ({len(pick)} draws): median RMS to truth in the "
+                f"measured range {rms:.4f}"
+            )
+    flat = np.array([r["band_error_flat"] for r in rows])
+    new = np.array([r["band_error_new"] for r in rows])
+    print(f"  largest band error against the truth's albedos: flat-source reading median "
+          f"{np.median(flat):.4f} (max {flat.max():.4f}); shared definition median "
+          f"{np.median(new):.2e}")  # fmt: skip
 
 
 def one_draw(seed: int, all_s: np.ndarray) -> dict[str, float]:
@@ -83,7 +165,12 @@ def one_draw(seed: int, all_s: np.ndarray) -> dict[str, float]:
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--draws", type=int, default=60)
+    parser.add_argument("--only", choices=("unmix", "upsample"), default=None)
     args = parser.parse_args()
+    if args.only != "unmix":
+        upsample_report(args.draws)
+    if args.only == "upsample":
+        return
     t0 = time.perf_counter()
     all_s = signatures()
     rows = [one_draw(1000 + i, all_s) for i in range(args.draws)]

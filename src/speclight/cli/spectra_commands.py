@@ -43,13 +43,20 @@ def upsample(
     force: Force = False,
 ) -> None:
     """Reflectance spectrum from band albedos: a sigmoid of a polynomial of order n-1 whose
-    photon-weighted band averages (band x optics x QE) equal the albedos (paper eq. 3-4).
+    band averages equal the albedos (paper eq. 3-4), weighted as fit's albedos are: the
+    detected photons of the mean Sun over the scenario's pass (Sun x atmosphere x band x
+    optics x QE).
 
-    Writes CSV wavelength_nm,reflectance on the scenario's wavelength grid.
+    Writes CSV wavelength_nm,reflectance on the scenario's wavelength grid, and
+    reflectance_std (propagated from bands.BAND.albedo_std) where the JSON has it.
     """
 
     def run() -> None:
-        from speclight.estimate.spectra.upsample_run import read_fit_albedos, spectrum_csv
+        from speclight.estimate.spectra.upsample_run import (
+            read_fit_albedo_std,
+            read_fit_albedos,
+            spectrum_csv,
+        )
         from speclight.estimate.spectra.upsample_run import upsample_scenario as upsample_from
         from speclight.scenario import load_scenario
 
@@ -61,7 +68,8 @@ def upsample(
         result = write_products(
             output, plot_file, force, {"scenario file": scenario, "fit file": fit},
             compute=lambda: upsample_from(
-                load_scenario(scenario), read_fit_albedos(fit), str(fit)
+                load_scenario(scenario), read_fit_albedos(fit), str(fit),
+                albedo_std=read_fit_albedo_std(fit),
             ),
             data=lambda r: spectrum_csv(r, str(scenario), str(fit)).encode(), figure=draw,
         )  # fmt: skip

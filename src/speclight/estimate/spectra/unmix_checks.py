@@ -1,5 +1,5 @@
 """What an unmixing can say about itself: abundance uncertainties, misfit against the noise,
-conditioning.
+conditioning; :func:`with_checks` puts them in the ABUND.nc dataset.
 
 **Uncertainties.** On its support ``P`` (the endmembers with a non-zero contribution) every
 solver of :mod:`.unmixing` is a linear function of the epoch's factors ``x``:
@@ -25,9 +25,11 @@ ed., sec. 5.3.8).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
+import xarray as xr
 from numpy.typing import NDArray
 
 F64 = NDArray[np.float64]
@@ -192,3 +194,55 @@ def condition_number(signatures: F64) -> float:
     """2-norm condition number of the (K, B) signature matrix [1]."""
     sv = np.linalg.svd(np.asarray(signatures, dtype=np.float64), compute_uv=False)
     return float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+
+
+def with_checks(
+    ds: xr.Dataset,
+    x: np.ndarray,
+    abundance: np.ndarray,
+    signatures: np.ndarray,
+    sigma: np.ndarray | None,
+    method: str,
+) -> xr.Dataset:
+    """``ds`` with ``abundance_std``, ``chi2``, ``misfit`` (:mod:`.unmix_checks`) where the
+    noise is known, the attribute ``notes`` and a warning per note."""
+    notes: list[str] = []
+    if sigma is None:
+        notes.append(
+            "the noise of the factors is unknown (no sigma in the data, no scenario): no "
+            "uncertainties and no test of the residuals against the noise"
+        )
+        cond = condition_number(np.asarray(ds["endmember_signature"].values))
+        ds.attrs["condition_number"] = cond
+    else:
+        checks = unmix_checks(x, abundance, signatures, sigma, method)
+        ds["abundance_std"] = (
+            ("time", "endmember"),
+            checks.abundance_std,
+            {
+                "units": ds["abundance"].attrs["units"],
+                "long_name": "standard deviation of abundance (noise propagated, support fixed)",
+            },
+        )
+        ds["chi2"] = (
+            "time",
+            checks.chi2,
+            {"units": "1", "long_name": "chi-square of the misfit against the noise"},
+        )
+        ds["chi2_dof"] = ("time", checks.dof, {"units": "1", "long_name": "its degrees of freedom"})
+        ds["misfit"] = (
+            "time",
+            checks.misfit.astype(np.int8),
+            {"units": "1", "long_name": f"1 where P(chi2) < {MISFIT_P_VALUE:g}"},
+        )
+        ds.attrs["condition_number"] = checks.condition_number
+        notes += checks.notes()
+    if ds.attrs["condition_number"] > CONDITION_WARNING and sigma is None:
+        notes.append(
+            f"the endmember signatures are nearly dependent (condition number "
+            f"{ds.attrs['condition_number']:.3g})"
+        )
+    for note in notes:
+        warnings.warn(note, stacklevel=2)
+    ds.attrs["notes"] = "; ".join(notes) if notes else "ok"
+    return ds

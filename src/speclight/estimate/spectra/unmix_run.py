@@ -25,7 +25,6 @@ estimated_class)``, ``confusion_count`` and the attribute ``mean_absolute_share_
 
 from __future__ import annotations
 
-import warnings
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -48,12 +47,7 @@ from speclight.estimate.spectra.endmember_spectra import (
 )
 from speclight.estimate.spectra.endmembers import ENDMEMBER_METHODS, extract_endmembers
 from speclight.estimate.spectra.factor_noise import factor_sigma
-from speclight.estimate.spectra.unmix_checks import (
-    CONDITION_WARNING,
-    MISFIT_P_VALUE,
-    condition_number,
-    unmix_checks,
-)
+from speclight.estimate.spectra.unmix_checks import with_checks
 from speclight.estimate.spectra.unmix_truth import compare_with_truth
 from speclight.estimate.spectra.unmixing import UNMIX_METHODS
 from speclight.estimate.spectra.unmixing_epochs import unmix_per_epoch
@@ -223,58 +217,6 @@ def _carried(measured: str | Path) -> LoadedScenario | None:
         return None
     head = read_user_dataset(measured, "MEASURED", what="measurements", variables=())
     return dataset_scenario(head, str(measured)) if "scenario_yaml" in head.attrs else None
-
-
-def with_checks(
-    ds: xr.Dataset,
-    x: np.ndarray,
-    abundance: np.ndarray,
-    signatures: np.ndarray,
-    sigma: np.ndarray | None,
-    method: str,
-) -> xr.Dataset:
-    """``ds`` with ``abundance_std``, ``chi2``, ``misfit`` (:mod:`.unmix_checks`) where the
-    noise is known, the attribute ``notes`` and a warning per note."""
-    notes: list[str] = []
-    if sigma is None:
-        notes.append(
-            "the noise of the factors is unknown (no sigma in the data, no scenario): no "
-            "uncertainties and no test of the residuals against the noise"
-        )
-        cond = condition_number(np.asarray(ds["endmember_signature"].values))
-        ds.attrs["condition_number"] = cond
-    else:
-        checks = unmix_checks(x, abundance, signatures, sigma, method)
-        ds["abundance_std"] = (
-            ("time", "endmember"),
-            checks.abundance_std,
-            {
-                "units": ds["abundance"].attrs["units"],
-                "long_name": "standard deviation of abundance (noise propagated, support fixed)",
-            },
-        )
-        ds["chi2"] = (
-            "time",
-            checks.chi2,
-            {"units": "1", "long_name": "chi-square of the misfit against the noise"},
-        )
-        ds["chi2_dof"] = ("time", checks.dof, {"units": "1", "long_name": "its degrees of freedom"})
-        ds["misfit"] = (
-            "time",
-            checks.misfit.astype(np.int8),
-            {"units": "1", "long_name": f"1 where P(chi2) < {MISFIT_P_VALUE:g}"},
-        )
-        ds.attrs["condition_number"] = checks.condition_number
-        notes += checks.notes()
-    if ds.attrs["condition_number"] > CONDITION_WARNING and sigma is None:
-        notes.append(
-            f"the endmember signatures are nearly dependent (condition number "
-            f"{ds.attrs['condition_number']:.3g})"
-        )
-    for note in notes:
-        warnings.warn(note, stacklevel=2)
-    ds.attrs["notes"] = "; ".join(notes) if notes else "ok"
-    return ds
 
 
 def check_distinct(members: Endmembers) -> None:
