@@ -146,7 +146,9 @@ def _constrained(std: F64, u: F64, surfaces: list[FreeSurface], bounds: tuple[F6
         limit = MAX_STD_DEX if is_log else MAX_STD_FRACTION * span
         if min(u[i] - lo[i], hi[i] - u[i]) < 1e-3 * span:
             out.append("at a bound of its range")
-        elif not np.isfinite(std[i]) or std[i] > limit:
+        elif not np.isfinite(std[i]):
+            out.append("no observed magnitude changes with it")
+        elif std[i] > limit:
             unit = " dex" if is_log else ""
             out.append(f"std {std[i]:.3g}{unit} > {limit:.3g}{unit}")
         else:
