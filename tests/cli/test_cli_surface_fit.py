@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 from speclight.cli import app
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "estimate"))
-from surface_fit_data import FAR_START, TRUTH, write_observations, write_scenario  # noqa: E402
+from surface_fit_data import FAR_START, TRUTH, write_observations, write_scenario
 
 
 def test_fit_brdf_end_to_end(tmp_path: Path) -> None:

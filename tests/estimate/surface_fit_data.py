@@ -16,7 +16,10 @@ from speclight.simulation import simulate
 #: The true coefficients: the chassis underside and the array as Phong surfaces.
 TRUTH = {"bus_nadir": {"kd": 0.3, "ks": 0.4, "n": 8.0}, "array": {"kd": 0.1, "ks": 0.3, "n": 20.0}}
 #: A start far from the truth (factors 6-12 in every coefficient).
-FAR_START = {"bus_nadir": {"kd": 0.05, "ks": 0.05, "n": 100.0}, "array": {"kd": 0.5, "ks": 0.05, "n": 2.0}}
+FAR_START = {
+    "bus_nadir": {"kd": 0.05, "ks": 0.05, "n": 100.0},
+    "array": {"kd": 0.5, "ks": 0.05, "n": 2.0},
+}
 #: Cerro Pachon, La Silla, Las Campanas (the same evening pass seen from each).
 SITES = [(-30.2446, -70.7494, 2663.0), (-29.2567, -70.7377, 2400.0), (-29.0146, -70.6926, 2380.0)]
 NOISE_MAG = 0.05

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from surface_fit_data import FAR_START, TRUTH, write_observations, write_scenario
 
 from speclight.errors import InputError
 from speclight.estimate.inputs.observations import read_observations
@@ -19,8 +20,6 @@ from speclight.estimate.surface_fit import fit_surfaces
 from speclight.estimate.surface_fit import surface_fit_run as run
 from speclight.estimate.surface_fit.robust_fit import night_halves
 from speclight.scenario import load_scenario
-
-from surface_fit_data import FAR_START, TRUTH, write_observations, write_scenario
 
 #: Agreement of the records' model with the pipeline at the same coefficients [mag]: the
 #: records hold the render's own cosines (merged where they agree to 1e-7) and areas; the
@@ -50,9 +49,7 @@ def test_model_matches_the_pipeline_at_other_coefficients(data: dict) -> None:
     loaded, obs = data["start"], data["obs"]
     surfaces = run.free_surfaces(loaded.scenario.target.materials, None)
     d = run._design(loaded, obs, surfaces, None, False)
-    u = np.concatenate(
-        [[np.log10(TRUTH[s.name][c.name]) for c in s.free] for s in surfaces]
-    )
+    u = np.concatenate([[np.log10(TRUTH[s.name][c.name]) for c in s.free] for s in surfaces])
     assert d.used.all()
     np.testing.assert_allclose(d.model.magnitude(u), data["clean"], atol=MODEL_TOL_MAG, rtol=0)
 

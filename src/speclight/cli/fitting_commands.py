@@ -112,7 +112,9 @@ def _fit_surfaces(
     from speclight.scenario import load_scenario
 
     if bin_s is not None:
-        raise InputError("it bins light curves; a BRDF fit takes magnitudes (leave it out)", field="--bin-s")
+        raise InputError(
+            "it bins light curves; a BRDF fit takes magnitudes (leave it out)", field="--bin-s"
+        )
     with flag_names(free="--free"):
         result = write_products(
             output, plot_file, force, {"scenario file": scenario, "observations": observations},

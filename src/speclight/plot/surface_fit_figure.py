@@ -22,8 +22,9 @@ def surface_fit_figure(result: Any) -> Any:
     ax.plot(phase, result.residual_start_mag, "o", ms=3, color="0.6",
             label=f"start (RMS {s['start']['rms_mag']:.3f} mag)")  # fmt: skip
     cv = s["cross_validation"]["rms_mag"]
+    cv_label = "cross-validated" + (f" (RMS {cv:.3f} mag)" if cv is not None else "")
     ax.plot(phase, result.residual_cross_mag, "^", ms=3, mfc="none", color="tab:orange",
-            label="cross-validated" + (f" (RMS {cv:.3f} mag)" if cv is not None else ""))  # fmt: skip
+            label=cv_label)  # fmt: skip
     ax.plot(phase, result.residual_fit_mag, "o", ms=3, color="tab:blue",
             label=f"fitted (RMS {s['fit']['rms_mag']:.3f} mag)")  # fmt: skip
     ax.axhline(0.0, color="k", lw=0.8)

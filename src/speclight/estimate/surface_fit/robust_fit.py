@@ -24,6 +24,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -66,7 +67,7 @@ def _solve(
     rows: I64,
     starts: list[F64],
     bounds: tuple[F64, F64],
-) -> object:
+) -> Any:
     def residual(u: F64) -> F64:
         return np.asarray((observed[rows] - magnitude(u)[rows]) / scale[rows])
 
@@ -103,26 +104,26 @@ def robust_fit(
     res = None
     for _ in range(rounds):
         res = _solve(magnitude, observed, _scale(sigma, tau), rows, starts, bounds)
-        starts = [res.x]  # type: ignore[attr-defined]
+        starts = [res.x]
         if tau_mag is None:
-            r = observed[rows] - magnitude(res.x)[rows]  # type: ignore[attr-defined]
+            r = observed[rows] - magnitude(res.x)[rows]
             mad = 1.4826 * float(np.median(np.abs(r - np.median(r))))
             sig2 = float(np.median(np.where(np.isfinite(sigma[rows]), sigma[rows], 0.0) ** 2))
             tau = float(np.sqrt(max(mad**2 - sig2, 0.0)))
     assert res is not None
-    n, p = rows.size, res.x.size  # type: ignore[attr-defined]
+    n, p = rows.size, res.x.size
     dof = max(n - p, 1)
-    chi2 = 2.0 * float(res.cost)  # type: ignore[attr-defined]
-    jac = np.asarray(res.jac)  # type: ignore[attr-defined]
+    chi2 = 2.0 * float(res.cost)
+    jac = np.asarray(res.jac)
     cov = covariance(jac) * max(1.0, chi2 / dof)
     return RobustFit(
-        u=np.asarray(res.x, dtype=float),  # type: ignore[attr-defined]
+        u=np.asarray(res.x, dtype=float),
         cov=cov,
         tau_mag=tau,
         chi2=chi2,
         dof=dof,
-        success=bool(res.success),  # type: ignore[attr-defined]
-        message=str(res.message),  # type: ignore[attr-defined]
+        success=bool(res.success),
+        message=str(res.message),
     )
 
 

@@ -136,7 +136,9 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
         cells = []
         for p, v in s["parameters"].items():
             spread = f" +- {v['std']:.2g}" if v["constrained"] and v["std"] is not None else ""
-            cells.append(f"{p} {v['value']:.4g}{spread}" + ("" if v["constrained"] else " (not constrained)"))
+            cells.append(
+                f"{p} {v['value']:.4g}{spread}" + ("" if v["constrained"] else " (not constrained)")
+            )
         lines.append(f"{name} ({s['bsdf']}): " + ", ".join(cells))
     yaw = summary["yaw_offset_deg"]
     if yaw is not None:

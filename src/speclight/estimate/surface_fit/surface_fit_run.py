@@ -136,7 +136,9 @@ def _bounds(surfaces: list[FreeSurface]) -> tuple[F64, F64]:
     return b[:, 0], b[:, 1]
 
 
-def _constrained(std: F64, u: F64, surfaces: list[FreeSurface], bounds: tuple[F64, F64]) -> list[str]:
+def _constrained(
+    std: F64, u: F64, surfaces: list[FreeSurface], bounds: tuple[F64, F64]
+) -> list[str]:
     """Why each variable is not constrained ("" where it is)."""
     out = []
     lo, hi = bounds
@@ -236,7 +238,9 @@ def fit_surfaces(
         raise InputError(f"n_bootstrap = {n_bootstrap} must be 0 or >= 2", field="n_bootstrap")
     surfaces = free_surfaces(sc.target.materials, materials)
     bounds = _bounds(surfaces)
-    yaw, yaw_std, profile, yaw_message = None, np.nan, [], ""
+    yaw: float | None = None
+    yaw_std, yaw_message = np.nan, ""
+    profile: list[tuple[float, float]] = []
     if "attitude" in free:
         yaw, yaw_std, profile, yaw_message = _yaw_profile(
             loaded, obs, surfaces, yaw_grid_deg, progress
@@ -251,7 +255,9 @@ def fit_surfaces(
         if n_bootstrap
         else np.full(fit.u.size, np.nan)
     )
-    std, how = calibrated_std(jac_std, boot) if n_bootstrap else (jac_std, ["jacobian"] * fit.u.size)
+    std, how = (
+        calibrated_std(jac_std, boot) if n_bootstrap else (jac_std, ["jacobian"] * fit.u.size)
+    )
     why = _constrained(std, fit.u, surfaces, bounds)
     with np.errstate(invalid="ignore", divide="ignore"):
         start_mag = m.magnitude(m.u0)

@@ -89,7 +89,7 @@ class SurfaceModel:
         epoch, ci, co, ch, cd, w = self._records[k]
         s = self.surfaces[k]
         f = evaluate(s.bsdf, s.coefficients(u_k), ci, co, ch, cd)
-        return np.bincount(epoch, weights=w * f, minlength=self.n_epochs)
+        return np.asarray(np.bincount(epoch, weights=w * f, minlength=self.n_epochs), dtype=float)
 
     def free_share(self, u: F64) -> F64:
         """The fitted surfaces' share per epoch (n_epochs,) [m2 sr-1]."""

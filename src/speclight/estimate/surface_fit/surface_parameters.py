@@ -82,7 +82,10 @@ def coefficient_value(coefficients: Mapping[str, Any], name: str) -> float:
 
 def with_values(coefficients: Mapping[str, Any], values: Mapping[str, float]) -> dict[str, Any]:
     """A copy of ``coefficients`` with the free coefficients set to ``values``."""
-    out = {k: (np.asarray(v, dtype=float).tolist() if k in "bc" else v) for k, v in coefficients.items()}
+    out = {
+        k: (np.asarray(v, dtype=float).tolist() if k in "bc" else v)
+        for k, v in coefficients.items()
+    }
     for name, v in values.items():
         if name == "b00":
             out["b"][0][0] = float(v)
@@ -113,7 +116,9 @@ class FreeSurface:
         return with_values(FORMS[self.bsdf].complete(self.start), values)
 
 
-def free_surfaces(materials: Mapping[str, Any], names: list[str] | None = None) -> list[FreeSurface]:
+def free_surfaces(
+    materials: Mapping[str, Any], names: list[str] | None = None
+) -> list[FreeSurface]:
     """The scenario's analytic materials to fit (``names``: those only; None: every one).
 
     ``materials`` maps a material key to its scenario model (``bsdf``, ``coefficients``,

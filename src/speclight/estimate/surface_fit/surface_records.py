@@ -101,7 +101,7 @@ class _Collector:
         light = unique[:, 0]
         self.parts.append(
             SurfaceRecords(
-                self.epoch_of[light], unique[:, 1], *mean,
+                self.epoch_of[light], unique[:, 1], mean[0], mean[1], mean[2], mean[3],
                 n * pixel_area_m2 * self.factor[light],
             )
         )  # fmt: skip
@@ -119,9 +119,7 @@ def _unit(x: F64) -> F64:
     return np.asarray(x / np.linalg.norm(x, axis=1, keepdims=True))
 
 
-def shading_records(
-    loaded: Any, geometry: Any, surfaces: list[str], epochs: I64
-) -> SurfaceRecords:
+def shading_records(loaded: Any, geometry: Any, surfaces: list[str], epochs: I64) -> SurfaceRecords:
     """The records of the fitted materials at ``epochs`` of one simulation.
 
     Parameters
@@ -187,8 +185,12 @@ def yawed(geometry: Any, yaw_deg: float) -> Any:
     """``geometry`` with the body turned by ``yaw_deg`` [deg] about its +z axis (the nadir
     axis of ``attitude: nadir``): the body-to-GCRS quaternion times that rotation, and every
     body-frame direction turned back by it."""
-    from speclight.attitude.quaternion import quat_conjugate, quat_from_axis_angle, quat_multiply
-    from speclight.attitude.quaternion import quat_rotate
+    from speclight.attitude.quaternion import (
+        quat_conjugate,
+        quat_from_axis_angle,
+        quat_multiply,
+        quat_rotate,
+    )
 
     geo = geometry
     turn = quat_from_axis_angle(np.array([0.0, 0.0, 1.0]), np.deg2rad(yaw_deg))
