@@ -130,7 +130,7 @@ def _fit_surfaces(
 
 
 def _surface_figure(result: Any) -> Any:
-    from speclight.plot.surface_fit_figure import surface_fit_figure
+    from speclight.plot.fit_figure import surface_fit_figure
 
     return surface_fit_figure(result)
 
