@@ -35,7 +35,12 @@ def fit(
     ],
     output: Annotated[str, output_option("FILE", "Output FIT.json.")] = "fit.json",
     free: Annotated[
-        str, typer.Option("--free", help="Parameters to fit: albedo, roughness or both (a,b).")
+        str,
+        typer.Option(
+            "--free",
+            help="Parameters to fit: albedo, roughness or both (a,b); or, with OBSERVATIONS "
+            "(magnitudes, as compare reads them), brdf or brdf,attitude.",
+        ),
     ] = "albedo",
     bin_s: Annotated[
         float | None, bin_s_option("Average the measurements into S-second bins.")
@@ -57,7 +62,16 @@ def fit(
 
     The scenario is simulated at the measured epochs, starting from its own reflectance and
     roughness. Outputs are claimed as `simulate` claims its output. See docs/fit.md.
+
+    With --free brdf[,attitude] the second file is OBSERVATIONS (magnitudes per epoch and
+    site, as `speclight compare` reads them) and the analytic BRDF coefficients of the
+    target's surfaces (and a yaw offset) are fitted; output SURFACES.json, figure:
+    residuals against phase angle. See docs/surface-fit.md.
     """
+    names = [p.strip() for p in free.split(",") if p.strip()]
+    if "brdf" in names or "attitude" in names:
+        guarded(lambda: _fit_surfaces(scenario, measured, output, names, plot_file, force, bin_s))
+        return
 
     def run() -> None:
         from speclight.estimate.fitting.fit_run import check_free, check_method, fit_scenario
@@ -85,6 +99,40 @@ def fit(
         say_wrote(output, plot_file)
 
     guarded(run)
+
+
+def _fit_surfaces(
+    scenario: Path, observations: Path, output: str, names: list[str],
+    plot_file: str | None, force: bool, bin_s: float | None,
+) -> None:  # fmt: skip
+    from speclight.errors import InputError
+    from speclight.estimate.inputs.observations import read_observations
+    from speclight.estimate.surface_fit import fit_surfaces
+    from speclight.estimate.surface_fit.surface_fit_report import summary_lines
+    from speclight.scenario import load_scenario
+
+    if bin_s is not None:
+        raise InputError(
+            "it bins light curves; a BRDF fit takes magnitudes (leave it out)", field="--bin-s"
+        )
+    with flag_names(free="--free"):
+        result = write_products(
+            output, plot_file, force, {"scenario file": scenario, "observations": observations},
+            compute=lambda: fit_surfaces(
+                load_scenario(scenario), read_observations(observations), free=names,
+                progress=sys.stderr.isatty(),
+            ),
+            data=lambda r: json_bytes(r.to_json()), figure=_surface_figure,
+        )  # fmt: skip
+    for line in summary_lines(result.summary):
+        typer.echo(line)
+    say_wrote(output, plot_file)
+
+
+def _surface_figure(result: Any) -> Any:
+    from speclight.plot.fit_figure import surface_fit_figure
+
+    return surface_fit_figure(result)
 
 
 def _fit_figure(result: Any) -> Any:

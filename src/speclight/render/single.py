@@ -70,6 +70,7 @@ def geometric_weights(
     on_hits: Callable[..., None] | None = None,
     layout: ChannelLayout | None = None,
     contributions: Callable[..., tuple[I64, I64, F64]] = pixel_contributions,
+    on_shading: Callable[..., None] | None = None,
 ) -> tuple[F64, dict[int, _Kept], float, ChannelLayout]:
     """Channel weights w (N, C) [m² sr-1], kept pixel data, pixel pitch [m] and the layout.
 
@@ -78,6 +79,10 @@ def geometric_weights(
     lasers for ranging, reuse the rays: :mod:`speclight.render.laser_returns`).
     ``layout`` and ``contributions`` (same arguments as :func:`pixel_contributions`) add
     channels of their own, e.g. roughness derivatives (:mod:`speclight.render.single_gradient`).
+    ``on_shading(epochs, material, cos_i, cos_o, cos_h, cos_d, pixel_area_m2)``, if given,
+    receives every lit, visible hit of a batch (its epoch index, material index and cosines)
+    and the pixel area, e.g. to evaluate other BRDFs on the same hits
+    (:mod:`speclight.estimate.surface_fit.surface_records`).
     """
     layout = ChannelLayout(target) if layout is None else layout
     centre, radius = target.bounding_sphere()
@@ -111,6 +116,8 @@ def geometric_weights(
         cos_d = dot_rows(s, half)[e_idx]
         mirror_ok = mirror_in_sun(n[idx], cos_o[idx], o[e_idx], s[e_idx])
         mat = layout.part_mat[hits.part[idx]]
+        if on_shading is not None:
+            on_shading(a + e_idx, mat, cos_i[idx], cos_o[idx], cos_h, cos_d, pixel_area)
         rows, chans, px_w = contributions(
             layout, mat, cos_i[idx], cos_o[idx], cos_h, cos_d, mirror_ok
         )

@@ -14,6 +14,7 @@ refused (an :class:`~speclight.errors.InputError`: the times or the scenario are
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -106,9 +107,6 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
     CompareResult
         ``dataset`` with dimension ``obs`` (one per row, file order): see docs/compare.md.
     """
-    from speclight.simulation.geometry_stage import scenario_geometry
-    from speclight.simulation.pipeline import simulate
-
     sc = loaded.scenario
     if sc.target is None and sc.render.mode != "map":
         raise InputError(
@@ -116,10 +114,6 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
             source=loaded.source,
             field="target",
         )
-    bands = _bands(loaded, obs)
-    base = loaded
-    if len(bands) > len(sc.instrument.bands):  # speclite filters added
-        base = with_overrides(loaded, {"instrument.bands": bands})  # a missing section is made
     groups = row_groups(loaded, obs)
     notes: list[str] = []
     if not sc.orbit.observed and np.any(np.isfinite(obs.elevation_deg)):
@@ -143,6 +137,67 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
     geo: dict[str, F64] = {k: np.full(n, np.nan) for k in GEOMETRY}
     for name in ("sun_direction_body", "observer_direction_body"):
         geo[name] = np.full((n, 3), np.nan)
+    for run in site_runs(loaded, obs, groups, progress):
+        ds = run.result.dataset
+        sim[run.rows] = ds["ab_magnitude"].values[run.epoch, run.band]
+        flags[run.rows] = ds["flags"].values[run.epoch]
+        for name, var in GEOMETRY.items():
+            geo[name][run.rows] = ds[var].values[run.epoch]
+    if not np.any(np.isfinite(sim) & np.isfinite(obs.magnitude)):
+        err = no_usable_epochs(n, loaded.source, obs.source, FIELD, "observed")
+        if lonely:  # the likelier cause
+            raise InputError(
+                f"{err.message}; {_lonely_note(lonely)}", source=obs.source, field=FIELD
+            ) from None
+        raise err
+    return CompareResult(dataset=_dataset(loaded, obs, sim, flags, geo), notes=notes)
+
+
+@dataclass
+class SiteRun:
+    """One site's simulation of the observed epochs, and where each row is in it.
+
+    Attributes
+    ----------
+    scenario
+        The scenario as run: the observer moved to the site (speclite filter bands added).
+    result
+        The simulation (:class:`~speclight.simulation.pipeline.SimulationResult`).
+    rows
+        (R,) the observation rows simulated (indices into the observations).
+    epoch, band
+        (R,) each row's epoch (time index) and band index in ``result.dataset``.
+    """
+
+    scenario: LoadedScenario
+    result: Any
+    rows: NDArray[np.intp]
+    epoch: NDArray[np.intp]
+    band: NDArray[np.intp]
+
+
+def site_runs(
+    loaded: LoadedScenario,
+    obs: Observations,
+    groups: list[RowGroup] | None = None,
+    progress: bool = False,
+    adjust: Callable[[Any], Any] | None = None,
+) -> Iterator[SiteRun]:
+    """Simulate ``loaded`` at every site of ``obs`` (one run per site, as :func:`compare`).
+
+    ``groups``: from :func:`~speclight.estimate.comparison.compare_geometry.row_groups`
+    (computed here when None). ``adjust(geometry) -> geometry``, if given, changes each
+    site's geometry before it is rendered (e.g. an attitude offset in ``speclight fit
+    --free attitude``); the geometry is then computed first for the scenario's orbit too.
+    """
+    from speclight.simulation.geometry_stage import scenario_geometry
+    from speclight.simulation.pipeline import simulate
+
+    bands = _bands(loaded, obs)
+    base = loaded
+    if len(bands) > len(loaded.scenario.instrument.bands):  # speclite filters added
+        base = with_overrides(loaded, {"instrument.bands": bands})  # a missing section is made
+    groups = row_groups(loaded, obs) if groups is None else groups
     sites = [(key, _site_parts(obs, rows, groups)) for key, rows in obs.site_groups()]
     _check_sites(len(sites), sum(len(parts) for _, parts in sites), obs)
     for (lat, lon, alt), parts in sites:
@@ -156,31 +211,28 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
                 "observer.altitude_m": alt,
             },
         )
-        if parts[0][2] is None:  # the scenario's orbit: one group
-            ds = simulate(site_scenario, progress, time_utc=parts[0][1]).dataset
+        if parts[0][2] is None and adjust is None:  # the scenario's orbit: one group
+            result = simulate(site_scenario, progress, time_utc=parts[0][1])
         else:
             g = join_geometries(
                 [scenario_geometry(site_scenario, epochs, trajectory=tr) for _, epochs, tr in parts]
             )
-            ds = simulate(site_scenario, progress, geometry=g).dataset
-        band_index = {str(b): col for col, b in enumerate(ds["band"].values)}
+            result = simulate(site_scenario, progress, geometry=g if adjust is None else adjust(g))
+        band_index = {str(b): col for col, b in enumerate(result.dataset["band"].values)}
         offset = 0
+        rows, epoch, band = [], [], []
         for idx, epochs, _ in parts:
-            k = offset + np.searchsorted(epochs, obs.time_utc[idx])
+            rows.append(idx)
+            epoch.append(offset + np.searchsorted(epochs, obs.time_utc[idx]))
             offset += epochs.size
-            cols = np.array([band_index[obs.band[i]] for i in idx], dtype=np.intp)
-            sim[idx] = ds["ab_magnitude"].values[k, cols]
-            flags[idx] = ds["flags"].values[k]
-            for name, var in GEOMETRY.items():
-                geo[name][idx] = ds[var].values[k]
-    if not np.any(np.isfinite(sim) & np.isfinite(obs.magnitude)):
-        err = no_usable_epochs(n, loaded.source, obs.source, FIELD, "observed")
-        if lonely:  # the likelier cause
-            raise InputError(
-                f"{err.message}; {_lonely_note(lonely)}", source=obs.source, field=FIELD
-            ) from None
-        raise err
-    return CompareResult(dataset=_dataset(loaded, obs, sim, flags, geo), notes=notes)
+            band.append(np.array([band_index[obs.band[i]] for i in idx], dtype=np.intp))
+        yield SiteRun(
+            site_scenario,
+            result,
+            np.concatenate(rows),
+            np.concatenate(epoch).astype(np.intp),
+            np.concatenate(band),
+        )
 
 
 def _lonely_note(names: list[str]) -> str:
