@@ -10,7 +10,7 @@ from itertools import pairwise
 import numpy as np
 from skyfield.api import EarthSatellite
 
-from speclight.orbit.observed_objects import _partition, object_layers
+from speclight.orbit.observed.observed_objects import _partition, object_layers
 from speclight.orbit.timescale import load_timescale, time_from_utc
 from speclight.orbit.tle import checksum
 

@@ -8,7 +8,7 @@ import numpy as np
 from skyfield.api import EarthSatellite, wgs84
 
 from speclight.orbit import Site
-from speclight.orbit.observed_position import (
+from speclight.orbit.observed.observed_position import (
     observed_trajectory,
     place_target_gcrs_m,
     range_from_height_m,

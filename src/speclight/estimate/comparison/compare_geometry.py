@@ -3,7 +3,7 @@
 
 The rows are split into groups that share one trajectory: all rows where the scenario has
 an orbit or the file has no ``object`` column (as before objects were known), else the
-layers of :func:`speclight.orbit.observed_objects.object_layers` (objects whose rows do
+layers of :func:`speclight.orbit.observed.observed_objects.object_layers` (objects whose rows do
 not overlap in time). A site's simulation covers all its groups: their geometries are
 joined along the epochs (:func:`join_geometries`) and rendered in one run.
 """
@@ -20,8 +20,8 @@ from speclight import orbit
 from speclight.constants import C_M_S
 from speclight.errors import InputError
 from speclight.estimate.inputs.observations import FIELD, Observations
-from speclight.orbit.observed_objects import object_layers
-from speclight.orbit.observed_position import (
+from speclight.orbit.observed.observed_objects import object_layers
+from speclight.orbit.observed.observed_position import (
     observed_trajectory,
     place_target_gcrs_m,
     range_from_height_m,

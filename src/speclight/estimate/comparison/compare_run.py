@@ -6,7 +6,7 @@ scenario with its observer moved to the site, :func:`~speclight.scenario.overrid
 with_overrides`). A row's band is a band of the scenario or a speclite filter, which is
 then added to the scenario's bands (its AB magnitude: band response only). Where the
 scenario has ``orbit: {observed: true}``, the target is placed where each row saw it
-(:mod:`speclight.orbit.observed_position`). Epochs where the target is not observable
+(:mod:`speclight.orbit.observed.observed_position`). Epochs where the target is not observable
 (below the minimum elevation, in the Earth's shadow, no attitude) keep their row with a
 NaN simulated magnitude and their ``flags``; where no row is observable the comparison is
 refused (an :class:`~speclight.errors.InputError`: the times or the scenario are wrong).

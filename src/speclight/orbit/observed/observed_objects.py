@@ -2,7 +2,7 @@
 
 Rows of two satellites seen 10 s apart must not make one trajectory (a straight line from
 one to the other). Each object gets the trajectory of
-:func:`~speclight.orbit.observed_position.observed_trajectory` through its own rows only.
+:func:`~speclight.orbit.observed.observed_position.observed_trajectory` through its own rows only.
 The geometry stage asks a trajectory for positions at times alone, so the objects are
 grouped into *layers*: within a layer the objects' time windows (first to last emission,
 widened by ``margin_s`` on both sides) do not overlap, and a layer's trajectory answers a
@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.orbit.observed_position import position_table, table_position, tt_seconds
+from speclight.orbit.observed.observed_position import position_table, table_position, tt_seconds
 from speclight.orbit.orbit_sources import Trajectory
 
 F64 = NDArray[np.float64]
