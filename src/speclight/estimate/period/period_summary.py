@@ -97,7 +97,7 @@ def summary(r: PeriodResult) -> dict[str, Any]:
                 "halves_differ": t.differ,
             }
             for t in r.decision.tests
-        ],  # fmt: skip
+        ],
         "alpha": ALPHA,
         "tumbling": _tumbling(r),
         "outliers": _outliers(r),
