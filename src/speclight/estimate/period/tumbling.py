@@ -126,6 +126,27 @@ def _harmonics_needed(series: BandSeries, f1: float, start: int, alpha: float) -
     return list(range(1, h + 1))
 
 
+def _reduced(f2: float, f1: float, f_min: float) -> float:
+    """The lowest frequency ``|f2 - j f1|`` (``j`` integer) within the grid: the pairs
+    ``(f1, f2)`` and ``(f1, |f2 - j f1|)`` span the same combinations, and the residuals'
+    best peak may be a combination (Pravec et al. 2005 pick the lowest)."""
+    r = abs(f2 - round(f2 / f1) * f1)
+    return r if r >= f_min else f2
+
+
+def _refined(series: BandSeries, f1: float, orders: list[int], f2: float, m: int) -> float:
+    """``f2`` minimising the chi-square of the two-frequency model with its mixed
+    combinations, within a quarter of a peak width (scipy's bounded Brent search)."""
+    from scipy.optimize import minimize_scalar
+
+    half = 0.25 / series.span_s
+    found = minimize_scalar(
+        lambda f: _fit(series, f1, orders, f, m, True)[0],
+        bounds=(f2 - half, f2 + half), method="bounded", options={"xatol": 1e-4 * half},
+    )  # fmt: skip
+    return float(found.x)
+
+
 def tumbling_test(
     series: BandSeries, frequency_hz: F64, rotation_hz: float, harmonics: int, alpha: float
 ) -> TumblingTest:
@@ -159,6 +180,7 @@ def tumbling_test(
     k = int(local_maxima(power, 1)[0])
     fap2 = analytic_fap(rest, frequency_hz, harmonics, float(frequency_hz[k])).fap(float(power[k]))
     f2 = refine_peak(rest, float(frequency_hz[k]), list(range(1, harmonics + 1))).frequency_hz
+    f2 = _reduced(f2, rotation_hz, float(frequency_hz[0]))
     none.second_fap, none.frequencies_hz = fap2, [rotation_hz, f2]
     if k == 0 or not fap2 < SECOND_FAP:
         why = (
@@ -169,6 +191,7 @@ def tumbling_test(
         none.text = f"one frequency: the residuals' best peak ({1 / f2:.6g} s) {why}"
         return none
     m = harmonics + 1
+    f2 = _refined(series, rotation_hz, orders, f2, m)
     chi_r, p_r, _, _ = _fit(series, rotation_hz, orders, f2, m, False)
     chi_f, p_f, coefs, _ = _fit(series, rotation_hz, orders, f2, m, True)
     stat, p = _f_test(chi_r, p_r, chi_f, p_f, series.t_s.size)
