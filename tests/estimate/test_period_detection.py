@@ -87,7 +87,7 @@ def _csv(path: Path, t_s, rate, sigma, names=("B", "G", "R")) -> Path:
     start = np.datetime64("2020-02-29T21:13:00", "ms")
     lines = ["time," + ",".join(names) + "," + ",".join(f"{b}_sigma" for b in names)]
     for i, t in enumerate(t_s):
-        stamp = str(start + np.timedelta64(int(round(t * 1000)), "ms")) + "Z"
+        stamp = str(start + np.timedelta64(round(t * 1000), "ms")) + "Z"
         lines.append(
             ",".join([stamp, *(f"{v:.6g}" for v in rate[i]), *(f"{v:.6g}" for v in sigma[i])])
         )
