@@ -8,8 +8,8 @@ the chi-square about the weighted band means that the model explains,
 ``P(f) = 1 - sum_b chi2_b(f) / sum_b chi2_0b`` ("standard" normalisation).
 
 Each band's ``chi2_b(f)`` comes from astropy's single-band
-:class:`~astropy.timeseries.LombScargle` (``nterms = K``, method ``chi2``, or ``fastchi2``
-for long series); the bands are
+:class:`~astropy.timeseries.LombScargle` (``nterms = K``, method ``chi2``, or for long series
+``fastchi2``, and ``fast`` (Press & Rybicki 1989) when ``K = 1``); the bands are
 combined with their ``chi2_0b`` as weights. (astropy's ``LombScargleMultiband(method="fast")``
 combines the same single-band powers but weights them by the sum of each band's squared powers,
 which is not the chi-square of the joint model; hence the combination here.)
@@ -118,7 +118,7 @@ def multiband_power(series: BandSeries, frequency_hz: F64, harmonics: int) -> F6
         if chi0[b] <= 0:
             continue
         ls = LombScargle(series.t_s[m], series.y[m], series.dy[m], nterms=harmonics)
-        method = "fastchi2" if m.sum() > FAST_ABOVE else "chi2"
+        method = "chi2" if m.sum() <= FAST_ABOVE else "fast" if harmonics == 1 else "fastchi2"
         total += chi0[b] * ls.power(frequency_hz, method=method, normalization="standard")
     return np.asarray(total / chi0.sum(), dtype=np.float64)
 

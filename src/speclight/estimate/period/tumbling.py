@@ -7,17 +7,21 @@ two-dimensional Fourier series (Pravec et al. 2005, Icarus 173, 108,
 doi:10.1016/j.icarus.2004.07.021, eq. 1; Kaasalainen 2001, A&A 376, 302). One period then
 fits only part of the light curve. The test:
 
-1. the harmonics ``1..2K`` of the rotation frequency ``f_1`` (and a cubic trend per band)
-   are fitted and subtracted;
-2. the residuals' multi-band periodogram on the same grid, away (``>= 1.5/span``) from the
-   harmonics of ``f_1``, gives a second frequency ``f_2``, refined as the first; it counts
+1. the harmonics ``1..H`` of the rotation frequency ``f_1`` (and a cubic trend per band)
+   are fitted and subtracted, ``H >= 2K`` grown while the next harmonic is significant (a
+   light curve with glints has many; their aliases would pass for a second frequency);
+2. the residuals' multi-band periodogram (one harmonic) on the same grid, away
+   (``>= 2.5/span``) from the harmonics of ``f_1``, gives a second frequency ``f_2``, refined
+   as the first, then with the mixed terms of step 3; it counts
    only with a false-alarm probability below 1 % (:mod:`.analytic_fap`, with the residuals'
    own noise level beside it, so a light curve that changes shape over the pass does not
    make a second frequency);
 3. a nested-model F-test: the harmonics of both frequencies (``K + 1`` of ``f_2``) against
    the same model plus their mixed combinations ``j f_1 + k f_2`` (``j != 0``, ``k >= 1``,
    ``|j| + k <= K + 1``; residual variance
-   from the data); tumbling when its p-value is below ``alpha`` (0.001).
+   from the data, and residuals correlated from epoch to epoch (a light curve that changes
+   over the pass) counted as fewer independent points); tumbling when its p-value is below
+   ``alpha`` (0.001).
 
 The combinations of largest amplitude are reported. Which of ``f_1`` and ``f_2`` is the
 rotation and which the precession frequency a light curve alone does not say.
@@ -103,14 +107,32 @@ def _fit(
     return chi2, npar, coefs, resid
 
 
-def _f_test(chi_r: float, p_r: int, chi_f: float, p_f: int, n: int) -> tuple[float, float]:
+def _f_test(
+    chi_r: float, p_r: int, chi_f: float, p_f: int, n: int, rho: float = 0.0
+) -> tuple[float, float]:
+    """F statistic and p-value of the nested models; residuals with lag-1 correlation
+    ``rho > 0`` count as ``n (1 - rho) / (1 + rho)`` independent points (the variance of an
+    AR(1) mean, Bartlett 1946; Zieba 2010, Meas. Sci. Rev. 10, 15): the statistic is divided
+    and the denominator's degrees of freedom multiplied by ``(1 - rho) / (1 + rho)``."""
     from scipy.stats import f as f_dist
 
     d1, d2 = p_f - p_r, n - p_f
     if d1 <= 0 or d2 <= 0 or chi_f <= 0:
         return float("nan"), 1.0
-    stat = max((chi_r - chi_f) / d1, 0.0) / (chi_f / d2)
-    return float(stat), float(f_dist.sf(stat, d1, d2))
+    shrink = (1 - rho) / (1 + rho) if rho > 0 else 1.0
+    stat = max((chi_r - chi_f) / d1, 0.0) / (chi_f / d2) * shrink
+    return float(stat), float(f_dist.sf(stat, d1, max(d2 * shrink, 1.0)))
+
+
+def _lag1(series: BandSeries, resid: F64) -> float:
+    """Lag-1 correlation of the normalised residuals, consecutive points of each band pooled
+    (at most 0.99)."""
+    num = den = 0.0
+    for b in range(series.n_bands):
+        r = resid[series.band == b] / series.dy[series.band == b]
+        num += float(np.sum(r[1:] * r[:-1]))
+        den += float(np.sum(r**2))
+    return min(num / den, 0.99) if den > 0 else 0.0
 
 
 def _harmonics_needed(series: BandSeries, f1: float, start: int, alpha: float) -> list[int]:
@@ -142,7 +164,7 @@ def _refined(series: BandSeries, f1: float, orders: list[int], f2: float, m: int
     half = 0.25 / series.span_s
     found = minimize_scalar(
         lambda f: _fit(series, f1, orders, f, m, True)[0],
-        bounds=(f2 - half, f2 + half), method="bounded", options={"xatol": 1e-4 * half},
+        bounds=(f2 - half, f2 + half), method="bounded", options={"xatol": 1e-3 * half},
     )  # fmt: skip
     return float(found.x)
 
@@ -170,7 +192,7 @@ def tumbling_test(
     orders = _harmonics_needed(series, rotation_hz, 2 * harmonics, alpha)
     _, _, _, resid = _fit(series, rotation_hz, orders, None, 0, False)
     rest = BandSeries(series.t_s, resid, series.dy, series.band, series.n_bands)
-    power = multiband_power(rest, frequency_hz, harmonics)
+    power = multiband_power(rest, frequency_hz, 1)
     width = EXCLUDE_WIDTH / series.span_s
     near = np.abs(frequency_hz[:, None] - rotation_hz * np.arange(1, len(orders) + 2)) < width
     power = np.where(np.any(near, axis=1) | ~np.isfinite(power), -np.inf, power)
@@ -178,8 +200,8 @@ def tumbling_test(
     if not np.any(np.isfinite(power)):
         return none
     k = int(local_maxima(power, 1)[0])
-    fap2 = analytic_fap(rest, frequency_hz, harmonics, float(frequency_hz[k])).fap(float(power[k]))
-    f2 = refine_peak(rest, float(frequency_hz[k]), list(range(1, harmonics + 1))).frequency_hz
+    fap2 = analytic_fap(rest, frequency_hz, 1, float(frequency_hz[k])).fap(float(power[k]))
+    f2 = refine_peak(rest, float(frequency_hz[k]), [1]).frequency_hz
     f2 = _reduced(f2, rotation_hz, float(frequency_hz[0]))
     none.second_fap, none.frequencies_hz = fap2, [rotation_hz, f2]
     if k == 0 or not fap2 < SECOND_FAP:
@@ -193,8 +215,9 @@ def tumbling_test(
     m = harmonics + 1
     f2 = _refined(series, rotation_hz, orders, f2, m)
     chi_r, p_r, _, _ = _fit(series, rotation_hz, orders, f2, m, False)
-    chi_f, p_f, coefs, _ = _fit(series, rotation_hz, orders, f2, m, True)
-    stat, p = _f_test(chi_r, p_r, chi_f, p_f, series.t_s.size)
+    chi_f, p_f, coefs, resid = _fit(series, rotation_hz, orders, f2, m, True)
+    rho = _lag1(series, resid)
+    stat, p = _f_test(chi_r, p_r, chi_f, p_f, series.t_s.size, rho)
     pairs = _combination_columns(series.t_s[:1], rotation_hz, f2, m, True)[1]
     amp = np.zeros(len(pairs))
     wsum = 0.0
