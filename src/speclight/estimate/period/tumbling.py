@@ -42,12 +42,16 @@ from speclight.estimate.period.periodogram import (
     local_maxima,
     multiband_power,
     refine_peak,
+    weighted_lstsq,
 )
 
 #: False-alarm probability below which the second frequency counts.
 SECOND_FAP = 0.01
 #: Combinations reported.
 N_COMBINATIONS = 6
+#: p-value of the mixed terms at the unrefined second frequency above which it is not
+#: refined (the refinement only lowers the chi-square of the full model).
+QUICK_P = 0.1
 #: Most harmonics of the first frequency fitted before the second is sought.
 MAX_HARMONICS = 24
 #: Half width of the frequencies left out around each harmonic, in units of ``1/span``.
@@ -99,7 +103,7 @@ def _fit(
             if mixed:
                 x = np.hstack([x, _combination_columns(t, f1, f2, m, True)[0]])
         w = 1.0 / series.dy[mk]
-        beta, *_ = np.linalg.lstsq(x * w[:, None], series.y[mk] * w, rcond=None)
+        beta = weighted_lstsq(x, series.y[mk], w)
         resid[mk] = series.y[mk] - x @ beta
         chi2 += float(np.sum((resid[mk] * w) ** 2))
         npar += x.shape[1]
@@ -213,7 +217,10 @@ def tumbling_test(
         none.text = f"one frequency: the residuals' best peak ({1 / f2:.6g} s) {why}"
         return none
     m = harmonics + 1
-    f2 = _refined(series, rotation_hz, orders, f2, m)
+    chi_r, p_r, _, _ = _fit(series, rotation_hz, orders, f2, m, False)
+    chi_f, p_f, _, resid = _fit(series, rotation_hz, orders, f2, m, True)
+    if _f_test(chi_r, p_r, chi_f, p_f, series.t_s.size, _lag1(series, resid))[1] < QUICK_P:
+        f2 = _refined(series, rotation_hz, orders, f2, m)  # worth refining
     chi_r, p_r, _, _ = _fit(series, rotation_hz, orders, f2, m, False)
     chi_f, p_f, coefs, resid = _fit(series, rotation_hz, orders, f2, m, True)
     rho = _lag1(series, resid)
