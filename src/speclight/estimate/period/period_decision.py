@@ -13,7 +13,10 @@ at P and at 2P through a nested-model F-test (Press et al., Numerical Recipes, 1
 * ``F = ((chi2_r - chi2_f) / (p_f - p_r)) / (chi2_f / (n - p_f))`` is F-distributed with
   ``(p_f - p_r, n - p_f)`` degrees of freedom when the two halves of the 2P fold are the same
   curve; its residual variance is estimated from the data, so mis-stated sigmas or a light
-  curve that changes over the pass make the test more cautious, not less;
+  curve that changes over the pass make the test more cautious, not less, and residuals
+  correlated from epoch to epoch (lag-1 correlation ``rho`` of the full model's) count as
+  ``n (1 - rho) / (1 + rho)`` points (:func:`nested_f_test`) in the test that doubles a
+  period (not in the one that halves it: each errs towards keeping the period found);
 * the halves differ when the p-value is below ``alpha`` (0.001);
 * a fold period is tested only when it fits at least 3 times into the span (with fewer
   cycles the odd harmonics of the long period fit the slow change of the light curve over
@@ -65,23 +68,43 @@ class HalvesTest:
     differ: bool
 
 
-def halves_test(series: BandSeries, period_s: float, harmonics: int) -> HalvesTest:
-    """Do the two halves of the light curve folded at ``period_s`` differ? (F-test)."""
+def nested_f_test(
+    chi_r: float, p_r: int, chi_f: float, p_f: int, n: int, rho: float = 0.0
+) -> tuple[float, float]:
+    """F statistic and p-value of nested least-squares models (chi-squares ``chi_r``,
+    ``chi_f`` with ``p_r < p_f`` parameters, ``n`` points); residuals with lag-1 correlation
+    ``rho > 0`` count as ``n (1 - rho) / (1 + rho)`` independent points (the variance of the
+    mean of an AR(1) series, Bartlett 1946, J. R. Stat. Soc. Suppl. 8, 27): the statistic
+    is divided, and the denominator's degrees of freedom multiplied, by that factor."""
     from scipy.stats import f as f_dist
 
+    d1, d2 = p_f - p_r, n - p_f
+    if d1 <= 0 or d2 <= 0 or chi_f <= 0:
+        return float("nan"), float("nan")
+    shrink = (1 - rho) / (1 + rho) if rho > 0 else 1.0
+    stat = max((chi_r - chi_f) / d1, 0.0) / (chi_f / d2) * shrink
+    return float(stat), float(f_dist.sf(stat, d1, max(d2 * shrink, 1.0)))
+
+
+def halves_test(
+    series: BandSeries, period_s: float, harmonics: int, correlated: bool = False
+) -> HalvesTest:
+    """Do the two halves of the light curve folded at ``period_s`` differ? (F-test; with
+    ``correlated``, counting the full model's residual correlation, :func:`nested_f_test`:
+    harder to call them different, used before doubling a period)."""
+    from speclight.estimate.period.periodogram import residual_lag1_correlation
+
     freq = 1.0 / period_s
-    full, p_full, _ = harmonic_chi2(
-        series, freq, list(range(1, 2 * harmonics + 1)), trend_degree=TREND_DEGREE
-    )
+    orders = list(range(1, 2 * harmonics + 1))
+    full, p_full, coefs = harmonic_chi2(series, freq, orders, trend_degree=TREND_DEGREE)
     reduced, p_red, _ = harmonic_chi2(
         series, freq, list(range(2, 2 * harmonics + 1, 2)), trend_degree=TREND_DEGREE
     )
-    d1, d2 = p_full - p_red, series.t_s.size - p_full
-    if d2 <= 0 or full <= 0:
-        return HalvesTest(period_s, float("nan"), float("nan"), False)
-    stat = max((reduced - full) / d1, 0.0) / (full / d2)
-    p = float(f_dist.sf(stat, d1, d2))
-    return HalvesTest(period_s, float(stat), p, p < ALPHA)
+    rho = 0.0
+    if correlated:
+        rho, _ = residual_lag1_correlation(series, freq, orders, coefs, trend_degree=TREND_DEGREE)
+    stat, p = nested_f_test(reduced, p_red, full, p_full, series.t_s.size, rho)
+    return HalvesTest(period_s, stat, p, bool(p < ALPHA))
 
 
 #: Prominence of a maximum, as a fraction of the folded curve's peak-to-peak range.
@@ -162,7 +185,7 @@ def rotation_period(
             "rotation period is taken as the photometric period"
         )
         return RotationDecision(p_ph, p_ph, factor, text, tests)
-    double = halves_test(series, 2 * p_ph, harmonics)
+    double = halves_test(series, 2 * p_ph, harmonics, correlated=True)
     tests.append(double)
     if double.differ:
         text = (

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from speclight.estimate.period.period_decision import nested_f_test
 from speclight.estimate.period.periodogram import (
     F64,
     TREND_DEGREE,
@@ -111,23 +112,6 @@ def _fit(
     return chi2, npar, coefs, resid
 
 
-def _f_test(
-    chi_r: float, p_r: int, chi_f: float, p_f: int, n: int, rho: float = 0.0
-) -> tuple[float, float]:
-    """F statistic and p-value of the nested models; residuals with lag-1 correlation
-    ``rho > 0`` count as ``n (1 - rho) / (1 + rho)`` independent points (the variance of an
-    AR(1) mean, Bartlett 1946; Zieba 2010, Meas. Sci. Rev. 10, 15): the statistic is divided
-    and the denominator's degrees of freedom multiplied by ``(1 - rho) / (1 + rho)``."""
-    from scipy.stats import f as f_dist
-
-    d1, d2 = p_f - p_r, n - p_f
-    if d1 <= 0 or d2 <= 0 or chi_f <= 0:
-        return float("nan"), 1.0
-    shrink = (1 - rho) / (1 + rho) if rho > 0 else 1.0
-    stat = max((chi_r - chi_f) / d1, 0.0) / (chi_f / d2) * shrink
-    return float(stat), float(f_dist.sf(stat, d1, max(d2 * shrink, 1.0)))
-
-
 def _lag1(series: BandSeries, resid: F64) -> float:
     """Lag-1 correlation of the normalised residuals, consecutive points of each band pooled
     (at most 0.99)."""
@@ -146,7 +130,7 @@ def _harmonics_needed(series: BandSeries, f1: float, start: int, alpha: float) -
     chi, npar, _, _ = _fit(series, f1, list(range(1, h + 1)), None, 0, False)
     while h < MAX_HARMONICS:
         chi2, npar2, _, _ = _fit(series, f1, list(range(1, h + 2)), None, 0, False)
-        if _f_test(chi, npar, chi2, npar2, series.t_s.size)[1] >= alpha:
+        if not nested_f_test(chi, npar, chi2, npar2, series.t_s.size)[1] < alpha:
             break
         h, chi, npar = h + 1, chi2, npar2
     return list(range(1, h + 1))
@@ -219,12 +203,12 @@ def tumbling_test(
     m = harmonics + 1
     chi_r, p_r, _, _ = _fit(series, rotation_hz, orders, f2, m, False)
     chi_f, p_f, _, resid = _fit(series, rotation_hz, orders, f2, m, True)
-    if _f_test(chi_r, p_r, chi_f, p_f, series.t_s.size, _lag1(series, resid))[1] < QUICK_P:
+    if nested_f_test(chi_r, p_r, chi_f, p_f, series.t_s.size, _lag1(series, resid))[1] < QUICK_P:
         f2 = _refined(series, rotation_hz, orders, f2, m)  # worth refining
     chi_r, p_r, _, _ = _fit(series, rotation_hz, orders, f2, m, False)
     chi_f, p_f, coefs, resid = _fit(series, rotation_hz, orders, f2, m, True)
     rho = _lag1(series, resid)
-    stat, p = _f_test(chi_r, p_r, chi_f, p_f, series.t_s.size, rho)
+    stat, p = nested_f_test(chi_r, p_r, chi_f, p_f, series.t_s.size, rho)
     pairs = _combination_columns(series.t_s[:1], rotation_hz, f2, m, True)[1]
     amp = np.zeros(len(pairs))
     wsum = 0.0
