@@ -13,7 +13,7 @@ from speclight.estimate.period.period_decision import RotationDecision
 from speclight.estimate.period.period_fap import BootstrapMaxima
 from speclight.estimate.period.periodogram import F64, BandSeries, Peak
 from speclight.estimate.period.synodic import SynodicCorrection
-from speclight.estimate.period.tumbling import TumblingTest
+from speclight.estimate.period.two_frequencies import TumblingTest
 
 #: False-alarm probability below which a period is detected.
 DETECTION_FAP = 0.01

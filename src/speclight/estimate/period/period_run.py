@@ -18,7 +18,7 @@ Steps (``docs/period.md``):
    power rising beyond it; otherwise no period, and where the light curve varies slowly a
    lower bound (:mod:`.period_result`);
 5. photometric or rotation period (:mod:`.period_decision`), then the two-frequency test
-   of a tumbler (:mod:`.tumbling`);
+   of a tumbler (:mod:`.two_frequencies`);
 6. synodic correction where the geometry is known (:mod:`.synodic`): from the dataset's
    ``attitude_quaternion`` and ``phase_vector_body`` or the scenario's geometry at the
    measured epochs; the spin axis from a scenario with ``attitude.model: spin``. Applied
@@ -61,7 +61,7 @@ from speclight.estimate.period.periodogram import (
     refine_peak,
 )
 from speclight.estimate.period.synodic import sidereal_period
-from speclight.estimate.period.tumbling import tumbling_test
+from speclight.estimate.period.two_frequencies import tumbling_test
 from speclight.scenario import LoadedScenario
 
 SynodicMode = Literal["auto", "report", "bisector"]

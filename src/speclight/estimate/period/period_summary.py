@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from speclight.estimate.period.period_decision import ALPHA
 
-if TYPE_CHECKING:
-    from speclight.estimate.period.period_result import PeriodResult
+#: A :class:`.period_result.PeriodResult` (not imported: that module imports this one).
+PeriodResult = Any
 
 
 def _fap_method(r: PeriodResult) -> str:
