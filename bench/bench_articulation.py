@@ -1,4 +1,7 @@
-"""Cost of articulated parts: the starlink-v1.5 pass rendered with its Sun-tracking array.
+"""Cost of articulated parts: the starlink-v1.5 pass rendered with a Sun-tracking array.
+
+The array turns about the nadir axis through its centre on a velocity-aligned bus (the
+example before issue 24; the example's bus now yaws instead, and its array is fixed).
 
 Run: ``PYTHONPATH=src .venv/bin/python bench/bench_articulation.py``
 
@@ -23,6 +26,18 @@ BASE = {
     "time.start": "2024-03-20T23:56:00Z",
     "time.stop": "2024-03-21T00:00:59Z",
     "time.step_s": 1.0,
+    "attitude": {"model": "nadir"},
+    "target.shape": {"builtin": "bus_array"},
+    "target.articulation": {
+        "array": {
+            "axis": [0, 0, 1],
+            "hinge_point_m": [0, 0, -1.75],
+            "normal": [1, 0, 0],
+            "mode": "sun_tracking",
+        }
+    },
+    "target.articulation_step_deg": 0.25,
+    "illumination.earthshine": None,
 }
 
 

@@ -122,7 +122,18 @@ def cost() -> None:
           f"simulation {t_sim:.2f} s, render pass with 3 derivatives {t_pass:.2f} s")  # fmt: skip
     array = {"bsdf": "ggx", "roughness": 0.1, "reflectance": 0.3}
     for earthshine in (None, {"albedo": 0.3, "samples": 64}):
-        values = {"target.materials.array": array, "illumination.earthshine": earthshine}
+        values = {
+            "target.materials.array": array,
+            "illumination.earthshine": earthshine,
+            # the array turned about nadir on a velocity-aligned bus (the example before
+            # issue 24, whose bus now yaws instead): an articulated target
+            "attitude": {"model": "nadir"},
+            "target.shape": {"builtin": "bus_array"},
+            "target.articulation": {
+                "array": {"axis": [0, 0, 1], "hinge_point_m": [0, 0, -1.75], "normal": [1, 0, 0]}
+            },
+            "target.articulation_step_deg": 0.25,
+        }
         loaded = replace_fields(load_example("starlink-v1.5"), values)
         t_sim, t_pass, refl = _time_pass(loaded, ["array"], [0.1])
         cells = 0 if refl.cells is None else refl.cells.epoch.size

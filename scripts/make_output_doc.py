@@ -73,10 +73,7 @@ def page() -> str:
         "| name | dimensions | units | meaning |",
         "|---|---|---|---|",
     ]
-    for name, info in schema.VARIABLES.items():
-        dims = ", ".join(info.dims)
-        meaning = f"{info.long_name} ({info.comment})" if info.comment else info.long_name
-        lines.append(f"| `{name}` | {dims or '(scalar)'} | {info.units} | {meaning} |")
+    lines += _rows(schema.VARIABLES)
     for name, dims in schema.BOUNDS.items():
         lines.append(f"| `{name}` | {', '.join(dims)} | (its coordinate's) | cell bounds |")
     dtype = schema.np.dtype(schema.FLAG_DTYPE).name
@@ -91,7 +88,30 @@ def page() -> str:
     ]
     for bit, meaning in schema.FLAG_MEANINGS.items():
         lines.append(f"| {bit} | `{meaning}` |")
+    lines += [
+        "",
+        "## `speclight compare` (CMP.nc): what an `object` column adds",
+        "",
+        "CMP.nc is described in docs/compare.md; an `object` column of the observations adds",
+        "these (dimension `obs`: one per row; `object`: one per object, first-seen order).",
+        "",
+        "| name | dimensions | units | meaning |",
+        "|---|---|---|---|",
+    ]
+    for name, attrs in schema.COMPARE_COORDINATES.items():
+        lines.append(f"| `{name}` | {name} | {attrs.get('units', '')} | {attrs['long_name']} |")
+    lines += _rows(schema.COMPARE_VARIABLES)
     return "\n".join(lines) + "\n"
+
+
+def _rows(table: dict[str, schema.VariableInfo]) -> list[str]:
+    """One table row per variable: name, dimensions, units, long name (and comment)."""
+    rows = []
+    for name, info in table.items():
+        dims = ", ".join(info.dims)
+        meaning = f"{info.long_name} ({info.comment})" if info.comment else info.long_name
+        rows.append(f"| `{name}` | {dims or '(scalar)'} | {info.units} | {meaning} |")
+    return rows
 
 
 if __name__ == "__main__":

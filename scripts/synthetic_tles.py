@@ -1,4 +1,4 @@
-"""Synthetic two-line element sets for the built-in examples (starlink-v1.5, gnss-*, geo-*).
+"""Synthetic two-line element sets for the built-in examples (starlink-*, gnss-*, geo-*).
 
 No real element set of these satellites is shipped with speclight, so the examples fly
 synthetic orbits with the elements below (SGP4 mean elements, no drag), written as TLEs with
@@ -70,11 +70,24 @@ def make_tle(e: Elements) -> tuple[str, str, str]:
 #: The examples' orbits. starlink-v1.5: a Starlink shell-1-like orbit (550 km, 53 deg) passing
 #: near the zenith of Cerro Pachon in evening twilight; gnss-meo: a GPS-like orbit (20,180 km,
 #: 55 deg) above Stuttgart for two hours of an October night; geo-arrays: a geostationary
-#: orbit over 10.3 deg E (south of Stuttgart at 34 deg elevation) outside eclipse season.
+#: orbit over 10.3 deg E (south of Stuttgart at 34 deg elevation) outside eclipse season;
+#: starlink-v2-mini: a Starlink V2-mini-like orbit (530 km, 43 deg, a second-generation shell)
+#: passing near the zenith of La Palma in evening twilight.
 SYNTHETIC: tuple[Elements, ...] = (
     Elements("STARLINK-LIKE", 99901, "2024-03-20T12:00:00Z", 550.0, 53.0, 264.0, 1e-4, 90.0, 300.0),
     Elements("GPS-LIKE", 99902, "2024-10-15T00:00:00Z", 20180.0, 55.0, 255.0, 5e-3, 0.0, 180.0),
     Elements("GEO-LIKE", 99903, "2024-10-15T00:00:00Z", 35786.0, 0.05, 0.0, 2e-4, 0.0, 32.0),
+    Elements(
+        "STARLINK-V2-MINI-LIKE",
+        99904,
+        "2024-09-15T12:00:00Z",
+        530.0,
+        43.0,
+        250.0,
+        1e-4,
+        90.0,
+        195.0,
+    ),
 )
 
 if __name__ == "__main__":

@@ -371,6 +371,35 @@ COORDINATES: dict[str, dict[str, str]] = {
     },
 }
 
+#: Variables of ``speclight compare``'s CMP.nc that an ``object`` column of the observations
+#: adds (docs/compare.md): one per row (``obs``) and one per object (``object``, first-seen
+#: order). The statistics count the object's finite residuals only.
+OBS, OBJECT = ("obs",), ("object",)
+COMPARE_VARIABLES: dict[str, VariableInfo] = {
+    "object_id": V(OBS, "", "object (satellite) of the observation, from the object column"),
+    "n_per_object": V(OBJECT, "1", "number of finite residuals of the object"),
+    "residual_mean_per_object": V(OBJECT, MAG, "mean residual (observed - simulated)"),
+    "residual_rms_per_object": V(OBJECT, MAG, "root mean square residual"),
+    "residual_median_abs_per_object": V(OBJECT, MAG, "median absolute residual"),
+    "pearson_r_per_object": V(
+        OBJECT,
+        "1",
+        "Pearson correlation coefficient of observed and simulated magnitudes",
+        comment="NaN for fewer than 2 residuals or constant magnitudes",
+    ),
+    "chi_square_per_object": V(
+        OBJECT,
+        "1",
+        "chi-square per pair: sum((simulated - observed)^2 / observed) / n",
+        comment="over the magnitudes themselves, as docs/compare.md defines it; NaN where "
+        "an observed magnitude is <= 0",
+    ),
+}
+#: Coordinates of CMP.nc that an ``object`` column adds.
+COMPARE_COORDINATES: dict[str, dict[str, str]] = {
+    "object": {"long_name": "object (satellite) name or id, as in the object column"},
+}
+
 #: CF boundary variables (no attributes of their own: they take their coordinate's units).
 BOUNDS: dict[str, tuple[str, ...]] = {"range_bin_bounds": ("range_bin", "nv")}
 
@@ -423,10 +452,13 @@ def flag_attributes() -> dict[str, Any]:
     }
 
 
-def attrs(name: str) -> dict[str, str]:
-    """CF attributes (units, long name, standard name) of an output variable."""
-    info = VARIABLES[name]
-    out = {"units": info.units, "long_name": info.long_name}
+def attrs(name: str, table: dict[str, VariableInfo] | None = None) -> dict[str, str]:
+    """CF attributes (units, long name, standard name) of an output variable of ``table``
+    (default :data:`VARIABLES`; :data:`COMPARE_VARIABLES` for CMP.nc); no ``units`` where
+    it has none (a name)."""
+    info = (VARIABLES if table is None else table)[name]
+    out = {"units": info.units, "long_name": info.long_name} if info.units else {}
+    out.setdefault("long_name", info.long_name)
     if info.standard_name:
         out["standard_name"] = info.standard_name
     if info.comment:

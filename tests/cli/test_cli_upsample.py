@@ -3,14 +3,18 @@
 The band responses are computed here independently of speclight (``synthetic_mixture``: the
 Gaussian bands bin-averaged with the normal CDF, times the scenario's constant optics
 transmission and a linear QE table, whose bin averages are its values at the bin centres),
-and the photon-weighted band averages of eq. 3 (Nussbaum et al. 2022) of the written CSV
-must equal the albedos to 1e-3, the accuracy upsampling promises (ALBEDO_CLIP and the fit
-tolerance are far below it). A grey input must give the flat spectrum.
+and the band averages of the written CSV weighted by the detected photons of the Sun
+(Nussbaum et al. 2022, eq. 5; the scenario's atmosphere is off, so the source at the aperture
+is the ASTM E490-00a table itself, read and bin-averaged here with numpy) must equal the
+albedos to 1e-3, the accuracy upsampling promises (ALBEDO_CLIP and the fit tolerance are far
+below it); the flat-source averages of eq. 3 miss them by 7e-3 in the bluest band (issue 25
+item 6: fit and upsample share this definition). A grey input must give the flat spectrum.
 """
 
 from __future__ import annotations
 
 import json
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -34,11 +38,24 @@ def _qe(wl: np.ndarray) -> np.ndarray:
     return 0.4 + 0.5 * (wl - 300.0) / 800.0  # the table below: linear from 300 to 1100 nm
 
 
+def _sun_bins() -> np.ndarray:
+    """ASTM E490-00a [W m-2 nm-1] averaged over the grid's 5-nm bins (the shipped table,
+    linearly interpolated and integrated by the trapezoid rule on a 0.025-nm grid)."""
+    path = resources.files("speclight").joinpath("data", "solar", "astm_e490_00a_am0.csv")
+    table = np.loadtxt(path.read_text().splitlines(), delimiter=",", comments="#", skiprows=3)
+    edges = np.concatenate([[WL[0] - 2.5], WL + 2.5])
+    fine = np.linspace(edges[0], edges[-1], 200 * WL.size + 1)
+    f = np.interp(fine, table[:, 0], table[:, 1])
+    cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(fine))])
+    return np.asarray(np.diff(np.interp(edges, fine, cumulative)) / np.diff(edges))
+
+
 @pytest.fixture
 def scenario(tmp_path: Path) -> Path:
     (tmp_path / "qe.csv").write_text("wavelength_nm,qe\n300,0.4\n1100,0.9\n")
     data = yaml.safe_load(example_text("calsphere"))
     data["spectrum"] = {"min_nm": float(WL[0]), "max_nm": float(WL[-1]), "step_nm": 5.0}
+    data["atmosphere"] = {"model": "none"}
     data["instrument"]["optics_transmission"] = OPTICS
     data["instrument"]["detector_qe"] = "qe.csv"
     data["instrument"]["bands"] = [
@@ -63,7 +80,7 @@ def _read_csv(path: Path) -> tuple[list[str], np.ndarray]:
     lines = path.read_text().splitlines()
     comments = [line for line in lines if line.startswith("#")]
     body = [line for line in lines if not line.startswith("#")]
-    assert body[0] == "wavelength_nm,reflectance"
+    assert body[0] in ("wavelength_nm,reflectance", "wavelength_nm,reflectance,reflectance_std")
     return comments, np.array([[float(v) for v in line.split(",")] for line in body[1:]])
 
 
@@ -77,11 +94,19 @@ def test_spectrum_reproduces_the_albedos(tmp_path: Path, scenario: Path) -> None
     comments, table = _read_csv(out)
     np.testing.assert_allclose(table[:, 0], WL)  # the scenario's grid
     response = gaussian_responses() * OPTICS * _qe(WL)
-    got = band_average(table[:, 1], response)
+    got = band_average(table[:, 1], response, source=_sun_bins())
     np.testing.assert_allclose(got, list(albedo.values()), atol=ALBEDO_TOLERANCE)
+    flat = band_average(table[:, 1], response)  # eq. 3's flat source: another number
+    assert np.max(np.abs(flat - list(albedo.values()))) > 5 * ALBEDO_TOLERANCE
+    assert any("# weighting:" in c and "mean Sun" in c for c in comments)
+    assert table.shape[1] == 3 and np.all(table[:, 2] > 0)  # albedo_std 0.01 given
     assert np.all((table[:, 1] >= 0) & (table[:, 1] <= 1))
     assert any("fit: converged" in c for c in comments)
-    assert "notice" not in result.stdout
+    # issue 25 item 6: six albedos fix six numbers, the rest is said to be a smooth fill
+    assert "did not converge" not in result.stdout
+    assert "not a measurement" in result.stdout
+    assert any(c.startswith("# underdetermined: 6 band albedos") for c in comments)
+    assert any(c.startswith("# measured range:") for c in comments)
 
 
 def test_grey_albedos_give_a_flat_spectrum(tmp_path: Path, scenario: Path) -> None:
@@ -91,6 +116,26 @@ def test_grey_albedos_give_a_flat_spectrum(tmp_path: Path, scenario: Path) -> No
     assert result.exit_code == 0, result.output
     _, table = _read_csv(out)
     np.testing.assert_allclose(table[:, 1], 0.42, atol=1e-9)  # 9 decimals in the CSV
+
+
+def test_without_albedo_std_no_spread_and_null_is_unconstrained(
+    tmp_path: Path, scenario: Path
+) -> None:
+    albedo = dict(zip(BANDS, [0.3, 0.4, 0.5, 0.6, 0.6, 0.6], strict=True))
+    bare = tmp_path / "bare.json"
+    bare.write_text(json.dumps({"bands": {b: {"albedo": a} for b, a in albedo.items()}}))
+    out = tmp_path / "bare.csv"
+    assert runner.invoke(app, ["upsample", str(scenario), str(bare), "-o", str(out)]).exit_code == 0
+    comments, table = _read_csv(out)
+    assert table.shape[1] == 2 and any("reflectance_std: none" in c for c in comments)
+    fit = _fit(tmp_path, albedo)
+    payload = json.loads(fit.read_text())
+    payload["bands"]["G-900/25"]["albedo_std"] = None  # fit: "not constrained"
+    fit.write_text(json.dumps(payload))
+    out = tmp_path / "null.csv"
+    assert runner.invoke(app, ["upsample", str(scenario), str(fit), "-o", str(out)]).exit_code == 0
+    _, table = _read_csv(out)
+    assert np.all(np.isinf(table[:, 2]))  # every wavelength depends on every band's albedo
 
 
 def test_plot_is_written(tmp_path: Path, scenario: Path) -> None:
@@ -115,6 +160,7 @@ def test_plot_is_written(tmp_path: Path, scenario: Path) -> None:
         ("no-bands", 'no "bands" mapping'),
         ("deep", "nested deeper than Python's JSON reader goes"),
         ("digits", "an integer of more than 4300 digits"),
+        ("std-negative", "bands.G-520/25.albedo_std = -0.01 must be a number >= 0"),
         ("exists", "exists; choose another name or pass --force"),
         ("output-is-fit", "is the fit file"),
         ("plot-is-output", "is the output"),
@@ -145,6 +191,10 @@ def test_bad_input_exits_2_and_writes_nothing(
         fit.write_text("[" * 100_000 + "]" * 100_000)
     elif case == "digits":
         fit.write_text('{"bands": {"G-520/25": {"albedo": ' + "1" * 5001 + "}}}")
+    elif case == "std-negative":
+        payload = json.loads(fit.read_text())
+        payload["bands"]["G-520/25"]["albedo_std"] = -0.01
+        fit.write_text(json.dumps(payload))
     elif case == "exists":
         out.write_text("precious")
     elif case == "output-is-fit":

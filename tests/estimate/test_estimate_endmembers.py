@@ -179,7 +179,7 @@ def test_k_of_one_is_the_largest_sample_or_the_mean(pure_and_mixed):
         (np.eye(3), 2.0, "atgp", "k", "integer"),
         (np.eye(3), True, "atgp", "k", "integer"),
         (np.array([[1.0, 0, 0], [2, 0, 0], [3, 0, 0]]), 2, "atgp", "k", "span only 1"),
-        (np.eye(3), 2, "ppi", "method", "choices: atgp, pca, nfindr"),
+        (np.eye(3), 2, "ppi", "method", "choices: purest, atgp, pca, nfindr"),
         (np.eye(3), 2, "nfinder", "method", "did you mean 'nfindr'"),
     ],
 )

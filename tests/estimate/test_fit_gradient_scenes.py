@@ -10,8 +10,9 @@ References, as in test_fit_gradient.py:
 * the fit: recovery of the roughness the noisy data were simulated with (Poisson draws,
   fixed seed), from a start a factor 4 away, to within 3 of the fit's standard deviations.
 
-Scenes: the ``starlink-v1.5`` example (a Sun-tracking array about the nadir axis, 0.25 deg
-pose steps) with its array made GGX (its shipped materials are lab-measured tables, which
+Scenes: the ``starlink-v1.5`` example's pass with its array turned to the Sun about the nadir
+axis (a Sun-tracking articulation, 0.25 deg pose steps, on a velocity-aligned bus: the
+example before issue 24) and made GGX (its shipped materials are lab-measured tables, which
 have no roughness), and the spinning Beckmann cube of test_fit_gradient.py with Earthshine.
 """
 
@@ -31,12 +32,18 @@ from speclight.simulation import simulate
 
 DATA = Path(__file__).parent / "data"
 ARRAY = {"bsdf": "ggx", "roughness": 0.1, "reflectance": 0.3}
+SUN_TRACKING = {"axis": [0, 0, 1], "hinge_point_m": [0, 0, -1.75], "normal": [1, 0, 0]}
 
 
 def _starlink(earthshine=False, noise=False):
     d = yaml.safe_load(example_text("starlink-v1.5"))
     d["render"]["resolution_px"] = 32
+    d["attitude"] = {"model": "nadir"}
+    d["target"]["shape"] = {"builtin": "bus_array"}
+    d["target"]["articulation"] = {"array": dict(SUN_TRACKING)}
+    d["target"]["articulation_step_deg"] = 0.25
     d["target"]["materials"]["array"] = dict(ARRAY)
+    d["illumination"] = {"sun": True}
     if earthshine:
         d["illumination"]["earthshine"] = {"albedo": 0.3, "samples": 16}
     if noise:

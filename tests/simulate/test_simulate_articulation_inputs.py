@@ -7,12 +7,18 @@ import yaml
 
 import speclight
 from speclight.errors import InputError
-from speclight.scenario import load_example
+
+#: The array turned toward the Sun about the nadir axis through its centre (the starlink-v1.5
+#: example before issue 24, whose bus now yaws instead): the array centred above the bus.
+SUN_TRACKING = {"axis": [0, 0, 1], "hinge_point_m": [0, 0, -1.75], "normal": [1, 0, 0]}
 
 
 def _starlink(articulation):
     d = yaml.safe_load(speclight.scenario.example_text("starlink-v1.5"))
+    d["attitude"] = {"model": "nadir"}
+    d["target"]["shape"] = {"builtin": "bus_array"}
     d["target"]["articulation"] = articulation
+    d["illumination"] = {"sun": True}
     return d
 
 
@@ -43,10 +49,9 @@ def test_tabulated_angle_turns_the_array(tmp_path):
     # The array (normal +x at angle 0) held at 0 and at 90 deg about z by a table: the two
     # runs differ, and the sun-tracking run equals the table run whose angle is the tracking
     # angle (atan2(s_y, s_x) for axis z and normal +x) at that epoch.
-    loaded = load_example("starlink-v1.5")
     t0 = "2024-03-20T23:59:30Z"
     over = {"time.start": t0, "time.stop": t0, "render.resolution_px": 32}
-    track = speclight.simulate(loaded, over)
+    track = speclight.simulate(_starlink({"array": SUN_TRACKING}), over)
     s = track.geometry.sun_direction_body[0]
     angle = float(np.degrees(np.arctan2(s[1], s[0])))
     f = tmp_path / "angles.csv"

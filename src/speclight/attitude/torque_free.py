@@ -29,7 +29,6 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.integrate import solve_ivp
 
 from speclight.attitude.fixed import validate_quaternion
 from speclight.attitude.inertia import principal_frame
@@ -85,6 +84,8 @@ def ivp_principal(
         if end == 0.0:
             out[sel] = y0
             continue
+        from scipy.integrate import solve_ivp  # 0.3 s of import: only for method='ivp'
+
         sol = solve_ivp(
             rhs, (0.0, end), y0, method="DOP853", rtol=rtol, atol=atol, dense_output=True
         )

@@ -100,7 +100,11 @@ def compare(
         Path, typer.Argument(help="Scenario YAML: target, attitude, orbit (or observed: true).")
     ],
     observations: Annotated[
-        Path, typer.Argument(help="OBSERVATIONS CSV: time, site, magnitude, sigma, band.")
+        Path,
+        typer.Argument(
+            help="OBSERVATIONS CSV: time, site, magnitude, sigma, band (optional: position, "
+            "object)."
+        ),
     ],
     output: Annotated[str, output_option("FILE", "Output NetCDF (CMP.nc).")] = "compare.nc",
     plot_file: Plot = None,
@@ -108,7 +112,9 @@ def compare(
 ) -> None:
     """Simulate the scenario at every observed epoch and site (one run per site) and write
     observed, simulated and residual magnitudes with the geometry of each observation, and
-    residual statistics (also printed). See docs/compare.md.
+    residual statistics with Pearson R and chi-square (also printed), per object too where
+    the file has an object column (with orbit: {observed: true} each object's trajectory
+    comes from its own rows). See docs/compare.md.
 
     Example: speclight compare calsphere.yaml observed.csv -o cmp.nc --plot cmp.png
     """
@@ -127,7 +133,7 @@ def compare(
             ),
             data=lambda r: dataset_file(r.dataset), figure=_compare_figure,
         )  # fmt: skip
-        for line in [*result.notes, *summary_lines(result.dataset.attrs)]:
+        for line in [*result.notes, *summary_lines(result.dataset)]:
             typer.echo(line)
         say_wrote(output, plot_file)
 

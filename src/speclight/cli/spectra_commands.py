@@ -43,13 +43,20 @@ def upsample(
     force: Force = False,
 ) -> None:
     """Reflectance spectrum from band albedos: a sigmoid of a polynomial of order n-1 whose
-    photon-weighted band averages (band x optics x QE) equal the albedos (paper eq. 3-4).
+    band averages equal the albedos (paper eq. 3-4), weighted as fit's albedos are: the
+    detected photons of the mean Sun over the scenario's pass (Sun x atmosphere x band x
+    optics x QE).
 
-    Writes CSV wavelength_nm,reflectance on the scenario's wavelength grid.
+    Writes CSV wavelength_nm,reflectance on the scenario's wavelength grid, and
+    reflectance_std (propagated from bands.BAND.albedo_std) where the JSON has it.
     """
 
     def run() -> None:
-        from speclight.estimate.spectra.upsample_run import read_fit_albedos, spectrum_csv
+        from speclight.estimate.spectra.upsample_run import (
+            read_fit_albedo_std,
+            read_fit_albedos,
+            spectrum_csv,
+        )
         from speclight.estimate.spectra.upsample_run import upsample_scenario as upsample_from
         from speclight.scenario import load_scenario
 
@@ -61,10 +68,17 @@ def upsample(
         result = write_products(
             output, plot_file, force, {"scenario file": scenario, "fit file": fit},
             compute=lambda: upsample_from(
-                load_scenario(scenario), read_fit_albedos(fit), str(fit)
+                load_scenario(scenario), read_fit_albedos(fit), str(fit),
+                albedo_std=read_fit_albedo_std(fit),
             ),
             data=lambda r: spectrum_csv(r, str(scenario), str(fit)).encode(), figure=draw,
         )  # fmt: skip
+        n_bands = len(result.spectrum.albedo)
+        typer.echo(
+            f"notice: {n_bands} band albedos fix {n_bands} numbers of the spectrum: between "
+            "and outside the bands it is the smoothest fit, not a measurement (the CSV header "
+            "gives the measured range)"
+        )
         if not result.spectrum.converged:
             typer.echo(
                 "notice: the fit did not converge: the spectrum reproduces the albedos only to "
@@ -86,7 +100,11 @@ def unmix(
     ] = None,
     extract: Annotated[
         str | None,
-        typer.Option("--extract", help="Extract endmembers from the data: atgp, pca or nfindr."),
+        typer.Option(
+            "--extract",
+            help="Extract endmembers from the data: purest (the purest epochs above the "
+            "noise; recommended), atgp, pca or nfindr.",
+        ),
     ] = None,
     n: Annotated[int | None, typer.Option("--n", help="Number of endmembers to extract.")] = None,
     method: Annotated[str, method_option("ls, nnls, nnls-norm (default) or fcls.")] = "nnls-norm",

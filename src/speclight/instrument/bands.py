@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.special import ndtr
 
 from speclight.errors import InputError, did_you_mean
+from speclight.instrument.speclite_files import read_speclite_filter, speclite_filter_folder
 from speclight.instrument.tables import read_table, sort_unique, value_to_fraction, wavelength_to_nm
 from speclight.wavelength_grid import bin_average, bin_edges_nm, check_wavelength_grid
 
@@ -90,9 +91,8 @@ def speclite_filter_names() -> tuple[str, ...]:
         If speclite is not installed (the message says how to install it).
     """
     _require_speclite("a speclite filter band")
-    from speclite.filters import get_path_of_data_file
-
-    folder = Path(get_path_of_data_file("filters/bessell-V.ecsv")).parent
+    folder = speclite_filter_folder()
+    assert folder is not None  # speclite is installed (checked above)
     return tuple(sorted(p.stem for p in folder.glob("*.ecsv")))
 
 
@@ -147,10 +147,9 @@ def _native(band: Band) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The band's own sampling: wavelength [nm], response."""
     if band.kind == "filter":
         _require_speclite(f"the speclite filter band {band.name!r}")
-        from speclite.filters import load_filter
-
-        f = load_filter(band.filter_name)
-        return np.asarray(f.wavelength, dtype=np.float64) / 10.0, np.asarray(f.response, float)
+        folder = speclite_filter_folder()
+        assert folder is not None and band.filter_name is not None
+        return read_speclite_filter(folder / f"{band.filter_name}.ecsv")
     assert band.file is not None
     src = str(band.file)
     header, data = read_table(band.file, "instrument.bands")

@@ -9,6 +9,9 @@ is replaced only when ``force`` is set. The memory needed is about twice the fil
 
 from __future__ import annotations
 
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -40,9 +43,35 @@ def dataset_bytes(ds: xr.Dataset) -> memoryview:
     SIGINT, SIGTERM and SIGHUP are held back while HDF5 writes (it would drop the exception
     of an interrupt, see :mod:`speclight.io.held_signals`) and act when it is done.
     """
-    with hold_signals():
+    with hold_signals(), _no_distributed_import():
         data = ds.to_netcdf(None, engine="h5netcdf", encoding=_encoding(ds))
     return memoryview(data)
+
+
+@contextmanager
+def _no_distributed_import() -> Iterator[None]:
+    """Keep xarray's writer from importing ``dask.distributed`` where it cannot matter.
+
+    ``to_netcdf`` asks whether the active Dask scheduler is a ``distributed.Client`` by
+    importing ``distributed`` (through ``dask.base.get_scheduler`` and ``dask.distributed``;
+    0.3-0.9 s, the largest part of a run's start-up). A Client exists only if
+    ``distributed`` was imported already; if it was not, the answer is "no" and the import
+    is skipped (``None`` in ``sys.modules`` makes it raise ImportError,
+    which xarray takes as "no distributed scheduler"). Where ``distributed`` is loaded (a
+    sweep, a Dask worker), nothing changes.
+    """
+    names = ("distributed", "dask.distributed")
+    if any(name in sys.modules for name in names):
+        yield
+        return
+    for name in names:
+        sys.modules[name] = None  # type: ignore[assignment]
+    try:
+        yield
+    finally:
+        for name in names:
+            if name in sys.modules and sys.modules[name] is None:
+                del sys.modules[name]
 
 
 def write_dataset(ds: xr.Dataset, path: str | Path, force: bool = False) -> Path:

@@ -99,11 +99,48 @@ def place_target_gcrs_m(
     return eo.itrs_to_gcrs(r_itrs)
 
 
-def _seconds(t: Any, ref_whole: float) -> F64:
+def tt_seconds(t: Any, ref_whole: float) -> F64:
     """Seconds of TT since the Julian date ``ref_whole`` (split JD keeps nanoseconds)."""
     whole = np.atleast_1d(np.asarray(t.whole, dtype=np.float64))
     frac = np.atleast_1d(np.asarray(t.tt_fraction, dtype=np.float64))
     return np.asarray((whole - ref_whole) * 86400.0 + frac * 86400.0, dtype=np.float64)
+
+
+def position_table(
+    emitted_utc: NDArray[np.datetime64], r_gcrs_m: F64, ref_whole: float | None = None
+) -> tuple[F64, F64, float]:
+    """The placed positions as a table for :func:`table_position`: TT seconds since
+    ``ref_whole`` (sorted, unique; default: the first epoch's Julian date), positions
+    (M, 3) [m] (rows with NaN dropped; of a repeated epoch the first kept) and ``ref_whole``."""
+    keep = np.all(np.isfinite(r_gcrs_m), axis=1)
+    order = np.argsort(emitted_utc[keep], kind="stable")
+    t_tab = time_from_utc(np.asarray(emitted_utc[keep])[order])
+    if ref_whole is None:
+        ref_whole = float(np.atleast_1d(t_tab.whole)[0]) if keep.any() else 0.0
+    s_tab, first = np.unique(tt_seconds(t_tab, ref_whole), return_index=True)
+    return s_tab, np.asarray(r_gcrs_m[keep][order][first], dtype=np.float64), ref_whole
+
+
+def table_position(s: F64, s_tab: F64, r_tab: F64) -> tuple[F64, NDArray[np.bool_]]:
+    """Positions (N, 3) [m] at TT seconds ``s`` from a table of :func:`position_table`:
+    exact at its epochs, linear between two at most :data:`MAX_GAP_S` apart, the nearest
+    within :data:`NEAR_S` of one elsewhere, NaN (``ok`` False) beyond."""
+    out = np.full((s.size, 3), np.nan)
+    if s_tab.size < 2:  # no interpolation: the one position near its epoch
+        near = np.abs(s - s_tab[0]) <= NEAR_S if s_tab.size else np.zeros(s.size, bool)
+        out[near] = r_tab[0] if s_tab.size else np.nan
+        return out, near
+    inside = (s >= s_tab[0]) & (s <= s_tab[-1])
+    k = np.clip(np.searchsorted(s_tab, s, side="right"), 1, s_tab.size - 1)
+    between = inside & (s_tab[k] - s_tab[k - 1] <= MAX_GAP_S)
+    nearest = np.where(np.abs(s - s_tab[k - 1]) <= np.abs(s - s_tab[k]), k - 1, k)
+    near = np.abs(s - s_tab[nearest]) <= NEAR_S
+    for axis in range(3):
+        out[:, axis] = np.interp(s, s_tab, r_tab[:, axis])
+    out[~between] = r_tab[nearest[~between]]
+    ok = between | near
+    out[~ok] = np.nan
+    return out, ok
 
 
 def observed_trajectory(
@@ -125,35 +162,11 @@ def observed_trajectory(
         ``t -> (r (N, 3), ok (N,))``: exact at the given epochs, linear between two given
         epochs at most :data:`MAX_GAP_S` apart (the velocity a nadir attitude needs is the
         chord's), the nearest position within :data:`NEAR_S` of a given epoch elsewhere,
-        NaN (``ok`` False) beyond.
+        NaN (``ok`` False) beyond (:func:`table_position`).
     """
-    keep = np.all(np.isfinite(r_gcrs_m), axis=1)
-    order = np.argsort(emitted_utc[keep], kind="stable")
-    t_tab = time_from_utc(np.asarray(emitted_utc[keep])[order])
-    ref = float(np.atleast_1d(t_tab.whole)[0]) if keep.any() else 0.0
-    s_tab = _seconds(t_tab, ref)
-    s_tab, first = np.unique(s_tab, return_index=True)
-    r_tab = np.asarray(r_gcrs_m[keep][order][first], dtype=np.float64)
+    s_tab, r_tab, ref = position_table(emitted_utc, r_gcrs_m)
 
     def trajectory(t: Any) -> tuple[F64, NDArray[np.bool_]]:
-        s = _seconds(t, ref)
-        out = np.full((s.size, 3), np.nan)
-        if s_tab.size < 2:  # no interpolation: the one position near its epoch
-            near = np.abs(s - s_tab[0]) <= NEAR_S if s_tab.size else np.zeros(s.size, bool)
-            out[near] = r_tab[0] if s_tab.size else np.nan
-            return out, near
-        inside = (s >= s_tab[0]) & (s <= s_tab[-1])
-        k = np.clip(np.searchsorted(s_tab, s, side="right"), 1, max(s_tab.size - 1, 1))
-        gap = s_tab[k] - s_tab[k - 1] if s_tab.size > 1 else np.zeros(s.size)
-        between = inside & (gap <= MAX_GAP_S)
-        nearest = np.where(np.abs(s - s_tab[k - 1]) <= np.abs(s - s_tab[k]), k - 1, k)
-        nearest = np.minimum(nearest, s_tab.size - 1)
-        near = np.abs(s - s_tab[nearest]) <= NEAR_S
-        for axis in range(3):
-            out[:, axis] = np.interp(s, s_tab, r_tab[:, axis])
-        out[~between] = r_tab[nearest[~between]]
-        ok = between | near
-        out[~ok] = np.nan
-        return out, ok
+        return table_position(tt_seconds(t, ref), s_tab, r_tab)
 
     return trajectory

@@ -42,8 +42,8 @@ def _shape_sizes(shape: Shape) -> Iterator[Check]:
         items = enumerate(value) if isinstance(value, list) else [(None, value)]
         for i, size in items:
             field = f"target.shape.{name}" + ("" if i is None else f".{i}")
-            if size != 0:  # a gap of 0 is no size
-                yield field, float(size), TARGET_SIZE_M
+            if size != 0:  # a gap of 0 is no size; an offset is a signed length
+                yield field, abs(float(size)), TARGET_SIZE_M
 
 
 def _tle_altitudes(text: str) -> Iterator[Check]:

@@ -35,7 +35,9 @@ ConductorName = Literal["Al", "Ag", "Au"]
 DielectricName = Literal["SiO2", "Si", "GaAs", "Kapton"]
 #: Shipped reflectance tables (``data/materials``, :mod:`speclight.target.material_tables`).
 MaterialTableName = Literal["aluminium", "kapton_mli", "solar_cell", "white_paint"]
-BuiltinShape = Literal["sphere", "plate", "cube", "cylinder", "box_wing", "bus_array"]
+BuiltinShape = Literal[
+    "sphere", "plate", "cube", "cylinder", "box_wing", "bus_array", "starlink_v2_mini"
+]
 
 #: Largest ``render.seed``: Mitsuba's sampler seed is a 32-bit unsigned integer (path mode
 #: hashes the run's seed, the epoch and the launch into one, :mod:`speclight.render.path_sampling`;
@@ -204,7 +206,8 @@ _SHAPE_SIZES: dict[str, tuple[str, ...]] = {
         "dish_depth_m",
         "dish",
     ),
-    "bus_array": ("bus_size_m", "array_size_m", "array_gap_m"),
+    "bus_array": ("bus_size_m", "array_size_m", "array_gap_m", "array_offset_m"),
+    "starlink_v2_mini": (),
 }
 _SHAPE_REQUIRED: dict[str, tuple[str, ...]] = {
     "sphere": ("radius_m",),
@@ -213,6 +216,7 @@ _SHAPE_REQUIRED: dict[str, tuple[str, ...]] = {
     "cylinder": ("radius_m", "length_m"),
     "box_wing": (),
     "bus_array": (),
+    "starlink_v2_mini": (),
 }
 
 
@@ -236,6 +240,9 @@ class Shape(Strict):
     dish: bool | None = Field(default=None, description="box_wing: false leaves out the dish")
     array_size_m: Annotated[list[float], Field(min_length=2, max_length=2)] | None = None
     array_gap_m: float | None = Field(default=None, ge=0)
+    array_offset_m: float | None = Field(
+        default=None, description="bus_array: the array plane's x [m] (-bus x / 2: an L)"
+    )
 
     @field_validator("builtin", mode="before")
     @classmethod

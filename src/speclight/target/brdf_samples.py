@@ -6,7 +6,11 @@ doi:10.48550/arXiv.2305.11123, repository Forrest-Fankhauser/satellite-optical-b
 the azimuth angle [deg] and the BRDF [sr-1]; a comment ``lambda = 532 nm`` gives the wavelength.
 A first line that is the column header itself (``phi_i theta_i phi_o theta_o brdf``, not
 commented, as in the second-generation Starlink tables of Kandula et al. 2025) is skipped.
-Shipped tables: ``starlink_v1p5_chassis_532nm``, ``starlink_v1p5_solar_array_532nm``.
+Shipped tables (``src/speclight/data/brdf/PROVENANCE.md``): ``starlink_v1p5_chassis_532nm``,
+``starlink_v1p5_solar_array_532nm`` (Fankhauser et al. 2023) and the second-generation tables
+of Kandula et al. 2025 (``starlink_gen2_dielectric_mirror``, ``starlink_gen2_chassis_bare``,
+``starlink_gen2_black_c138``, ``starlink_gen2_LRB50XL2``, ``starlink_gen2_A700``; wavelength
+not stated).
 """
 
 from __future__ import annotations
@@ -24,7 +28,15 @@ from speclight.errors import InputError, did_you_mean
 from speclight.input_files import read_user_text
 
 F64 = NDArray[np.float64]
-SHIPPED_BRDF: tuple[str, ...] = ("starlink_v1p5_chassis_532nm", "starlink_v1p5_solar_array_532nm")
+SHIPPED_BRDF: tuple[str, ...] = (
+    "starlink_v1p5_chassis_532nm",
+    "starlink_v1p5_solar_array_532nm",
+    "starlink_gen2_dielectric_mirror",
+    "starlink_gen2_chassis_bare",
+    "starlink_gen2_black_c138",
+    "starlink_gen2_LRB50XL2",
+    "starlink_gen2_A700",
+)
 _HEADER = ["phi_i", "theta_i", "phi_o", "theta_o", "brdf"]
 
 

@@ -4,7 +4,7 @@ Accepted forms (docs/scenario.md): ``reflectance`` is a number, ``{file: path}``
 ``{wavelength_nm: [...], value: [...]}``, ``{conductor: Al}`` or ``{dielectric: SiO2}``;
 a material is ``{bsdf, reflectance, roughness?, diffuse_reflectance?, brdf_table?, extension?,
 coefficients?}``; a shape is
-``{builtin: sphere|plate|cube|cylinder|box_wing|bus_array, ...sizes}`` or
+``{builtin: sphere|plate|cube|cylinder|box_wing|bus_array|starlink_v2_mini, ...sizes}`` or
 ``{mesh_file: path}`` (or a list of PLY files). Unknown keys are errors with a did-you-mean.
 """
 
@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from speclight.errors import InputError, did_you_mean
-from speclight.target import shapes
+from speclight.target import shapes, starlink_gen2
 from speclight.target.bsdf_models import BSDF_MODELS, PARAMETERS
 from speclight.target.material_tables import material_table_path
 from speclight.target.materials import Material
@@ -34,7 +34,11 @@ BUILTIN_SHAPES = {
         ("bus_size_m", "wing_span_m", "wing_width_m", "wing_gap_m", "dish_radius_m",
          "dish_depth_m", "dish"),
     ),
-    "bus_array": (shapes.bus_array, ("bus_size_m", "array_size_m", "array_gap_m")),
+    "bus_array": (
+        shapes.bus_array,
+        ("bus_size_m", "array_size_m", "array_gap_m", "array_offset_m"),
+    ),
+    "starlink_v2_mini": (starlink_gen2.starlink_v2_mini, ()),
 }  # fmt: skip
 _MATERIAL_KEYS = ("bsdf", "reflectance", *PARAMETERS)
 

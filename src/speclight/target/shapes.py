@@ -201,26 +201,36 @@ def bus_array(
     bus_size_m: tuple[float, float, float] = (2.8, 1.3, 0.3),
     array_size_m: tuple[float, float] = (8.1, 2.8),
     array_gap_m: float = 0.2,
+    array_offset_m: float = 0.0,
 ) -> Target:
     """A flat bus with one solar array above it (Starlink-like, for nadir pointing).
 
     The bus is a box centred on the origin; its +z face (part ``bus_nadir``, the chassis
     underside when body +z points to nadir) is the face Fankhauser, Askari & Tyson 2023 model,
     the other five faces are part ``bus``. The array (part ``array``) is a plate
-    perpendicular to the bus, in the y-z plane (normal +x, length ``array_size_m[0]`` along y,
-    height ``array_size_m[1]`` along z), on the -z (zenith) side ``array_gap_m`` above the bus,
-    centred on the z axis: turning it about z (``target.articulation``) keeps it perpendicular
-    to the bus and clear of it. The defaults give the Starlink v1.5 areas: bus underside
-    2.8 x 1.3 = 3.64 m², array 8.1 x 2.8 = 22.68 m².
+    perpendicular to the bus, in the plane x = ``array_offset_m`` parallel to y-z (normal
+    +x, length ``array_size_m[0]`` along y, height ``array_size_m[1]`` along z), on the -z
+    (zenith) side ``array_gap_m`` above the bus, centred on y = 0. With the default offset 0
+    it stands on the z axis: turning it about z (``target.articulation``) keeps it
+    perpendicular to the bus and clear of it. ``array_offset_m = -bus_size_m[0] / 2`` and
+    ``array_gap_m = 0`` hinge it on the bus's top -x edge, an L whose +x (normal) side looks
+    over the bus. The defaults give the Starlink v1.5 areas: bus underside 2.8 x 1.3 =
+    3.64 m², array 8.1 x 2.8 = 22.68 m².
     """
     half = np.array([_positive("bus_size_m", s) for s in bus_size_m]) / 2
     length, height = (_positive("array_size_m", s) for s in array_size_m)
     gap = float(array_gap_m)
     if not (np.isfinite(gap) and gap >= 0):
         raise InputError(f"array_gap_m = {array_gap_m!r} must be >= 0", field="shape.array_gap_m")
+    x = float(array_offset_m)
+    if not np.isfinite(x):
+        raise InputError(
+            f"array_offset_m = {array_offset_m!r} must be a finite number",
+            field="shape.array_offset_m",
+        )
     faces = _box_faces(half, np.zeros(3))
     nadir = faces.pop("+z")
     z0, z1, y = -half[2] - gap, -half[2] - gap - height, length / 2
-    arr = _quad((0, y, z0), (0, -y, z0), (0, -y, z1), (0, y, z1))
+    arr = _quad((x, y, z0), (x, -y, z0), (x, -y, z1), (x, y, z1))
     meshes = {"bus_nadir": nadir, "bus": _merge(list(faces.values())), "array": arr}
     return _build(meshes, materials)

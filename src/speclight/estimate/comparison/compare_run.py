@@ -21,18 +21,17 @@ import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
-from speclight import orbit, schema
-from speclight.constants import C_M_S
+from speclight import schema
 from speclight.errors import InputError
-from speclight.estimate.comparison.compare_stats import residual_statistics
+from speclight.estimate.comparison.compare_geometry import (
+    RowGroup,
+    join_geometries,
+    row_groups,
+    single_epoch_objects,
+)
+from speclight.estimate.comparison.compare_stats import per_object, residual_statistics
 from speclight.estimate.inputs.measured_checks import no_usable_epochs
 from speclight.estimate.inputs.observations import FIELD, Observations
-from speclight.orbit.observed_position import (
-    observed_trajectory,
-    place_target_gcrs_m,
-    range_from_height_m,
-)
-from speclight.orbit.timescale import time_from_utc
 from speclight.scenario import LoadedScenario
 from speclight.scenario.overrides import with_overrides
 
@@ -40,6 +39,10 @@ F64 = NDArray[np.float64]
 #: Least time of one site's simulation [s]: the target's build and one render launch, a lower
 #: bound of the 5.7 s per site of 100 observations each measured in BENCHMARKS.md ("Compare").
 SECONDS_PER_SITE = 1.0
+#: Least time of one geometry pass of a group of objects (``orbit: {observed: true}`` with an
+#: ``object`` column) [s]: a lower bound of the 0.0034-0.037 s measured per pass of 3 epochs
+#: on 2 shared cores (``bench/bench_compare_objects.py``, BENCHMARKS.md, "Compare").
+SECONDS_PER_GROUP = 0.003
 #: Per-observation geometry copied from the simulation: output name -> simulate variable.
 GEOMETRY = {
     "phase_angle": "phase_angle",
@@ -85,40 +88,6 @@ def _bands(loaded: LoadedScenario, obs: Observations) -> list[dict[str, Any]]:
     return bands
 
 
-def _placed(loaded: LoadedScenario, obs: Observations) -> Any:
-    """The trajectory through the observed positions of every row (all sites)."""
-    if not obs.has_positions:
-        bad = ~(
-            np.isfinite(obs.elevation_deg) & (np.isfinite(obs.range_m) | np.isfinite(obs.height_m))
-        )
-        line = int(obs.line[np.flatnonzero(bad)[0]])
-        raise InputError(
-            f"line {line}: the scenario has orbit: {{observed: true}}, so every row must give "
-            "where the target was seen: elevation_deg, azimuth_deg and range_m (or height_m)",
-            source=obs.source,
-            field=FIELD,
-        )
-    n = obs.time_utc.size
-    r = np.full((n, 3), np.nan)
-    rng = obs.range_m.copy()
-    for (lat, lon, alt), idx in obs.site_groups():
-        site = orbit.Site(lat, lon, alt)
-        need = idx[~np.isfinite(rng[idx])]
-        if need.size:
-            rng[need] = range_from_height_m(
-                site, obs.azimuth_deg[need], obs.elevation_deg[need], obs.height_m[need]
-            )
-        t = time_from_utc(obs.time_utc[idx])
-        r[idx] = place_target_gcrs_m(
-            site, t, obs.azimuth_deg[idx], obs.elevation_deg[idx], rng[idx]
-        )
-    emitted = obs.time_utc.copy()
-    if loaded.scenario.observer.light_time:
-        delay_ns = np.rint(np.nan_to_num(rng) / C_M_S * 1e9).astype("timedelta64[ns]")
-        emitted = obs.time_utc - delay_ns
-    return observed_trajectory(emitted, r)
-
-
 def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -> CompareResult:
     """Simulate ``loaded`` at every epoch and site of ``obs`` and compare the magnitudes.
 
@@ -151,22 +120,34 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
     base = loaded
     if len(bands) > len(sc.instrument.bands):  # speclite filters added
         base = with_overrides(loaded, {"instrument.bands": bands})  # a missing section is made
-    trajectory = _placed(loaded, obs) if sc.orbit.observed else None
+    groups = row_groups(loaded, obs)
     notes: list[str] = []
-    if trajectory is None and np.any(np.isfinite(obs.elevation_deg)):
+    if not sc.orbit.observed and np.any(np.isfinite(obs.elevation_deg)):
         notes.append(
             "the rows' elevation/azimuth/range are not used: the scenario has an orbit "
             "(orbit: {observed: true} places the target there instead)"
         )
+    n_objects = len(obs.object_index()[0])
+    if not sc.orbit.observed and obs.object_name is not None and n_objects > 1:
+        notes.append(
+            f"the scenario's orbit is used for all {n_objects} objects: the object column "
+            "only groups the statistics (orbit: {observed: true} gives each object the "
+            "trajectory of its own rows)"
+        )
+    lonely = single_epoch_objects(loaded, obs)
+    if lonely:
+        notes.append(_lonely_note(lonely))
     n = obs.time_utc.size
     sim = np.full(n, np.nan)
-    flags = np.zeros(n, dtype=schema.FLAG_DTYPE)
+    flags = np.full(n, schema.FLAG_ORBIT_FAILED, dtype=schema.FLAG_DTYPE)  # until simulated
     geo: dict[str, F64] = {k: np.full(n, np.nan) for k in GEOMETRY}
     for name in ("sun_direction_body", "observer_direction_body"):
         geo[name] = np.full((n, 3), np.nan)
-    groups = obs.site_groups()
-    _check_sites(len(groups), obs)
-    for (lat, lon, alt), idx in groups:
+    sites = [(key, _site_parts(obs, rows, groups)) for key, rows in obs.site_groups()]
+    _check_sites(len(sites), sum(len(parts) for _, parts in sites), obs)
+    for (lat, lon, alt), parts in sites:
+        if not parts:  # every row's object without a placed position
+            continue
         site_scenario = with_overrides(
             base,
             {
@@ -175,36 +156,76 @@ def compare(loaded: LoadedScenario, obs: Observations, progress: bool = False) -
                 "observer.altitude_m": alt,
             },
         )
-        epochs = np.unique(obs.time_utc[idx])
-        if trajectory is not None:
-            g = scenario_geometry(site_scenario, epochs, trajectory=trajectory)
-            ds = simulate(site_scenario, progress, geometry=g).dataset
+        if parts[0][2] is None:  # the scenario's orbit: one group
+            ds = simulate(site_scenario, progress, time_utc=parts[0][1]).dataset
         else:
-            ds = simulate(site_scenario, progress, time_utc=epochs).dataset
-        k = np.searchsorted(epochs, obs.time_utc[idx])
+            g = join_geometries(
+                [scenario_geometry(site_scenario, epochs, trajectory=tr) for _, epochs, tr in parts]
+            )
+            ds = simulate(site_scenario, progress, geometry=g).dataset
         band_index = {str(b): col for col, b in enumerate(ds["band"].values)}
-        cols = np.array([band_index[obs.band[i]] for i in idx], dtype=np.intp)
-        sim[idx] = ds["ab_magnitude"].values[k, cols]
-        flags[idx] = ds["flags"].values[k]
-        for name, var in GEOMETRY.items():
-            geo[name][idx] = ds[var].values[k]
+        offset = 0
+        for idx, epochs, _ in parts:
+            k = offset + np.searchsorted(epochs, obs.time_utc[idx])
+            offset += epochs.size
+            cols = np.array([band_index[obs.band[i]] for i in idx], dtype=np.intp)
+            sim[idx] = ds["ab_magnitude"].values[k, cols]
+            flags[idx] = ds["flags"].values[k]
+            for name, var in GEOMETRY.items():
+                geo[name][idx] = ds[var].values[k]
     if not np.any(np.isfinite(sim) & np.isfinite(obs.magnitude)):
-        raise no_usable_epochs(n, loaded.source, obs.source, FIELD, "observed")
+        err = no_usable_epochs(n, loaded.source, obs.source, FIELD, "observed")
+        if lonely:  # the likelier cause
+            raise InputError(
+                f"{err.message}; {_lonely_note(lonely)}", source=obs.source, field=FIELD
+            ) from None
+        raise err
     return CompareResult(dataset=_dataset(loaded, obs, sim, flags, geo), notes=notes)
 
 
-def _check_sites(n_sites: int, obs: Observations) -> None:
-    """Refuse observations from so many sites that one simulation each cannot finish in a
-    day (:mod:`speclight.estimate.inputs.cost_limits`), at :data:`SECONDS_PER_SITE` each at
-    least."""
+def _lonely_note(names: list[str]) -> str:
+    shown = ", ".join(f"'{o}'" for o in names[:5]) + (", ..." if len(names) > 5 else "")
+    return (
+        f"{len(names)} object(s) seen at one epoch only ({shown}): one position gives no "
+        "velocity, so an attitude that needs it (nadir; a velocity or orbit_normal "
+        "constraint) is undefined there (flag attitude_undefined, left out of the "
+        "statistics); give each object at least two rows at most 30 s apart"
+    )
+
+
+def _site_parts(
+    obs: Observations, site_rows: NDArray[np.intp], groups: list[RowGroup]
+) -> list[tuple[NDArray[np.intp], NDArray[np.datetime64], Any]]:
+    """Per group with rows at this site: those rows (ascending), their distinct epochs
+    (sorted) and the group's trajectory (None: the scenario's orbit)."""
+    parts = []
+    for group in groups:
+        idx = np.intersect1d(site_rows, group.rows)
+        if idx.size:
+            parts.append((idx, np.unique(obs.time_utc[idx]), group.trajectory))
+    return parts
+
+
+def _check_sites(n_sites: int, n_passes: int, obs: Observations) -> None:
+    """Refuse observations from so many sites (or objects seen at once) that one simulation
+    each (and one geometry pass per group of objects at each site) cannot finish in a day
+    (:mod:`speclight.estimate.inputs.cost_limits`), at :data:`SECONDS_PER_SITE` and
+    :data:`SECONDS_PER_GROUP` each at least."""
     from speclight.estimate.inputs.cost_limits import check_cost
 
-    check_cost(
-        FIELD, f"{obs.source} ({obs.time_utc.size} rows)",
+    what = (
         f"one simulation for each of its {n_sites} sites (at least {SECONDS_PER_SITE:g} s "
-        "each: the target's build and a render launch)",
-        0.0, n_sites * SECONDS_PER_SITE,
-        "group the observations by site into fewer files, or round the sites' coordinates",
+        "each: the target's build and a render launch)"
+    )
+    if n_passes > n_sites:
+        what += (
+            f" and {n_passes} geometry passes, one per site and group of objects seen at "
+            f"overlapping times (at least {SECONDS_PER_GROUP:g} s each)"
+        )
+    check_cost(
+        FIELD, f"{obs.source} ({obs.time_utc.size} rows)", what,
+        0.0, n_sites * SECONDS_PER_SITE + n_passes * SECONDS_PER_GROUP,
+        "split the file, group the observations by site, or round the sites' coordinates",
     )  # fmt: skip
 
 
@@ -238,7 +259,9 @@ def _dataset(
         dims = ("obs", "xyz") if geo[name].ndim == 2 else ("obs",)
         ds[name] = (dims, geo[name], schema.attrs(name))
     ds["flags"] = ("obs", flags, {**schema.attrs("flags"), **_flag_attrs()})
-    ds.attrs.update(residual_statistics(residual, geo["phase_angle"], geo["elevation"]))
+    ds.attrs.update(residual_statistics(obs.magnitude, sim, geo["phase_angle"], geo["elevation"]))
+    if obs.object_name is not None:
+        ds = _add_objects(ds, obs, sim)
     ds.attrs.update(
         {
             "title": "speclight compare: simulated against observed magnitudes",
@@ -248,6 +271,38 @@ def _dataset(
             "n_sites": len(obs.site_groups()),
         }
     )
+    return ds
+
+
+#: Per-object variables of CMP.nc (described in :data:`speclight.schema.COMPARE_VARIABLES`)
+#: -> key of :func:`~speclight.estimate.comparison.compare_stats.per_object`.
+PER_OBJECT = {
+    "n_per_object": "n",
+    "residual_mean_per_object": "mean",
+    "residual_rms_per_object": "rms",
+    "residual_median_abs_per_object": "median_abs",
+    "pearson_r_per_object": "pearson_r",
+    "chi_square_per_object": "chi_square",
+}
+
+
+def _add_objects(ds: xr.Dataset, obs: Observations, sim: F64) -> xr.Dataset:
+    """The ``object_id(obs)`` of each row and the statistics per object (dimension
+    ``object``, first-seen order)."""
+    table = schema.COMPARE_VARIABLES
+    names, index = obs.object_index()
+    stats = per_object(obs.magnitude, sim, index, len(names))
+    ds["object_id"] = (
+        "obs",
+        np.array(obs.object_name, dtype=object),
+        schema.attrs("object_id", table),
+    )
+    ds = ds.assign_coords(object=("object", np.array(names, dtype=object)))
+    ds["object"].attrs.update(schema.COMPARE_COORDINATES["object"])
+    for name, key in PER_OBJECT.items():
+        data = stats[key].astype(np.int64) if key == "n" else stats[key]
+        ds[name] = (table[name].dims, data, schema.attrs(name, table))
+    ds.attrs["n_objects"] = len(names)
     return ds
 
 

@@ -7,6 +7,8 @@ reflectance factors, band responses, source spectra, and the up-front limits.
 * :mod:`.reflectance_factors`: band reflectance factors (eq. 5) of a dataset or of count
   rates with a scenario;
 * :mod:`.band_responses`: band curve x optics x QE of a scenario or a dataset;
+* :mod:`.band_albedo`: what a band albedo is (weighted by the source's detected photons), for
+  fit, upsample and unmix alike, and the mean source over a pass;
 * :mod:`.source_spectrum`: the source at the aperture (Sun, coaxial lasers);
 * :mod:`.geometry_match`: can a scenario be the measured target (before its geometry is used);
 * :mod:`.cost_limits`: memory and time of what a user's options make large, checked first.

@@ -20,7 +20,11 @@ Columns (any order, names exact):
   as columns (every row) or once in ``# key: value`` header lines, not both;
 * optionally where the target was seen: ``elevation_deg``, ``azimuth_deg`` (from north
   through east, geometric) and ``range_m`` or ``height_m`` (above the WGS84 ellipsoid),
-  for a scenario with ``orbit: {observed: true}``.
+  for a scenario with ``orbit: {observed: true}``;
+* optionally ``object``: which satellite the row saw (any printable text of at most
+  :data:`MAX_OBJECT_CHARS` characters, e.g. a NORAD id); with ``orbit: {observed: true}``
+  each object's trajectory is built from its own rows, and the statistics are also given
+  per object.
 
 Rows need not be sorted; several rows may share an epoch (several bands).
 """
@@ -43,7 +47,10 @@ FIELD = "OBSERVATIONS"
 SITE_KEYS = ("latitude_deg", "longitude_deg", "altitude_m")
 POSITION_KEYS = ("elevation_deg", "azimuth_deg", "range_m", "height_m")
 REQUIRED = ("time", "magnitude", "magnitude_sigma", "band")
-COLUMNS = REQUIRED + SITE_KEYS + POSITION_KEYS
+COLUMNS = (*REQUIRED, *SITE_KEYS, *POSITION_KEYS, "object")
+#: Longest accepted ``object`` name [characters]: NORAD ids have up to 9 digits, COSPAR ids 11
+#: characters, satellite names rarely pass 40; a longer cell is a misplaced column.
+MAX_OBJECT_CHARS = 100
 #: Accepted values per numeric column: (low, high, what it is).
 RANGES = {
     "magnitude": (-30.0, 40.0, "an AB magnitude"),
@@ -78,6 +85,8 @@ class Observations:
         (N,) line number of each row in the file.
     source
         The file read.
+    object_name
+        (N,) the ``object`` of each row; None where the file has no ``object`` column.
     """
 
     time_utc: NDArray[np.datetime64]
@@ -93,6 +102,7 @@ class Observations:
     height_m: F64
     line: NDArray[np.int64]
     source: str
+    object_name: list[str] | None = None
 
     @property
     def has_positions(self) -> bool:
@@ -109,6 +119,15 @@ class Observations:
         for i, k in enumerate(keys):
             groups.setdefault((float(k[0]), float(k[1]), float(k[2])), []).append(i)
         return [(k, np.array(v, dtype=np.intp)) for k, v in groups.items()]
+
+    def object_index(self) -> tuple[list[str], NDArray[np.intp]]:
+        """The objects in first-seen order and each row's index into them (one object
+        named ``""`` for a file without an ``object`` column)."""
+        if self.object_name is None:
+            return [""], np.zeros(self.time_utc.size, dtype=np.intp)
+        index: dict[str, int] = {}
+        rows = np.array([index.setdefault(o, len(index)) for o in self.object_name], np.intp)
+        return list(index), rows
 
 
 def _error(message: str, src: str) -> InputError:
@@ -225,7 +244,7 @@ def _rows(
     col = {name: i for i, name in enumerate(header)}
     n = len(rows)
     num = {k: np.full(n, np.nan) for k in RANGES}
-    times, bands, lines = [], [], []
+    times, bands, lines, objects = [], [], [], []
     for i, (lineno, cells) in enumerate(rows):
         if len(cells) != len(header):
             raise _error(f"line {lineno}: {len(cells)} cells, the header names {len(header)}", src)
@@ -240,6 +259,8 @@ def _rows(
             )
         bands.append(band)
         lines.append(lineno)
+        if "object" in col:
+            objects.append(_object(cells[col["object"]], lineno, src))
         for k in RANGES:
             if k in col:
                 required = k in ("magnitude", "latitude_deg", "longitude_deg")
@@ -270,4 +291,21 @@ def _rows(
         height_m=num["height_m"],
         line=np.array(lines, dtype=np.int64),
         source=src,
+        object_name=objects if "object" in col else None,
     )
+
+
+def _object(text: str, line: int, src: str) -> str:
+    """An ``object`` cell, checked: not empty, printable, at most MAX_OBJECT_CHARS."""
+    what = f"a name or id of the satellite (e.g. a NORAD id), at most {MAX_OBJECT_CHARS} characters"
+    if not text:
+        raise _error(f"line {line}, column 'object': a value is required ({what})", src)
+    if len(text) > MAX_OBJECT_CHARS or not text.isprintable():
+        shown = text[:40].encode("unicode_escape").decode("ascii")
+        problem = f"{len(text)} characters" if len(text) > MAX_OBJECT_CHARS else "unprintable"
+        raise _error(
+            f"line {line}, column 'object': '{shown}{'...' if len(text) > 40 else ''}' is "
+            f"not accepted ({problem}); expected {what}",
+            src,
+        )
+    return text

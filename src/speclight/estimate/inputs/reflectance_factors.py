@@ -101,6 +101,10 @@ class ReflectanceFactors:
         ``"sun"`` or ``"laser"``: which factors these are.
     material_labels
         (M,) the materials' reflectance labels (``material_reflectance``), or None.
+    rates
+        The measured count rates behind ``factor`` at the same epochs (binned alike), with
+        their standard deviations where the data give them: the factors' noise is
+        ``factor x sigma / rate`` (eq. 5 is linear in the rate). None where unknown.
     """
 
     time_utc: NDArray[np.datetime64]
@@ -112,6 +116,7 @@ class ReflectanceFactors:
     source_W_m2_nm: F64 | None = None
     light: str = "sun"
     material_labels: list[str] | None = None
+    rates: MeasuredLightCurve | None = None
 
 
 def bin_factors(time: NDArray[np.datetime64], values: F64, bin_s: float, src: str) -> tuple:
@@ -219,8 +224,9 @@ def read_reflectance_factors(
         _, source = bin_factors(t0, source, bin_s, src)
         if truth is not None:
             _, truth = bin_factors(t0, truth, bin_s, src)
+        checked = bin_light_curve(checked, bin_s)
     return ReflectanceFactors(
-        time, factor, bands, f"{src}: {what}", truth, names, source, chosen, labels
+        time, factor, bands, f"{src}: {what}", truth, names, source, chosen, labels, checked
     )
 
 
@@ -285,4 +291,5 @@ def _factors_from_rates(
         f"{lc.source}: count rates ({light}), scenario {loaded.source}",
         source_W_m2_nm=source,
         light=light,
+        rates=lc,
     )

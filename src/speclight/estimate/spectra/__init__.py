@@ -30,7 +30,11 @@ from speclight.estimate.spectra.ground_truth import (
 from speclight.estimate.spectra.unmix_run import unmix_measured
 from speclight.estimate.spectra.unmixing import UNMIX_METHODS, UnmixResult, unmix
 from speclight.estimate.spectra.unmixing_epochs import unmix_per_epoch
-from speclight.estimate.spectra.upsample_run import read_fit_albedos, upsample_scenario
+from speclight.estimate.spectra.upsample_run import (
+    read_fit_albedo_std,
+    read_fit_albedos,
+    upsample_scenario,
+)
 from speclight.estimate.spectra.upsampling import UpsampledSpectrum, upsample
 
 __all__ = [
@@ -46,6 +50,7 @@ __all__ = [
     "in_reference_units",
     "material_signatures",
     "mean_absolute_share_error",
+    "read_fit_albedo_std",
     "read_fit_albedos",
     "spectral_angle_rad",
     "true_contributions",

@@ -30,6 +30,11 @@ non-finite value are left out and the returned indices count the rows of ``x`` a
     the sweeps are repeated until no replacement increases the volume. The volume with one
     vertex replaced is linear in the new vertex (cofactor expansion along its column), so each
     trial over all samples is one (N, K) product.
+``purest``
+    ATGP on the shapes (each sample divided by its band sum) of the samples above the noise,
+    each pick averaged with the shapes within its noise
+    (:mod:`speclight.estimate.spectra.endmember_purest`): the purest epochs, not the
+    brightest; it says when the data hold fewer pure epochs than endmembers asked.
 """
 
 from __future__ import annotations
@@ -43,10 +48,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.errors import InputError, did_you_mean
+from speclight.estimate.spectra.endmember_purest import purest
 from speclight.estimate.spectra.unmixing import _validated_samples
 
 F64 = NDArray[np.float64]
-EndmemberMethod = Literal["atgp", "pca", "nfindr"]
+EndmemberMethod = Literal["purest", "atgp", "pca", "nfindr"]
 ENDMEMBER_METHODS: tuple[str, ...] = get_args(EndmemberMethod)
 #: A residual norm below this fraction of the largest sample norm counts as zero in ATGP:
 #: the samples then span fewer than K directions.
@@ -75,12 +81,15 @@ class EndmemberResult:
     volumes
         ``nfindr`` only: the simplex volume in the principal-component space at the ATGP start
         and after each replacement [(m2 sr-1)**(K-1)], non-decreasing; None otherwise.
+    notes
+        What the extraction found doubtful (e.g. fewer pure epochs than endmembers).
     """
 
     signatures: F64
     indices: NDArray[np.intp] | None
     method: str
     volumes: F64 | None = None
+    notes: tuple[str, ...] = ()
 
 
 def _checked_k(k: object, n_samples: int, n_bands: int, method: str) -> int:
@@ -167,7 +176,9 @@ def _nfindr(x: F64, k: int) -> tuple[NDArray[np.intp], F64]:
     return chosen, np.asarray(volumes)
 
 
-def extract_endmembers(x: ArrayLike, k: int, method: EndmemberMethod = "atgp") -> EndmemberResult:
+def extract_endmembers(
+    x: ArrayLike, k: int, method: EndmemberMethod = "atgp", sigma: ArrayLike | None = None
+) -> EndmemberResult:
     """Extract ``k`` endmember signatures from the samples ``x``.
 
     Parameters
@@ -181,7 +192,10 @@ def extract_endmembers(x: ArrayLike, k: int, method: EndmemberMethod = "atgp") -
     method
         ``"atgp"`` (Ren & Chang 2003, doi:10.1109/TAES.2003.1261119), ``"pca"`` (mean and
         K - 1 principal directions) or ``"nfindr"`` (Winter 1999, doi:10.1117/12.366289);
-        see the module docstring for how each forms the signatures.
+        see the module docstring for how each forms the signatures; ``"purest"`` (the
+        shapes of the samples above the noise, :mod:`.endmember_purest`).
+    sigma
+        (N, B) standard deviation of ``x`` [m2 sr-1], for ``purest`` (None: unknown).
 
     Returns
     -------
@@ -210,6 +224,12 @@ def extract_endmembers(x: ArrayLike, k: int, method: EndmemberMethod = "atgp") -
         signatures = np.vstack([mean, mean + sigma[:, None] * directions])
         return EndmemberResult(signatures=signatures, indices=None, method=method)
     volumes = None
+    if method == "purest":
+        noise = None if sigma is None else np.asarray(sigma, dtype=np.float64)[rows]
+        if noise is not None and not np.all(np.isfinite(noise)):
+            noise = None
+        picked, signatures, notes = purest(xg, kk, noise, _atgp)
+        return EndmemberResult(signatures, rows[picked], method, notes=notes)
     if method == "atgp":
         chosen = _atgp(xg, kk)
     else:

@@ -46,6 +46,8 @@ from speclight.estimate.spectra.endmember_spectra import (
     endmembers_from_scenario,
 )
 from speclight.estimate.spectra.endmembers import ENDMEMBER_METHODS, extract_endmembers
+from speclight.estimate.spectra.factor_noise import factor_sigma
+from speclight.estimate.spectra.unmix_checks import with_checks
 from speclight.estimate.spectra.unmix_truth import compare_with_truth
 from speclight.estimate.spectra.unmixing import UNMIX_METHODS
 from speclight.estimate.spectra.unmixing_epochs import unmix_per_epoch
@@ -91,7 +93,7 @@ def check_unmix_options(
     if bool(endmembers) == (extract is not None):
         raise InputError(
             "give endmembers=[E1.csv, E2.csv, ...] (or endmembers=['scenario']) or "
-            "extract=atgp|pca|nfindr with n=K, one of them",
+            "extract=purest|atgp|pca|nfindr with n=K, one of them",
             field="endmembers",
         )
     if extract is not None:
@@ -175,7 +177,8 @@ def unmix_measured(
                 f"n = {n} endmembers is more than the {n_bands} bands; ask for `n` <= {n_bands}",
                 field="n",
             )
-        found = extract_endmembers(data.factor, n, extract)  # type: ignore[arg-type]
+        sigma = factor_sigma(data.factor, data.rates, loaded or _carried(measured), data.bands)
+        found = extract_endmembers(data.factor, n, extract, sigma)  # type: ignore[arg-type]
         names = [f"{extract}-{k + 1}" for k in range(n)]
         members = Endmembers(names, np.full((n, 0), np.nan), found.signatures)
         origin = f"extracted by {extract} from the reflectance factors"
@@ -198,9 +201,22 @@ def unmix_measured(
     sig = members.signatures if members.signatures_epoch is None else members.signatures_epoch
     result = unmix_per_epoch(data.factor, sig, method)  # type: ignore[arg-type]
     ds = _dataset(data, members, result.abundance, result.residual, method, extract, origin)
+    if extract is not None:
+        ds.attrs["extraction"] = "; ".join(found.notes) if found.notes else "ok"
+    if extract is None:
+        sigma = factor_sigma(data.factor, data.rates, loaded or _carried(measured), data.bands)
+    ds = with_checks(ds, data.factor, result.abundance, sig, sigma, method)
     if data.material_contribution is not None and data.material_names is not None:
         ds = compare_with_truth(ds, data, members, result.abundance, by_name=extract is None)
     return ds
+
+
+def _carried(measured: str | Path) -> LoadedScenario | None:
+    """The scenario a NetCDF carries (its noise model), or None."""
+    if Path(measured).suffix.lower() not in (".nc", ".nc4", ".netcdf", ".h5"):
+        return None
+    head = read_user_dataset(measured, "MEASURED", what="measurements", variables=())
+    return dataset_scenario(head, str(measured)) if "scenario_yaml" in head.attrs else None
 
 
 def check_distinct(members: Endmembers) -> None:

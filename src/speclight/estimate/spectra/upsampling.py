@@ -9,13 +9,17 @@ doi:10.1111/cgf.13626) from three tristimulus values to n arbitrary bands:
 
     g(\\lambda) = S(p(\\lambda)), \\qquad S(x) = \\frac{1}{2} + \\frac{x}{2\\sqrt{1 + x^2}},
 
-with p a polynomial of order n - 1, whose n coefficients are fitted so that the
-photon-weighted band averages of g equal the band albedos:
+with p a polynomial of order n - 1, whose n coefficients are fitted so that the band
+albedos of g equal the given ones:
 
 .. math::
 
-    \\rho_j = \\frac{\\int g(\\lambda) R_j(\\lambda) \\lambda / (h c) \\, d\\lambda}
-                   {\\int R_j(\\lambda) \\lambda / (h c) \\, d\\lambda}.
+    \\rho_j = \\frac{\\int g(\\lambda) E(\\lambda) R_j(\\lambda) \\lambda \\, d\\lambda}
+                   {\\int E(\\lambda) R_j(\\lambda) \\lambda \\, d\\lambda},
+
+the one definition of a band albedo (:mod:`speclight.estimate.inputs.band_albedo`): the
+average weighted by the detected photons of the source spectrum E at the aperture (the
+paper's eq. 3 is the flat source E = 1).
 
 Here p is written in the Legendre basis of the scaled wavelength
 ``x = (lambda - centre_nm) / half_span_nm``, which maps the grid onto [-1, 1] (``centre_nm``
@@ -31,6 +35,16 @@ the sigmoid saturates; the start is the Legendre interpolant of ``S^-1(rho_j)`` 
 centroids. Albedos of exactly 0 or 1 would need infinite coefficients, so non-grey input is
 clipped to ``[clip, 1 - clip]`` first (:data:`ALBEDO_CLIP`); grey input (all albedos
 equal, including n = 1) is returned as the constant spectrum without a fit.
+
+**Uncertainty.** Given the band albedos' standard deviations, the spectrum's is the spread of
+the spectra upsampled from :data:`NOISE_DRAWS` albedo sets drawn around the given ones
+(Gaussian, independent bands, clipped to [0, 1]; a fixed seed, so that a run repeats). The
+first-order propagation through the fit's Jacobian was tried and left: where the sigmoid
+saturates or the fit does not converge it misstates the spread by orders of magnitude
+(``bench/bench_calibration_spectra.py``: standard deviation of (spectrum - noise-free spectrum)
+/ sigma 1.92 on converged draws against 0.97 for the draws). It holds the model fixed: it is
+the spread of the upsampled spectrum over the albedos' noise, not the distance to the true
+spectrum between the bands, which n albedos do not bound.
 """
 
 from __future__ import annotations
@@ -41,9 +55,13 @@ import numpy as np
 from numpy.polynomial import legendre
 from numpy.typing import ArrayLike, NDArray
 
-from speclight.constants import HC_J_M
 from speclight.errors import InputError
-from speclight.wavelength_grid import bin_widths_nm, check_wavelength_grid
+from speclight.estimate.inputs.band_albedo import (
+    band_albedo,
+    check_band_response,
+    check_source,
+    photon_weights,
+)
 
 #: Default clipping of non-grey albedos to ``[ALBEDO_CLIP, 1 - ALBEDO_CLIP]`` [1]. It keeps
 #: the coefficients finite (``|S^-1| <= 1 / (2 sqrt(ALBEDO_CLIP))``, about 50) and costs at
@@ -54,6 +72,12 @@ ALBEDO_CLIP = 1e-4
 
 #: Default largest band-albedo error [1] for which a fit counts as converged.
 BAND_TOLERANCE = 1e-8
+
+#: Albedo sets drawn for ``reflectance_std``; its relative standard error is
+#: ``1 / sqrt(2 (NOISE_DRAWS - 1))``, 7 %.
+NOISE_DRAWS = 100
+#: Seed of those draws (a run repeats itself).
+NOISE_SEED = 25
 
 
 @dataclass(frozen=True)
@@ -82,6 +106,10 @@ class UpsampledSpectrum:
         ``max |albedo_fit - albedo|`` [1]; it includes the clipping.
     converged
         Whether ``max |albedo_fit - albedo_target| <= tol``.
+    reflectance_std
+        Standard deviation of ``reflectance`` [1] (L,) over the albedos' noise (module doc:
+        Uncertainty; ``inf`` where a band's ``albedo_std`` is); None where no ``albedo_std``
+        was given.
     """
 
     wavelength_nm: NDArray[np.float64]
@@ -94,6 +122,7 @@ class UpsampledSpectrum:
     albedo_fit: NDArray[np.float64]
     max_band_error: float
     converged: bool
+    reflectance_std: NDArray[np.float64] | None = None
 
 
 def sigmoid(x: ArrayLike) -> NDArray[np.float64]:
@@ -159,82 +188,13 @@ def sigmoid_polynomial(
     return sigmoid(legendre.legval(x, c))
 
 
-def photon_weights(band_response: ArrayLike, wavelength_nm: ArrayLike) -> NDArray[np.float64]:
-    """Normalised photon weights of eq. 3 [1] (n, L): ``R_j lambda / (h c) dl`` over its sum.
-
-    Parameters
-    ----------
-    band_response
-        Band responses on the grid (n, L) (band response x optics x QE) [1].
-    wavelength_nm
-        The grid [nm] (L,).
-
-    Returns
-    -------
-    numpy.ndarray
-        Weights whose rows sum to 1; ``weights @ g`` are the band albedos of ``g``.
-    """
-    wl = np.asarray(wavelength_nm, dtype=np.float64)
-    photons = np.asarray(band_response, dtype=np.float64) * (wl * 1e-9 / HC_J_M)
-    w = photons * bin_widths_nm(wl)
-    return np.asarray(w / w.sum(axis=-1, keepdims=True), dtype=np.float64)
-
-
-def band_albedo(
-    reflectance: ArrayLike, band_response: ArrayLike, wavelength_nm: ArrayLike
-) -> NDArray[np.float64]:
-    """Photon-weighted band averages of a reflectance spectrum (eq. 3) [1] (n,).
-
-    Parameters
-    ----------
-    reflectance
-        The spectrum on the grid [1] (L,).
-    band_response
-        Band responses on the grid (n, L) [1].
-    wavelength_nm
-        The grid [nm] (L,).
-    """
-    wl, response = _check_grid_and_response(band_response, wavelength_nm)
-    g = np.asarray(reflectance, dtype=np.float64)
-    if g.shape != wl.shape:
-        raise InputError(
-            f"reflectance has shape {g.shape}, expected {wl.shape} (one value per wavelength)",
-            field="reflectance",
-        )
-    return np.asarray(photon_weights(response, wl) @ g, dtype=np.float64)
-
-
-def _check_grid_and_response(
-    band_response: ArrayLike, wavelength_nm: ArrayLike
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    try:
-        wl = check_wavelength_grid(wavelength_nm)
-    except InputError as err:
-        raise InputError(err.message, field="wavelength_nm") from None
-    response = np.asarray(band_response, dtype=np.float64)
-    if response.ndim != 2 or response.shape[1] != wl.size:
-        raise InputError(
-            f"band_response has shape {response.shape}, expected (n_bands, {wl.size}) "
-            f"(one row per band on the {wl.size}-point wavelength grid)",
-            field="band_response",
-        )
-    if not np.all(np.isfinite(response)) or np.any(response < 0):
-        raise InputError("band_response must be finite and >= 0", field="band_response")
-    empty = np.flatnonzero(~(response.sum(axis=1) > 0))
-    if empty.size:
-        raise InputError(
-            f"band_response rows {empty.tolist()} are zero on the whole wavelength grid "
-            "(each band needs some response inside the grid)",
-            field="band_response",
-        )
-    return wl, response
-
-
 def upsample(
     albedo: ArrayLike,
     band_response: ArrayLike,
     wavelength_nm: ArrayLike,
     *,
+    source_W_m2_nm: ArrayLike | None = None,
+    albedo_std: ArrayLike | None = None,
     clip: float = ALBEDO_CLIP,
     tol: float = BAND_TOLERANCE,
     max_iterations: int = 200,
@@ -250,6 +210,12 @@ def upsample(
         transmission x detector QE; bands may overlap.
     wavelength_nm
         The grid [nm] (L,), strictly increasing, L >= 2 and L >= n.
+    source_W_m2_nm
+        The source spectrum at the aperture (L,) [W m-2 nm-1] that weights the band
+        averages (:mod:`speclight.estimate.inputs.band_albedo`); None: flat (eq. 3).
+    albedo_std
+        Standard deviations of the albedos [1] (n,), >= 0 (or inf where a band is not
+        constrained); None: no ``reflectance_std``.
     clip
         Non-grey albedos are clipped to ``[clip, 1 - clip]`` before the fit [1]; this
         costs at most ``clip`` in each band (see :data:`ALBEDO_CLIP`).
@@ -278,7 +244,7 @@ def upsample(
     Jakob, W. & Hanika, J. (2019). A Low-Dimensional Function Space for Efficient Spectral
     Upsampling. Computer Graphics Forum 38(2), 147-155. doi:10.1111/cgf.13626
     """
-    wl, response = _check_grid_and_response(band_response, wavelength_nm)
+    wl, response = check_band_response(band_response, wavelength_nm)
     rho = np.asarray(albedo, dtype=np.float64)
     n = response.shape[0]
     if rho.ndim != 1 or rho.size < 1:
@@ -307,19 +273,23 @@ def upsample(
 
     centre = 0.5 * (wl[0] + wl[-1])
     half_span = 0.5 * (wl[-1] - wl[0])
-    weights = photon_weights(response, wl)
+    weights = photon_weights(response, wl, check_source(source_W_m2_nm, wl, response))
+    std = _checked_std(albedo_std, n)
+    vander = legendre.legvander(scaled_wavelength(wl, centre, half_span), n - 1)
 
     if np.all(rho == rho[0]):
         coefficients = np.zeros(n)
         coefficients[0] = inverse_sigmoid(rho[0])
         reflectance = np.full(wl.size, rho[0])
         fit = weights @ reflectance
-        return _result(wl, reflectance, coefficients, centre, half_span, rho, rho.copy(), fit, tol)
+        spread = _noise_spread(rho, std, response, wl, source_W_m2_nm, clip, tol, max_iterations)
+        return _result(
+            wl, reflectance, coefficients, centre, half_span, rho, rho.copy(), fit, tol, spread
+        )
 
     from scipy.optimize import least_squares  # here: importing scipy.optimize costs ~0.3 s
 
     target = np.clip(rho, clip, 1.0 - clip)
-    vander = legendre.legvander(scaled_wavelength(wl, centre, half_span), n - 1)
     target_inv = inverse_sigmoid(target)
 
     def model(c: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -353,7 +323,54 @@ def upsample(
     coefficients = np.asarray(solution.x, dtype=np.float64)
     reflectance = sigmoid(vander @ coefficients)
     fit = weights @ reflectance
-    return _result(wl, reflectance, coefficients, centre, half_span, rho, target, fit, tol)
+    spread = _noise_spread(rho, std, response, wl, source_W_m2_nm, clip, tol, max_iterations)
+    return _result(wl, reflectance, coefficients, centre, half_span, rho, target, fit, tol, spread)
+
+
+def _checked_std(albedo_std: ArrayLike | None, n: int) -> NDArray[np.float64] | None:
+    if albedo_std is None:
+        return None
+    std = np.asarray(albedo_std, dtype=np.float64)
+    if std.shape != (n,) or np.any(np.isnan(std)) or np.any(std < 0):
+        raise InputError(
+            f"albedo_std = {std.tolist()!r} must be {n} values >= 0 (inf: not constrained)",
+            field="albedo_std",
+        )
+    return std
+
+
+def _noise_spread(
+    rho: NDArray[np.float64],
+    std: NDArray[np.float64] | None,
+    response: NDArray[np.float64],
+    wl: NDArray[np.float64],
+    source: ArrayLike | None,
+    clip: float,
+    tol: float,
+    max_iterations: int,
+) -> NDArray[np.float64] | None:
+    """Standard deviation (L,) of the spectra upsampled from albedos drawn with ``std``."""
+    if std is None:
+        return None
+    if np.any(np.isinf(std)):
+        return np.full(wl.size, np.inf)
+    if not np.any(std > 0):
+        return np.zeros(wl.size)
+    rng = np.random.default_rng(NOISE_SEED)
+    drawn = np.clip(rho + rng.normal(0.0, std, (NOISE_DRAWS, rho.size)), 0.0, 1.0)
+    spectra = [
+        upsample(
+            a,
+            response,
+            wl,
+            source_W_m2_nm=source,
+            clip=clip,
+            tol=tol,
+            max_iterations=max_iterations,
+        ).reflectance
+        for a in drawn
+    ]
+    return np.asarray(np.std(spectra, axis=0, ddof=1), dtype=np.float64)
 
 
 def _result(
@@ -366,6 +383,7 @@ def _result(
     target: NDArray[np.float64],
     fit: NDArray[np.float64],
     tol: float,
+    reflectance_std: NDArray[np.float64] | None,
 ) -> UpsampledSpectrum:
     fit_error = float(np.max(np.abs(fit - target)))
     return UpsampledSpectrum(
@@ -379,6 +397,7 @@ def _result(
         albedo_fit=np.asarray(fit, dtype=np.float64),
         max_band_error=float(np.max(np.abs(fit - rho))),
         converged=bool(np.isfinite(fit_error) and fit_error <= tol),
+        reflectance_std=reflectance_std,
     )
 
 
