@@ -234,8 +234,8 @@ def period(
         typer.Option(
             "--if-symmetric",
             help="auto, double or keep: the rotation period when the halves of the 2P fold "
-            "agree: double (the body looks alike after half a turn), keep, or auto (double "
-            "when the light curve has one maximum per cycle); see docs/period.md.",
+            "agree (P or 2P, said in the decision): double (the body looks alike after half a "
+            "turn), keep, or auto (2P, stated as ambiguous); see docs/period.md.",
         ),
     ] = "auto",
     synodic: Annotated[

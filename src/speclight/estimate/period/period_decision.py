@@ -24,16 +24,13 @@ at P and at 2P through a nested-model F-test (Press et al., Numerical Recipes, 1
 
 :func:`rotation_period` first halves P while the halves of the P fold do not differ (the best
 peak was a multiple of the photometric period), then doubles it when the halves of the 2P
-fold differ. When they do not (a body whose halves look alike within the noise), the data
-cannot tell, and ``if_symmetric`` says what to assume: ``"double"``, the body looks alike
-after half a turn (a box-wing with two like wings spinning about its antenna axis): P is
-doubled; ``"keep"``: P is kept; ``"auto"`` (the default): a light curve with one maximum per
-photometric cycle is taken as half a turn and P is doubled (maxima: the brightness maxima of
-the fitted K-harmonic curve, averaged over the bands with weights ``sum 1/dy^2``, whose
-prominence is at least a quarter of the curve's peak-to-peak range), the convention of
-asteroid photometry that a rotating body shows two maxima per turn (Harris et al. 1984,
-Icarus 57, 251, doi:10.1016/0019-1035(84)90140-1); a light curve that already shows two
-maxima per cycle is kept.
+fold differ. When they do not, the light curve cannot tell a body that turns in P from one
+that looks alike after half a turn and turns in 2P (the built-in box-wing spinning about
+its antenna axis is such a body: its light curves at rotation phases 0 and 180 deg agree to
+1e-15), the decision says "P or 2P" (``ambiguous``) and ``if_symmetric`` says what to
+report: ``"auto"`` (default) and ``"double"``: 2P (man-made bodies are often two-fold
+symmetric about their spin axis; a rotating body shows two maxima per turn, Harris et al.
+1984, Icarus 57, 251, doi:10.1016/0019-1035(84)90140-1); ``"keep"``: P.
 """
 
 from __future__ import annotations
@@ -41,12 +38,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-import numpy as np
-
 from speclight.estimate.period.periodogram import (
     TREND_DEGREE,
     BandSeries,
-    design_matrix,
     harmonic_chi2,
 )
 
@@ -107,33 +101,6 @@ def halves_test(
     return HalvesTest(period_s, stat, p, bool(p < ALPHA))
 
 
-#: Prominence of a maximum, as a fraction of the folded curve's peak-to-peak range.
-PROMINENCE = 0.25
-
-
-def maxima_per_cycle(series: BandSeries, period_s: float, harmonics: int) -> int:
-    """Brightness maxima per cycle of the fitted curve folded at ``period_s`` (module doc);
-    the series holds magnitudes, so maxima of brightness are minima of the curve."""
-    from scipy.signal import find_peaks
-
-    orders = list(range(1, harmonics + 1))
-    _, _, coefs = harmonic_chi2(series, 1.0 / period_s, orders)
-    phase = np.linspace(0.0, 3.0, 3 * 360, endpoint=False)
-    x = design_matrix(phase * period_s, 1.0 / period_s, orders)
-    curve = np.zeros(phase.size)
-    wsum = 0.0
-    for b, beta in enumerate(coefs):
-        w = float(np.sum(1.0 / series.dy[series.band == b] ** 2))
-        curve += w * (x @ beta)
-        wsum += w
-    curve /= wsum
-    span = float(np.ptp(curve))
-    if span <= 0:
-        return 0
-    peaks, _ = find_peaks(-curve, prominence=PROMINENCE * span)
-    return int(np.sum((phase[peaks] >= 1.0) & (phase[peaks] < 2.0)))
-
-
 @dataclass
 class RotationDecision:
     """The rotation period chosen from the photometric one, and why."""
@@ -143,6 +110,8 @@ class RotationDecision:
     factor: float
     decision: str
     tests: list[HalvesTest]
+    #: True where the halves of the 2P fold agree: the rotation period is P or 2P.
+    ambiguous: bool = False
 
 
 def rotation_period(
@@ -195,28 +164,23 @@ def rotation_period(
         )
         return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests)
     same = (
-        f"the halves of the 2P fold agree within the noise (F = {double.f_statistic:.3g}, "
-        f"p = {double.p_value:.2g} >= {ALPHA:g})"
+        f"P or 2P: the halves of the 2P fold agree within the noise "
+        f"(F = {double.f_statistic:.3g}, p = {double.p_value:.2g} >= {ALPHA:g}), so the light "
+        f"curve cannot tell a body that turns in P = {p_ph:.6g} s from one that looks alike "
+        f"after half a turn and turns in 2P = {2 * p_ph:.6g} s"
     )
     if if_symmetric == "double":
         text = (
-            f"{same}; the body is said to look alike after half a turn (--if-symmetric "
-            "double): the rotation period is 2P"
+            f"{same}; the body is said to look alike after half a turn (--if-symmetric double): 2P"
         )
         return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests)
-    maxima = maxima_per_cycle(series, p_ph, harmonics)
-    if if_symmetric == "auto" and maxima <= 1:
+    if if_symmetric == "auto":
         text = (
-            f"{same}; the light curve shows one maximum per photometric cycle: taken as "
-            "half a turn of a body "
-            "that looks alike after half a turn (two maxima per turn), so the rotation "
-            "period is 2P (--if-symmetric keep keeps P)"
+            f"{same}; 2P is reported (a convention: man-made bodies are often two-fold "
+            "symmetric about their spin axis, two like wings, a cylinder end over end, and "
+            "a rotating body shows two maxima per turn, Harris et al. 1984); --if-symmetric "
+            "keep gives P"
         )
-        return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests)
-    why = (
-        f"the light curve already shows {maxima} maxima per cycle"
-        if maxima > 1
-        else "--if-symmetric keep"
-    )
-    text = f"{same}; {why}: the rotation period is the photometric period"
-    return RotationDecision(p_ph, p_ph, factor, text, tests)
+        return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests, ambiguous=True)
+    text = f"{same}; P is reported (--if-symmetric keep)"
+    return RotationDecision(p_ph, p_ph, factor, text, tests, ambiguous=True)

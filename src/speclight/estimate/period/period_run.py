@@ -218,6 +218,8 @@ def estimate_period(
     analytic: AnalyticFap = analytic_fap(series, freq, harmonics, peak.frequency_hz)
     boot = bootstrap_maxima(series, freq, harmonics, draws, seed) if boot_wanted else None
     decision = rotation_period(series, 1 / peak.frequency_hz, harmonics, min_p, if_symmetric)
+    if decision.ambiguous:
+        notices.append(decision.decision)
     tumbling = tumbling_test(series, freq, 1 / decision.rotation_period_s, harmonics, ALPHA)
     correction = None
     geometry = pass_geometry(measured, lc, loaded, source)
