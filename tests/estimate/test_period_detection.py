@@ -171,3 +171,42 @@ def test_unsorted_rows_are_sorted_with_a_notice(tmp_path):
     ordered = estimate_period(_csv(tmp_path / "o.csv", t, rate, sigma))
     assert "sorted by time" in mixed.to_json()["notices"][0]
     assert mixed.period_s == pytest.approx(ordered.period_s, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("shoulder", "expected"),
+    [(0.0, 1), (0.3, 1), (1.0, 2)],  # second maximum's height relative to the first
+)
+def test_principal_maxima_per_cycle(shoulder, expected):
+    # A brightness curve (magnitudes: maxima are minima) with one maximum at phase 0 and a
+    # second of relative height `shoulder` at phase 0.5: exactly representable by K = 4
+    # harmonics (cos^2 terms), so the fit is the curve itself.
+    from speclight.estimate.period.period_decision import maxima_per_cycle
+
+    period = 10.0
+    t = np.linspace(0.0, 200.0, 2001)
+    phase = 2 * np.pi * t / period
+    y = -(np.cos(phase / 2) ** 8) - shoulder * np.sin(phase / 2) ** 8
+    series = _series(t, y[None], np.full(t.size, 0.01), 1)
+    assert maxima_per_cycle(series, period, 4) == expected
+
+
+def test_auto_reports_2p_for_one_maximum_and_p_for_two():
+    # Halves of the 2P fold alike (a curve exactly periodic in P): "P or 2P" either way;
+    # one principal maximum per P -> 2P (half a turn), two unequal principal maxima (heights
+    # 1 and 0.8: P cannot be halved) -> P (Harris 1984).
+    from speclight.estimate.period.period_decision import rotation_period
+
+    period = 10.0
+    t = np.linspace(0.0, 300.0, 3001)
+    phase = 2 * np.pi * t / period
+    rng = np.random.default_rng(3)
+    for y, expected in (
+        (-(np.cos(phase / 2) ** 8), 2 * period),
+        (-(np.cos(phase / 2) ** 8) - 0.8 * np.sin(phase / 2) ** 8, period),
+    ):
+        y = y + rng.normal(0.0, 0.01, t.size)
+        series = _series(t, y[None], np.full(t.size, 0.01), 1)
+        decision = rotation_period(series, period, 4, 1.0, "auto")
+        assert decision.ambiguous
+        assert decision.rotation_period_s == pytest.approx(expected, rel=1e-12)

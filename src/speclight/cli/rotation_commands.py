@@ -235,7 +235,8 @@ def period(
             "--if-symmetric",
             help="auto, double or keep: the rotation period when the halves of the 2P fold "
             "agree (P or 2P, said in the decision): double (the body looks alike after half a "
-            "turn), keep, or auto (2P, stated as ambiguous); see docs/period.md.",
+            "turn), keep, or auto (2P if the folded curve has one principal maximum, P if two; "
+            "stated as ambiguous); see docs/period.md.",
         ),
     ] = "auto",
     synodic: Annotated[

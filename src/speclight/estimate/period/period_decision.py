@@ -28,9 +28,11 @@ fold differ. When they do not, the light curve cannot tell a body that turns in 
 that looks alike after half a turn and turns in 2P (the built-in box-wing spinning about
 its antenna axis is such a body: its light curves at rotation phases 0 and 180 deg agree to
 1e-15), the decision says "P or 2P" (``ambiguous``) and ``if_symmetric`` says what to
-report: ``"auto"`` (default) and ``"double"``: 2P (man-made bodies are often two-fold
-symmetric about their spin axis; a rotating body shows two maxima per turn, Harris et al.
-1984, Icarus 57, 251, doi:10.1016/0019-1035(84)90140-1); ``"keep"``: P.
+report: ``"double"``: 2P; ``"keep"``: P; ``"auto"`` (the default): the convention of
+asteroid photometry that a rotating body shows two maxima per turn (Harris et al. 1984,
+Icarus 57, 251, doi:10.1016/0019-1035(84)90140-1): a light curve with one principal maximum
+per photometric cycle (:func:`maxima_per_cycle`) is half a turn, 2P is reported; one that
+already shows two is a whole turn, P is reported. Either way the ambiguity is stated.
 """
 
 from __future__ import annotations
@@ -38,9 +40,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
+import numpy as np
+
 from speclight.estimate.period.periodogram import (
     TREND_DEGREE,
     BandSeries,
+    design_matrix,
     harmonic_chi2,
 )
 
@@ -99,6 +104,39 @@ def halves_test(
         rho, _ = residual_lag1_correlation(series, freq, orders, coefs, trend_degree=TREND_DEGREE)
     stat, p = nested_f_test(reduced, p_red, full, p_full, series.t_s.size, rho)
     return HalvesTest(period_s, stat, p, bool(p < ALPHA))
+
+
+#: Prominence of a principal maximum, as a fraction of the folded curve's peak-to-peak range:
+#: the two maxima per turn of a double-peaked light curve are comparable; a bump of less than
+#: half the range is a shoulder of one maximum (a glint beside a face), not the second one.
+PROMINENCE = 0.5
+
+
+def maxima_per_cycle(series: BandSeries, period_s: float, harmonics: int) -> int:
+    """Principal brightness maxima per cycle of the fitted curve folded at ``period_s``.
+
+    The K-harmonic curve of each band, averaged with weights ``sum 1/dy^2``; the series
+    holds magnitudes, so maxima of brightness are minima of the curve. A maximum counts when
+    its prominence is at least :data:`PROMINENCE` of the curve's peak-to-peak range.
+    """
+    from scipy.signal import find_peaks
+
+    orders = list(range(1, harmonics + 1))
+    _, _, coefs = harmonic_chi2(series, 1.0 / period_s, orders)
+    phase = np.linspace(0.0, 3.0, 3 * 360, endpoint=False)  # three cycles: no edge effects
+    x = design_matrix(phase * period_s, 1.0 / period_s, orders)
+    curve = np.zeros(phase.size)
+    weight_sum = 0.0
+    for b, beta in enumerate(coefs):
+        w = float(np.sum(1.0 / series.dy[series.band == b] ** 2))
+        curve += w * (x @ beta)
+        weight_sum += w
+    curve /= weight_sum
+    span = float(np.ptp(curve))
+    if span <= 0:
+        return 0
+    peaks, _ = find_peaks(-curve, prominence=PROMINENCE * span)
+    return int(np.sum((phase[peaks] >= 1.0) & (phase[peaks] < 2.0)))
 
 
 @dataclass
@@ -175,12 +213,21 @@ def rotation_period(
         )
         return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests)
     if if_symmetric == "auto":
+        maxima = maxima_per_cycle(series, p_ph, harmonics)
+        if maxima <= 1:
+            text = (
+                f"{same}; the light curve shows one principal maximum per photometric cycle "
+                "(maxima of at least half its range): taken as half a turn of a body that "
+                "shows two maxima per turn (Harris et al. 1984; man-made bodies are often "
+                "two-fold symmetric about their spin axis), so 2P is reported; "
+                "--if-symmetric keep gives P"
+            )
+            return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests, ambiguous=True)
         text = (
-            f"{same}; 2P is reported (a convention: man-made bodies are often two-fold "
-            "symmetric about their spin axis, two like wings, a cylinder end over end, and "
-            "a rotating body shows two maxima per turn, Harris et al. 1984); --if-symmetric "
-            "keep gives P"
+            f"{same}; the light curve already shows {maxima} principal maxima per cycle, the "
+            "two maxima per turn of a rotating body (Harris et al. 1984), so P is reported; "
+            "--if-symmetric double gives 2P"
         )
-        return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests, ambiguous=True)
+        return RotationDecision(p_ph, p_ph, factor, text, tests, ambiguous=True)
     text = f"{same}; P is reported (--if-symmetric keep)"
     return RotationDecision(p_ph, p_ph, factor, text, tests, ambiguous=True)
