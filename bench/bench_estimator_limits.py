@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from speclight.estimate.period.period_run import SECONDS_PER_BAND_FREQUENCY, SECONDS_PER_TERM
+from speclight.estimate.period.period_options import SECONDS_PER_BAND_FREQUENCY, SECONDS_PER_TERM
 from speclight.estimate.period.periodogram import BandSeries, multiband_power
 from speclight.estimate.spin_axis.spin_axis_core import grid_terms, radec_grid
 from speclight.estimate.spin_axis.spin_axis_limits import (

@@ -38,7 +38,7 @@ SPIN_AXIS_FLAGS = {
 PERIOD_FLAGS = {
     "min_period_s": "--min-period-s", "max_period_s": "--max-period-s", "draws": "--draws",
     "harmonics": "--harmonics", "seed": "--seed", "synodic": "--synodic", "bin_s": "--bin-s",
-    "loaded": "--scenario", "source": "--source",
+    "loaded": "--scenario", "source": "--source", "fap_method": "--fap",
 }  # fmt: skip
 
 
@@ -219,14 +219,24 @@ def period(
         int,
         typer.Option("--draws", help="Bootstrap draws for the false-alarm probability (1..10000)."),
     ] = 40,
+    fap: Annotated[
+        str,
+        typer.Option(
+            "--fap",
+            help="auto, analytic or bootstrap: the false-alarm probability by Baluev's "
+            "approximation (analytic), by --draws permutations (bootstrap), or analytic "
+            "where every band has 10 points per model parameter (auto).",
+        ),
+    ] = "auto",
     seed: Annotated[int, typer.Option("--seed", help="Seed of the bootstrap.")] = 0,
     if_symmetric: Annotated[
         str,
         typer.Option(
             "--if-symmetric",
             help="auto, double or keep: the rotation period when the halves of the 2P fold "
-            "agree: double (the body looks alike after half a turn), keep, or auto (double "
-            "when the light curve has one maximum per cycle); see docs/period.md.",
+            "agree (P or 2P, said in the decision): double (the body looks alike after half a "
+            "turn), keep, or auto (2P if the folded curve has one principal maximum, P if two; "
+            "stated as ambiguous); see docs/period.md.",
         ),
     ] = "auto",
     synodic: Annotated[
@@ -249,8 +259,10 @@ def period(
     force: Force = False,
 ) -> None:
     """Rotation period from one or many bands: multi-band multi-harmonic Lomb-Scargle,
-    bootstrap false-alarm probability, photometric or rotation period (the halves of the
-    2P fold), synodic correction where the geometry is known. Writes PERIOD.json.
+    false-alarm probability at the noise level beside the peak (no period below 1 %: a
+    lower bound where the light curve varies slowly), outliers left out, photometric or
+    rotation period (the halves of the 2P fold), tumbling (two frequencies), synodic
+    correction where the geometry is known. Writes PERIOD.json.
 
     Example: speclight period pass.nc -o period.json --plot period.png
     """
@@ -274,7 +286,7 @@ def period(
                 min_period_s=min_period_s, max_period_s=max_period_s, harmonics=harmonics,
                 bin_s=bin_s, draws=draws, seed=seed, if_symmetric=rule,
                 synodic=synodic,  # type: ignore[arg-type]  # checked by estimate_period
-                source=source,
+                source=source, fap_method=fap,  # type: ignore[arg-type]  # checked there
             ),
             data=lambda r: json_bytes(r.to_json()), figure=_period_figure, flags=PERIOD_FLAGS,
         )  # fmt: skip
@@ -283,11 +295,22 @@ def period(
         def shown(key: str, spec: str) -> str:  # null: not determined (PERIOD.json says)
             return "undetermined" if summary[key] is None else format(summary[key], spec)
 
-        typer.echo(
-            f"rotation period {shown('period_s', '.6g')} +- {shown('period_std_s', '.2g')} s "
-            f"(photometric {shown('photometric_period_s', '.6g')} s, false-alarm probability "
-            f"{shown('false_alarm_probability', '.2g')})"
-        )
+        if not summary["detected"]:
+            typer.echo(summary["verdict"])
+        else:
+            typer.echo(
+                f"rotation period {shown('period_s', '.6g')} +- "
+                f"{shown('period_std_s', '.2g')} s (photometric "
+                f"{shown('photometric_period_s', '.6g')} s, false-alarm probability "
+                f"{shown('false_alarm_probability', '.2g')})"
+            )
+            if summary["tumbling"] and summary["tumbling"]["detected"]:
+                typer.echo(summary["verdict"])
+        for notice in summary["outliers"]:
+            typer.echo(
+                f"outlier left out: band {notice['band']} at {notice['time_s']:.6g} s "
+                f"({notice['residual_sigma']:.3g} sigma)"
+            )
         say_wrote(output, plot_file)
 
     guarded(run)

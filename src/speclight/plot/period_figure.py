@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from speclight.estimate.period.period_run import PeriodResult
+from speclight.estimate.period.period_result import PeriodResult
 from speclight.estimate.period.periodogram import design_matrix, harmonic_chi2
 from speclight.plot.style import new_figure
 
@@ -36,7 +36,7 @@ def period_figure(result: PeriodResult) -> Any:
     period = 1.0 / result.frequency_hz
     ax1.plot(period, result.power, lw=0.8, color="k")
     ax1.set_xscale("log")
-    level = result.bootstrap.power_at(0.01)
+    level = result.power_at(0.01)
     ax1.axhline(level, ls="--", color="tab:red", lw=0.8, label="1 % false-alarm level")
     for i, (p, w) in enumerate(result.candidates, 1):
         ax1.annotate(str(i), (p, w), textcoords="offset points", xytext=(0, 3), ha="center")

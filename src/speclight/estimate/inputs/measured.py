@@ -129,10 +129,11 @@ class MeasuredLightCurve:
         )
 
 
-def read_measured(path: str | Path, source: str = "sun") -> MeasuredLightCurve:
+def read_measured(path: str | Path, source: str = "sun", sort: bool = False) -> MeasuredLightCurve:
     """Read measured light curves from a CSV or a speclight NetCDF file (module doc).
 
-    ``source``: ``"sun"`` (the count rates) or ``"laser"`` (a NetCDF's laser return rates).
+    ``source``: ``"sun"`` (the count rates) or ``"laser"`` (a NetCDF's laser return rates);
+    ``sort``: a CSV's rows out of time order are sorted (with a warning), not refused.
     """
     p = Path(path)
     if source not in ("sun", "laser"):
@@ -146,7 +147,7 @@ def read_measured(path: str | Path, source: str = "sun") -> MeasuredLightCurve:
             source=str(p),
             field="source",
         )
-    c = read_csv_columns(p)
+    c = read_csv_columns(p, sort)
     ones = np.ones(c.time_utc.size, np.int64)
     return MeasuredLightCurve(
         c.time_utc,

@@ -48,8 +48,10 @@ class CsvLightCurve:
     sigma_per_s: F64 | None
 
 
-def read_csv_columns(path: Path) -> CsvLightCurve:
-    """The epochs, band names, rates and sigmas of a CSV (module docstring), checked."""
+def read_csv_columns(path: Path, sort: bool = False) -> CsvLightCurve:
+    """The epochs, band names, rates and sigmas of a CSV (module docstring), checked; with
+    ``sort``, rows out of time order are sorted by time (a warning says how many moved)
+    instead of refused."""
     src = str(path)
     text = read_user_text(path, FIELD, what="measurements")
     numbered = [
@@ -87,6 +89,14 @@ def read_csv_columns(path: Path) -> CsvLightCurve:
         times.append(parse_utc_time(cells[0], f"line {k}", src))
         values.append([_number(c, k, col, src) for c, col in zip(cells[1:], names, strict=True)])
     t = np.array(times, dtype="datetime64[ns]")
+    if sort and np.any(np.diff(t) < np.timedelta64(0, "ns")):
+        import warnings
+
+        order = np.argsort(t, kind="stable")
+        moved = int(np.sum(order != np.arange(t.size)))
+        warnings.warn(f"{src}: {moved} rows out of time order; sorted by time", stacklevel=2)
+        t, values = t[order], [values[i] for i in order]
+        lines = [lines[0]] + [lines[1 + int(i)] for i in order]
 
     def row(i: int) -> str:
         return f"line {lines[i + 1]}"

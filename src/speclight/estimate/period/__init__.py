@@ -8,6 +8,7 @@
 * :mod:`.period_geometry`: the phase-angle bisector and the spin axis of a scenario.
 """
 
-from speclight.estimate.period.period_run import PeriodResult, estimate_period
+from speclight.estimate.period.period_result import PeriodResult
+from speclight.estimate.period.period_run import estimate_period
 
 __all__ = ["PeriodResult", "estimate_period"]

@@ -13,7 +13,10 @@ at P and at 2P through a nested-model F-test (Press et al., Numerical Recipes, 1
 * ``F = ((chi2_r - chi2_f) / (p_f - p_r)) / (chi2_f / (n - p_f))`` is F-distributed with
   ``(p_f - p_r, n - p_f)`` degrees of freedom when the two halves of the 2P fold are the same
   curve; its residual variance is estimated from the data, so mis-stated sigmas or a light
-  curve that changes over the pass make the test more cautious, not less;
+  curve that changes over the pass make the test more cautious, not less, and residuals
+  correlated from epoch to epoch (lag-1 correlation ``rho`` of the full model's) count as
+  ``n (1 - rho) / (1 + rho)`` points (:func:`nested_f_test`) in the test that doubles a
+  period (not in the one that halves it: each errs towards keeping the period found);
 * the halves differ when the p-value is below ``alpha`` (0.001);
 * a fold period is tested only when it fits at least 3 times into the span (with fewer
   cycles the odd harmonics of the long period fit the slow change of the light curve over
@@ -21,16 +24,15 @@ at P and at 2P through a nested-model F-test (Press et al., Numerical Recipes, 1
 
 :func:`rotation_period` first halves P while the halves of the P fold do not differ (the best
 peak was a multiple of the photometric period), then doubles it when the halves of the 2P
-fold differ. When they do not (a body whose halves look alike within the noise), the data
-cannot tell, and ``if_symmetric`` says what to assume: ``"double"``, the body looks alike
-after half a turn (a box-wing with two like wings spinning about its antenna axis): P is
-doubled; ``"keep"``: P is kept; ``"auto"`` (the default): a light curve with one maximum per
-photometric cycle is taken as half a turn and P is doubled (maxima: the brightness maxima of
-the fitted K-harmonic curve, averaged over the bands with weights ``sum 1/dy^2``, whose
-prominence is at least a quarter of the curve's peak-to-peak range), the convention of
+fold differ. When they do not, the light curve cannot tell a body that turns in P from one
+that looks alike after half a turn and turns in 2P (the built-in box-wing spinning about
+its antenna axis is such a body: its light curves at rotation phases 0 and 180 deg agree to
+1e-15), the decision says "P or 2P" (``ambiguous``) and ``if_symmetric`` says what to
+report: ``"double"``: 2P; ``"keep"``: P; ``"auto"`` (the default): the convention of
 asteroid photometry that a rotating body shows two maxima per turn (Harris et al. 1984,
-Icarus 57, 251, doi:10.1016/0019-1035(84)90140-1); a light curve that already shows two
-maxima per cycle is kept.
+Icarus 57, 251, doi:10.1016/0019-1035(84)90140-1): a light curve with one principal maximum
+per photometric cycle (:func:`maxima_per_cycle`) is half a turn, 2P is reported; one that
+already shows two is a whole turn, P is reported. Either way the ambiguity is stated.
 """
 
 from __future__ import annotations
@@ -65,45 +67,71 @@ class HalvesTest:
     differ: bool
 
 
-def halves_test(series: BandSeries, period_s: float, harmonics: int) -> HalvesTest:
-    """Do the two halves of the light curve folded at ``period_s`` differ? (F-test)."""
+def nested_f_test(
+    chi_r: float, p_r: int, chi_f: float, p_f: int, n: int, rho: float = 0.0
+) -> tuple[float, float]:
+    """F statistic and p-value of nested least-squares models (chi-squares ``chi_r``,
+    ``chi_f`` with ``p_r < p_f`` parameters, ``n`` points); residuals with lag-1 correlation
+    ``rho > 0`` count as ``n (1 - rho) / (1 + rho)`` independent points (the variance of the
+    mean of an AR(1) series, Bartlett 1946, J. R. Stat. Soc. Suppl. 8, 27): the statistic
+    is divided, and the denominator's degrees of freedom multiplied, by that factor."""
     from scipy.stats import f as f_dist
 
+    d1, d2 = p_f - p_r, n - p_f
+    if d1 <= 0 or d2 <= 0 or chi_f <= 0:
+        return float("nan"), float("nan")
+    shrink = (1 - rho) / (1 + rho) if rho > 0 else 1.0
+    stat = max((chi_r - chi_f) / d1, 0.0) / (chi_f / d2) * shrink
+    return float(stat), float(f_dist.sf(stat, d1, max(d2 * shrink, 1.0)))
+
+
+def halves_test(
+    series: BandSeries, period_s: float, harmonics: int, correlated: bool = False
+) -> HalvesTest:
+    """Do the two halves of the light curve folded at ``period_s`` differ? (F-test; with
+    ``correlated``, counting the full model's residual correlation, :func:`nested_f_test`:
+    harder to call them different, used before doubling a period)."""
+    from speclight.estimate.period.periodogram import residual_lag1_correlation
+
     freq = 1.0 / period_s
-    full, p_full, _ = harmonic_chi2(
-        series, freq, list(range(1, 2 * harmonics + 1)), trend_degree=TREND_DEGREE
-    )
+    orders = list(range(1, 2 * harmonics + 1))
+    full, p_full, coefs = harmonic_chi2(series, freq, orders, trend_degree=TREND_DEGREE)
     reduced, p_red, _ = harmonic_chi2(
         series, freq, list(range(2, 2 * harmonics + 1, 2)), trend_degree=TREND_DEGREE
     )
-    d1, d2 = p_full - p_red, series.t_s.size - p_full
-    if d2 <= 0 or full <= 0:
-        return HalvesTest(period_s, float("nan"), float("nan"), False)
-    stat = max((reduced - full) / d1, 0.0) / (full / d2)
-    p = float(f_dist.sf(stat, d1, d2))
-    return HalvesTest(period_s, float(stat), p, p < ALPHA)
+    rho = 0.0
+    if correlated:
+        rho, _ = residual_lag1_correlation(series, freq, orders, coefs, trend_degree=TREND_DEGREE)
+    stat, p = nested_f_test(reduced, p_red, full, p_full, series.t_s.size, rho)
+    return HalvesTest(period_s, stat, p, bool(p < ALPHA))
 
 
-#: Prominence of a maximum, as a fraction of the folded curve's peak-to-peak range.
-PROMINENCE = 0.25
+#: Prominence of a principal maximum, as a fraction of the folded curve's peak-to-peak range:
+#: the two maxima per turn of a double-peaked light curve are comparable; a bump of less than
+#: half the range is a shoulder of one maximum (a glint beside a face), not the second one.
+PROMINENCE = 0.5
 
 
 def maxima_per_cycle(series: BandSeries, period_s: float, harmonics: int) -> int:
-    """Brightness maxima per cycle of the fitted curve folded at ``period_s`` (module doc);
-    the series holds magnitudes, so maxima of brightness are minima of the curve."""
+    """Principal brightness maxima per cycle of the fitted curve folded at ``period_s``.
+
+    The K-harmonic curve of each band, averaged with weights ``sum 1/dy^2``; the series
+    holds magnitudes, so maxima of brightness are minima of the curve. A maximum counts when
+    its prominence is at least :data:`PROMINENCE` of the curve's peak-to-peak range.
+    """
     from scipy.signal import find_peaks
 
     orders = list(range(1, harmonics + 1))
     _, _, coefs = harmonic_chi2(series, 1.0 / period_s, orders)
-    phase = np.linspace(0.0, 3.0, 3 * 360, endpoint=False)
+    phase = np.linspace(0.0, 3.0, 3 * 360, endpoint=False)  # three cycles: no edge effects
     x = design_matrix(phase * period_s, 1.0 / period_s, orders)
     curve = np.zeros(phase.size)
-    wsum = 0.0
+    weight_sum = 0.0
     for b, beta in enumerate(coefs):
         w = float(np.sum(1.0 / series.dy[series.band == b] ** 2))
         curve += w * (x @ beta)
-        wsum += w
-    curve /= wsum
+        weight_sum += w
+    curve /= weight_sum
     span = float(np.ptp(curve))
     if span <= 0:
         return 0
@@ -120,6 +148,8 @@ class RotationDecision:
     factor: float
     decision: str
     tests: list[HalvesTest]
+    #: True where the halves of the 2P fold agree: the rotation period is P or 2P.
+    ambiguous: bool = False
 
 
 def rotation_period(
@@ -162,7 +192,7 @@ def rotation_period(
             "rotation period is taken as the photometric period"
         )
         return RotationDecision(p_ph, p_ph, factor, text, tests)
-    double = halves_test(series, 2 * p_ph, harmonics)
+    double = halves_test(series, 2 * p_ph, harmonics, correlated=True)
     tests.append(double)
     if double.differ:
         text = (
@@ -172,28 +202,32 @@ def rotation_period(
         )
         return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests)
     same = (
-        f"the halves of the 2P fold agree within the noise (F = {double.f_statistic:.3g}, "
-        f"p = {double.p_value:.2g} >= {ALPHA:g})"
+        f"P or 2P: the halves of the 2P fold agree within the noise "
+        f"(F = {double.f_statistic:.3g}, p = {double.p_value:.2g} >= {ALPHA:g}), so the light "
+        f"curve cannot tell a body that turns in P = {p_ph:.6g} s from one that looks alike "
+        f"after half a turn and turns in 2P = {2 * p_ph:.6g} s"
     )
     if if_symmetric == "double":
         text = (
-            f"{same}; the body is said to look alike after half a turn (--if-symmetric "
-            "double): the rotation period is 2P"
+            f"{same}; the body is said to look alike after half a turn (--if-symmetric double): 2P"
         )
         return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests)
-    maxima = maxima_per_cycle(series, p_ph, harmonics)
-    if if_symmetric == "auto" and maxima <= 1:
+    if if_symmetric == "auto":
+        maxima = maxima_per_cycle(series, p_ph, harmonics)
+        if maxima <= 1:
+            text = (
+                f"{same}; the light curve shows one principal maximum per photometric cycle "
+                "(maxima of at least half its range): taken as half a turn of a body that "
+                "shows two maxima per turn (Harris et al. 1984; man-made bodies are often "
+                "two-fold symmetric about their spin axis), so 2P is reported; "
+                "--if-symmetric keep gives P"
+            )
+            return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests, ambiguous=True)
         text = (
-            f"{same}; the light curve shows one maximum per photometric cycle: taken as "
-            "half a turn of a body "
-            "that looks alike after half a turn (two maxima per turn), so the rotation "
-            "period is 2P (--if-symmetric keep keeps P)"
+            f"{same}; the light curve already shows {maxima} principal maxima per cycle, the "
+            "two maxima per turn of a rotating body (Harris et al. 1984), so P is reported; "
+            "--if-symmetric double gives 2P"
         )
-        return RotationDecision(p_ph, 2 * p_ph, 2 * factor, text, tests)
-    why = (
-        f"the light curve already shows {maxima} maxima per cycle"
-        if maxima > 1
-        else "--if-symmetric keep"
-    )
-    text = f"{same}; {why}: the rotation period is the photometric period"
-    return RotationDecision(p_ph, p_ph, factor, text, tests)
+        return RotationDecision(p_ph, p_ph, factor, text, tests, ambiguous=True)
+    text = f"{same}; P is reported (--if-symmetric keep)"
+    return RotationDecision(p_ph, p_ph, factor, text, tests, ambiguous=True)

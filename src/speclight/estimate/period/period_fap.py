@@ -14,6 +14,12 @@ Gumbel law is its shape-0 case, stable with few draws): this reaches below ``1/d
 where counting cannot. The plain permutation p-value ``(1 + #{max_i >= p}) / (1 + draws)``
 (an upper bound when no draw reaches ``p``) is reported beside it. ``power_at(0.01)`` is the
 power whose fitted false-alarm probability is 1 %, marked in the figure.
+
+The draws run in parallel threads (astropy's periodogram spends its time in numpy, which
+releases the interpreter lock); each draw has its own random stream spawned from ``seed``
+(numpy's ``SeedSequence.spawn``), so the result does not depend on the number of threads.
+The bootstrap is what ``speclight period --fap bootstrap`` computes; by default the
+analytic approximation of :mod:`.analytic_fap` replaces it where it is valid.
 """
 
 from __future__ import annotations
@@ -88,8 +94,16 @@ def bootstrap_maxima(
     seed
         Seed of the permutations.
     """
-    rng = np.random.default_rng(seed)
-    maxima = np.empty(draws)
-    for i in range(draws):
-        maxima[i] = multiband_power(series.permuted(rng), frequency_hz, harmonics).max()
+    import os
+    from concurrent.futures import ThreadPoolExecutor
+
+    streams = np.random.SeedSequence(seed).spawn(draws)
+
+    def one(stream: np.random.SeedSequence) -> float:
+        permuted = series.permuted(np.random.default_rng(stream))
+        return float(np.nanmax(multiband_power(permuted, frequency_hz, harmonics)))
+
+    workers = max(1, min(draws, os.cpu_count() or 1))
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        maxima = np.fromiter(pool.map(one, streams), dtype=float, count=draws)
     return BootstrapMaxima(maxima, seed)

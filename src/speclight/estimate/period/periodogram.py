@@ -8,8 +8,8 @@ the chi-square about the weighted band means that the model explains,
 ``P(f) = 1 - sum_b chi2_b(f) / sum_b chi2_0b`` ("standard" normalisation).
 
 Each band's ``chi2_b(f)`` comes from astropy's single-band
-:class:`~astropy.timeseries.LombScargle` (``nterms = K``, method ``chi2``, or ``fastchi2``
-for long series); the bands are
+:class:`~astropy.timeseries.LombScargle` (``nterms = K``, method ``chi2``, or for long series
+``fastchi2``, and ``fast`` (Press & Rybicki 1989) when ``K = 1``); the bands are
 combined with their ``chi2_0b`` as weights. (astropy's ``LombScargleMultiband(method="fast")``
 combines the same single-band powers but weights them by the sum of each band's squared powers,
 which is not the chi-square of the joint model; hence the combination here.)
@@ -118,7 +118,7 @@ def multiband_power(series: BandSeries, frequency_hz: F64, harmonics: int) -> F6
         if chi0[b] <= 0:
             continue
         ls = LombScargle(series.t_s[m], series.y[m], series.dy[m], nterms=harmonics)
-        method = "fastchi2" if m.sum() > FAST_ABOVE else "chi2"
+        method = "chi2" if m.sum() <= FAST_ABOVE else "fast" if harmonics == 1 else "fastchi2"
         total += chi0[b] * ls.power(frequency_hz, method=method, normalization="standard")
     return np.asarray(total / chi0.sum(), dtype=np.float64)
 
@@ -143,6 +143,15 @@ def _with_trend(series: BandSeries, m: NDArray[np.bool_], x: F64, degree: int) -
         return x
     u = 2 * (series.t_s[m] - series.t_s.min()) / max(series.span_s, 1e-12) - 1
     return np.hstack([x, np.stack([u**d for d in range(1, degree + 1)], axis=1)])
+
+
+def weighted_lstsq(x: F64, y: F64, w: F64) -> F64:
+    """Least-squares coefficients of ``(x * w) beta ~ y * w``, through the normal equations
+    (``p x p`` for ``N x p`` columns: many times faster than an SVD of the tall matrix for
+    the few columns here), solved by SVD so that collinear columns stay finite."""
+    a = x * w[:, None]
+    beta, *_ = np.linalg.lstsq(a.T @ a, a.T @ (y * w), rcond=None)
+    return np.asarray(beta, dtype=np.float64)
 
 
 def harmonic_chi2(
@@ -187,7 +196,7 @@ def harmonic_chi2(
         x = _with_trend(
             series, m, design_matrix(series.t_s[m], frequency_hz, orders, ph), trend_degree
         )
-        beta, *_ = np.linalg.lstsq(x * w[:, None], series.y[m] * w, rcond=None)
+        beta = weighted_lstsq(x, series.y[m], w)
         chi2 += float(np.sum(((series.y[m] - x @ beta) * w) ** 2))
         npar += x.shape[1]
         coefs.append(beta)

@@ -9,7 +9,7 @@ Plain-array cores beside the run, as in the other estimate products:
   polyhedron with analytic derivatives), :mod:`.lm_solver`, :mod:`.convex_fit`;
 * :mod:`.period_scan`, :mod:`.pole_search`, :mod:`.uncertainty`, :mod:`.minkowski` (the
   polyhedron of an EGI, OBJ), :mod:`.facet_spectra` (per-band facet factors);
-* :mod:`.tumbling`: torque-free states fitted through speclight's propagation, families;
+* :mod:`.two_frequencies`: torque-free states fitted through speclight's propagation, families;
 * :mod:`.shape_run` (files to a result) and :mod:`.shape_dataset` (SHAPE.nc).
 """
 
