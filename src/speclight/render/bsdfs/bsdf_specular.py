@@ -17,6 +17,7 @@ from speclight.render.bsdfs.bsdf_interface import (
     fresnel_linear_factor,
 )
 from speclight.render.bsdfs.bsdf_microfacet import fresnel_path_parameters
+from speclight.render.kernel_ops import NUMPY_OPS, ShadingOps
 from speclight.render.shading import SUN_SOLID_ANGLE_SR
 
 
@@ -26,7 +27,15 @@ class SpecularBsdf(MaterialBsdf):
     def mirror_lobe(self) -> bool:
         return True
 
-    def main_weight(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mirror_ok: F64) -> F64:
+    def main_weight(
+        self,
+        cos_i: F64,
+        cos_o: F64,
+        cos_h: F64,
+        cos_d: F64,
+        mirror_ok: F64,
+        ops: ShadingOps = NUMPY_OPS,
+    ) -> F64:
         return mirror_ok / SUN_SOLID_ANGLE_SR
 
     def main_factor(self, cos_half_phase: F64, wavelength_nm: F64) -> F64:
