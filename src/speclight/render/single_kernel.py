@@ -84,7 +84,7 @@ class SingleKernel:
         self.face_part = mi.UInt32(caster.face_part) if len(caster.face_part) else None
         self.part_mat = mi.UInt32(np.asarray(layout.part_mat))
         #: Largest |weight| [sr-1] the fixed-point sums hold (module doc).
-        self.max_weight = 2.0 ** (95 - FRACTION_BITS) / max(self.pixels, 1) / _WORD
+        self.max_weight = 2.0 ** (95 - FRACTION_BITS) / max(self.pixels, 1)
 
     def _epoch(self, values: F64, e: Any) -> list[Any]:
         """The three components of per-epoch vectors ``values`` (b, 3) at every ray."""
@@ -125,7 +125,7 @@ class SingleKernel:
         norm = dr.maximum(dr.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), 1e-30)
         n = [v / norm for v in n]
         cos_o = n[0] * o[0] + n[1] * o[1] + n[2] * o[2]
-        flip = dr.select(cos_o < 0, -1.0, 1.0)  # thin sheets reflect on both faces
+        flip = dr.select(cos_o < 0, f64(-1.0), f64(1.0))  # thin sheets reflect on both faces
         n = [v * flip for v in n]
         cos_o = cos_o * flip
         cos_i = n[0] * s[0] + n[1] * s[1] + n[2] * s[2]
@@ -142,7 +142,7 @@ class SingleKernel:
         cos_d = dr.gather(f64, f64(np.einsum("nk,nk->n", sun_dir, half)), e)
         mirror = [2.0 * cos_o * n[c] - o[c] for c in range(3)]
         glint = mirror[0] * s[0] + mirror[1] * s[1] + mirror[2] * s[2] >= SUN_COS
-        mirror_ok = dr.select(glint, 1.0, 0.0)
+        mirror_ok = dr.select(glint, f64(1.0), f64(0.0))
         part = self._parts(si)
         mat = dr.gather(u32, self.part_mat, part, hit)
         return self._sums(b, e, mat, lit, (cos_i, cos_o, cos_h, cos_d, mirror_ok))

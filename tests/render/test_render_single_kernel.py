@@ -1,0 +1,141 @@
+"""The single mode's Dr.Jit kernel (speclight.render.single_kernel) against its numpy path.
+
+The numpy path (pixel rays in numpy, Mitsuba's intersections copied back, weights in numpy,
+``np.bincount`` per epoch) is the independent implementation here: the kernel generates the
+same float32 rays, shades in float64 and sums in fixed point, so its channel sums must equal
+numpy's to the rounding stated in each test. The per-model weights are held together by
+the BSDF contract test (test_bsdf_contract.py); closed forms (Lambert's sphere, plates) run
+through the kernel in test_render_single_closed_forms.py with the vectorised caster.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from speclight.render import available_variants
+from speclight.render import single as single_module
+from speclight.render import single_kernel
+from speclight.render.material_channels import ChannelLayout
+from speclight.render.raycast import MitsubaCaster
+from speclight.render.single import geometric_weights
+from speclight.target import Reflectance, box_wing, material_from_spec, sphere
+
+VARIANT = next(
+    (v for v in available_variants() if v.startswith(("llvm_", "cuda_")) and v.endswith("_rgb")),
+    None,
+)
+pytestmark = pytest.mark.skipif(VARIANT is None, reason="the kernel needs a vectorised variant")
+RESOLUTION_PX = 48
+EPS = np.finfo(float).eps
+
+
+def _materials() -> dict:
+    """One material per kernel model family: coat (rough and smooth: a glint), lab table
+    with its extension, analytic fit, microfacet, Lambert."""
+    spec = {
+        "bus": {"bsdf": "plastic", "roughness": 0.3, "reflectance": {"dielectric": "Kapton"},
+                "diffuse_reflectance": 0.5},
+        "wing_+y": {"bsdf": "plastic", "reflectance": {"dielectric": "SiO2"},
+                    "diffuse_reflectance": 0.06},
+        "wing_-y": {"bsdf": "measured", "brdf_table": "starlink_v1p5_solar_array_532nm",
+                    "extension": "abg"},
+        "antenna": {"bsdf": "phong", "coefficients": {"kd": 0.2, "ks": 0.5, "n": 30.0}},
+    }  # fmt: skip
+    return {part: material_from_spec(part.replace("+", "p"), s) for part, s in spec.items()}
+
+
+def _geometry(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Random Sun and observer directions, with a backscatter and a glint epoch."""
+    rng = np.random.default_rng(seed)
+    sun = rng.normal(size=(n, 3))
+    obs = rng.normal(size=(n, 3))
+    obs[0] = sun[0]  # phase angle 0
+    sun[1], obs[1] = [1.0, 0.3, 0.2], [1.0, -0.3, -0.2]  # the wings' mirror pair (normal x)
+    unit = np.linalg.norm
+    return sun / unit(sun, axis=1, keepdims=True), obs / unit(obs, axis=1, keepdims=True)
+
+
+def _numpy_path(monkeypatch: pytest.MonkeyPatch, *args, **kw):
+    """geometric_weights with the kernel switched off (every batch through numpy)."""
+    with monkeypatch.context() as m:
+        m.setattr(single_module, "kernel_supported", lambda *a: False)
+        return geometric_weights(*args, **kw)[0]
+
+
+def _tolerance(w: np.ndarray, pixel_area_m2: float) -> np.ndarray:
+    """What the two paths may differ by per channel [m² sr-1]: the kernel's fixed-point
+    rounding (2^-49 sr-1 per pixel, at most one per pixel and channel), the models' float64
+    rounding on either side (16 ulp, test_bsdf_contract.KERNEL_ULPS) and numpy's sequential
+    float64 sum over the pixels (at most one ulp of the sum per pixel added)."""
+    pixels = RESOLUTION_PX**2
+    return pixel_area_m2 * pixels * 2.0**-49 + (16 + pixels) * EPS * np.abs(w)
+
+
+def test_kernel_channel_sums_equal_the_numpy_path(monkeypatch):
+    target = box_wing(_materials())
+    caster = MitsubaCaster(target, VARIANT)
+    sun, obs = _geometry(12, seed=4)
+    w_kernel, _, pitch, layout = geometric_weights(target, sun, obs, caster, RESOLUTION_PX)
+    w_numpy = _numpy_path(monkeypatch, target, sun, obs, caster, RESOLUTION_PX)
+    kernel = single_kernel.SingleKernel(target, caster, layout, RESOLUTION_PX)
+    assert kernel.channel_sums(sun, obs) is not None  # the kernel's sums, not numpy's
+    assert layout.n_channels == 4 + 2 * 33**2 + 1  # main, two coats' bases, the extension
+    for k in range(4):  # every material seen and lit (main channel or block)
+        start = layout.block.get(k, k)
+        assert np.any(w_numpy[:, k] > 0) or np.any(w_numpy[:, start : start + 33**2] > 0)
+    assert w_numpy[1, 1] > 0  # the smooth coat's glint
+    assert np.all(np.abs(w_kernel - w_numpy) <= _tolerance(w_numpy, pitch**2))
+
+
+def test_kernel_on_a_sphere_with_roughness_derivatives(monkeypatch):
+    # Spheres are Mitsuba shapes (no triangles); the derivative channels of the gradient
+    # render (speclight.render.single_gradient) are summed in the kernel too.
+    m = material_from_spec("m", {"bsdf": "ggx", "roughness": 0.2, "reflectance": 0.7})
+    target = sphere(1.0, m)
+    caster = MitsubaCaster(target, VARIANT)
+    sun, obs = _geometry(6, seed=9)
+    layout = ChannelLayout(target, [0])
+    w_kernel, _, pitch, _ = geometric_weights(
+        target, sun, obs, caster, RESOLUTION_PX, layout=layout
+    )
+    w_numpy = _numpy_path(monkeypatch, target, sun, obs, caster, RESOLUTION_PX, layout=layout)
+    kernel = single_kernel.SingleKernel(target, caster, layout, RESOLUTION_PX)
+    assert kernel.channel_sums(sun, obs) is not None  # the kernel's sums, not numpy's
+    assert np.all(w_numpy[:, 0] > 0) and np.any(w_numpy[:, 1] != 0)
+    assert np.all(np.abs(w_kernel - w_numpy) <= _tolerance(w_numpy, pitch**2))
+
+
+def test_kernel_sums_do_not_depend_on_the_thread_count():
+    # Integer (fixed-point) atomics are exact: the sums are the same bits however the
+    # lanes are scheduled (float atomics would sum in a schedule-dependent order).
+    import drjit as dr
+
+    target = box_wing(_materials())
+    caster = MitsubaCaster(target, VARIANT)
+    kernel = single_kernel.SingleKernel(target, caster, ChannelLayout(target), RESOLUTION_PX)
+    sun, obs = _geometry(8, seed=2)
+    threads = dr.thread_count()
+    try:
+        many = kernel.channel_sums(sun, obs)
+        dr.set_thread_count(1)
+        one = kernel.channel_sums(sun, obs)
+    finally:
+        dr.set_thread_count(threads)
+    assert many is not None and one is not None
+    assert np.array_equal(many, one)
+
+
+def test_weights_beyond_the_fixed_point_range_take_the_numpy_path(monkeypatch):
+    # With 90 fractional bits no weight fits: every batch is refused by the kernel and
+    # rendered by numpy, so the result is the numpy path's to the bit.
+    m = {"body": material_from_spec("m", {"bsdf": "lambertian", "reflectance": 0.5})}
+    target = sphere(1.0, m["body"])
+    caster = MitsubaCaster(target, VARIANT)
+    sun, obs = _geometry(3, seed=1)
+    monkeypatch.setattr(single_kernel, "FRACTION_BITS", 90)
+    kernel = single_kernel.SingleKernel(target, caster, ChannelLayout(target), RESOLUTION_PX)
+    assert kernel.channel_sums(sun, obs) is None
+    w = geometric_weights(target, sun, obs, caster, RESOLUTION_PX)[0]
+    assert np.array_equal(w, _numpy_path(monkeypatch, target, sun, obs, caster, RESOLUTION_PX))
+    assert Reflectance.constant(0.5).value == 0.5
