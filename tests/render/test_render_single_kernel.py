@@ -13,9 +13,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from speclight.render import available_variants
+from speclight.render import available_variants, single_kernel
 from speclight.render import single as single_module
-from speclight.render import single_kernel
 from speclight.render.material_channels import ChannelLayout
 from speclight.render.raycast import MitsubaCaster
 from speclight.render.single import geometric_weights

@@ -37,7 +37,7 @@ from speclight.render import material_channels as channels
 from speclight.render.camera import image_axes, primary_rays
 from speclight.render.material_channels import ChannelLayout, pixel_contributions
 from speclight.render.polarization import check_polarizable
-from speclight.render.raycast import Caster
+from speclight.render.raycast import Caster, MitsubaCaster
 from speclight.render.result import RenderImage
 from speclight.render.shading import dot_rows, half_vectors, mirror_in_sun
 from speclight.render.single_kernel import SingleKernel, kernel_supported
@@ -92,7 +92,7 @@ def geometric_weights(
     kept: dict[int, _Kept] = {}
     pixel_area = (2.0 * radius / resolution_px) ** 2
     kernel = None
-    if on_hits is None and kernel_supported(caster, layout):
+    if on_hits is None and isinstance(caster, MitsubaCaster) and kernel_supported(caster, layout):
         kernel = SingleKernel(target, caster, layout, resolution_px)
     for a in range(0, n_ep, batch):
         s, o = sun_dir[a : a + batch], obs_dir[a : a + batch]
@@ -156,7 +156,7 @@ def _numpy_batch(
         layout, mat, cos_i[idx], cos_o[idx], cos_h, cos_d, mirror_ok
     )
     flat = e_idx[rows] * n_ch + chans
-    w = (np.bincount(flat, px_w, minlength=b * n_ch) * pixel_area).reshape(b, n_ch)
+    w = np.asarray(np.bincount(flat, px_w, minlength=b * n_ch) * pixel_area, dtype=float)
     kept: dict[int, _Kept] = {}
     for j in keep:
         sel = e_idx[rows] == j
@@ -171,7 +171,7 @@ def _numpy_batch(
             right=right[0],
             up=up[0],
         )
-    return w, kept
+    return w.reshape(b, n_ch), kept
 
 
 def render_single(

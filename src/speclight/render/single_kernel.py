@@ -48,10 +48,11 @@ FRACTION_BITS = 48
 _WORD = 2.0**32
 
 
-def kernel_supported(caster: Any, layout: ChannelLayout) -> bool:
-    """True when :class:`SingleKernel` can render: a Mitsuba caster and every material's
-    weights written for the kernel (:meth:`~speclight.render.bsdfs.MaterialBsdf.in_kernel`)."""
-    return isinstance(caster, MitsubaCaster) and all(b.in_kernel() for b in layout.bsdfs)
+def kernel_supported(caster: MitsubaCaster, layout: ChannelLayout) -> bool:
+    """True when :class:`SingleKernel` can render with the Mitsuba ``caster``: every
+    material's weights written for the kernel
+    (:meth:`~speclight.render.bsdfs.MaterialBsdf.in_kernel`)."""
+    return all(b.in_kernel() for b in layout.bsdfs)
 
 
 class SingleKernel:
@@ -118,7 +119,7 @@ class SingleKernel:
         si = self.caster.scene.ray_intersect(
             self._ray(origin, [-v for v in o]),
             ray_flags=mi.RayFlags.Minimal,
-            coherent=True,
+            coherent=False,  # Embree's coherent mode picks other triangles at shared edges
         )
         hit = si.is_valid()
         n = [f64(si.n.x), f64(si.n.y), f64(si.n.z)]
