@@ -3,8 +3,9 @@
 Microfacet terms follow Walter, Marschner, Li & Torrance 2007, "Microfacet models for
 refraction through rough surfaces", EGSR, doi:10.2312/EGWR/EGSR07/195-206 (eqs. 25-27 Beckmann,
 33-34 GGX), with the separable Smith shadowing G = G1(i) G1(o) as Mitsuba 3 uses, so that the
-single-scattering and path-traced renders share one model. ``ops``: numpy's array functions,
-or Dr.Jit's in the single mode's kernel (:mod:`speclight.render.kernel_ops`).
+single-scattering and path-traced renders share one model. ``ops``: the array functions (``clip``,
+``exp``, ``where``, ``sqrt``, ``maximum``): the numpy module itself, or Dr.Jit's in the single
+mode's kernel (:mod:`speclight.render.kernel_ops`).
 """
 
 from __future__ import annotations
@@ -14,15 +15,13 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.render.kernel_ops import NUMPY_OPS, ShadingOps
-
 F64 = NDArray[np.float64]
 
 
 Kind = Literal["beckmann", "ggx"]
 
 
-def microfacet_d(cos_h: Any, alpha: float, kind: Kind, ops: ShadingOps = NUMPY_OPS) -> Any:
+def microfacet_d(cos_h: Any, alpha: float, kind: Kind, ops: Any = np) -> Any:
     """Normal distribution D(h) [sr-1] for microfacet normals at ``cos_h`` from the normal."""
     c2 = ops.clip(cos_h, 1e-12, 1.0) ** 2
     tan2 = (1.0 - c2) / c2
@@ -34,7 +33,7 @@ def microfacet_d(cos_h: Any, alpha: float, kind: Kind, ops: ShadingOps = NUMPY_O
     return ops.where(cos_h > 0, d, 0.0)
 
 
-def smith_g1(cos_v: Any, alpha: float, kind: Kind, ops: ShadingOps = NUMPY_OPS) -> Any:
+def smith_g1(cos_v: Any, alpha: float, kind: Kind, ops: Any = np) -> Any:
     """Smith masking G1 for a direction at ``cos_v`` from the macro normal [1]."""
     c = ops.clip(cos_v, 1e-12, 1.0)
     tan = ops.sqrt(ops.maximum(1.0 - c * c, 0.0)) / c
@@ -48,7 +47,7 @@ def smith_g1(cos_v: Any, alpha: float, kind: Kind, ops: ShadingOps = NUMPY_OPS) 
 
 
 def microfacet_weight(
-    cos_i: Any, cos_o: Any, cos_h: Any, alpha: float, kind: Kind, ops: ShadingOps = NUMPY_OPS
+    cos_i: Any, cos_o: Any, cos_h: Any, alpha: float, kind: Kind, ops: Any = np
 ) -> Any:
     """``f cos_i / F`` of the Cook-Torrance model: D G / (4 cos_o) [sr-1]."""
     g = smith_g1(cos_i, alpha, kind, ops) * smith_g1(cos_o, alpha, kind, ops)

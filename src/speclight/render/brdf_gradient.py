@@ -24,13 +24,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.render.brdf import microfacet_d, smith_g1
-from speclight.render.kernel_ops import NUMPY_OPS, ShadingOps
 
 F64 = NDArray[np.float64]
 Kind = Literal["beckmann", "ggx"]
 
 
-def microfacet_d_dalpha(cos_h: Any, alpha: float, kind: Kind, ops: ShadingOps = NUMPY_OPS) -> Any:
+def microfacet_d_dalpha(cos_h: Any, alpha: float, kind: Kind, ops: Any = np) -> Any:
     """dD/dalpha [sr-1] of :func:`~speclight.render.brdf.microfacet_d` (module doc)."""
     c2 = ops.clip(cos_h, 1e-12, 1.0) ** 2
     tan2 = (1.0 - c2) / c2
@@ -40,7 +39,7 @@ def microfacet_d_dalpha(cos_h: Any, alpha: float, kind: Kind, ops: ShadingOps = 
     return d * (2.0 / alpha - 4.0 * alpha / (alpha * alpha + tan2))
 
 
-def smith_g1_dalpha(cos_v: Any, alpha: float, kind: Kind, ops: ShadingOps = NUMPY_OPS) -> Any:
+def smith_g1_dalpha(cos_v: Any, alpha: float, kind: Kind, ops: Any = np) -> Any:
     """dG1/dalpha [1] of :func:`~speclight.render.brdf.smith_g1` (module doc)."""
     c = ops.clip(cos_v, 1e-12, 1.0)
     tan = ops.sqrt(ops.maximum(1.0 - c * c, 0.0)) / c
@@ -57,7 +56,7 @@ def smith_g1_dalpha(cos_v: Any, alpha: float, kind: Kind, ops: ShadingOps = NUMP
 
 
 def microfacet_weight_dalpha(
-    cos_i: Any, cos_o: Any, cos_h: Any, alpha: float, kind: Kind, ops: ShadingOps = NUMPY_OPS
+    cos_i: Any, cos_o: Any, cos_h: Any, alpha: float, kind: Kind, ops: Any = np
 ) -> Any:
     """d/dalpha of :func:`~speclight.render.brdf.microfacet_weight` [sr-1]."""
     gi, go = smith_g1(cos_i, alpha, kind, ops), smith_g1(cos_o, alpha, kind, ops)
