@@ -93,7 +93,7 @@ class BareKernel:
         origin = (
             mi.Point3f(*[float(c) for c in self.centre]) + x * right + y * up + 2 * self.radius * o
         )
-        si = self.scene.ray_intersect(mi.Ray3f(origin, -o), mi.RayFlags.Minimal)
+        si = self.scene.ray_intersect(mi.Ray3f(origin, -o), mi.RayFlags.Minimal, False)
         n = dr.normalize(si.n)
         n = dr.select(dr.dot(n, o) < 0, -n, n)
         cos_o, cos_i = dr.dot(n, o), dr.dot(n, s)

@@ -18,7 +18,7 @@ from speclight.render import single as single_module
 from speclight.render.material_channels import ChannelLayout
 from speclight.render.raycast import MitsubaCaster
 from speclight.render.single import geometric_weights
-from speclight.target import Reflectance, box_wing, material_from_spec, sphere
+from speclight.target import box_wing, cube, material_from_spec, sphere
 
 VARIANT = next(
     (v for v in available_variants() if v.startswith(("llvm_", "cuda_")) and v.endswith("_rgb")),
@@ -128,8 +128,7 @@ def test_kernel_sums_do_not_depend_on_the_thread_count():
 def test_weights_beyond_the_fixed_point_range_take_the_numpy_path(monkeypatch):
     # With 90 fractional bits no weight fits: every batch is refused by the kernel and
     # rendered by numpy, so the result is the numpy path's to the bit.
-    m = {"body": material_from_spec("m", {"bsdf": "lambertian", "reflectance": 0.5})}
-    target = sphere(1.0, m["body"])
+    target = sphere(1.0, material_from_spec("m", {"bsdf": "lambertian", "reflectance": 0.5}))
     caster = MitsubaCaster(target, VARIANT)
     sun, obs = _geometry(3, seed=1)
     monkeypatch.setattr(single_kernel, "FRACTION_BITS", 90)
@@ -137,4 +136,24 @@ def test_weights_beyond_the_fixed_point_range_take_the_numpy_path(monkeypatch):
     assert kernel.channel_sums(sun, obs) is None
     w = geometric_weights(target, sun, obs, caster, RESOLUTION_PX)[0]
     assert np.array_equal(w, _numpy_path(monkeypatch, target, sun, obs, caster, RESOLUTION_PX))
-    assert Reflectance.constant(0.5).value == 0.5
+
+
+def test_materials_sharing_a_weight_function_are_summed_apart(monkeypatch):
+    # Materials whose weights are one function of the cosines (Lambert at any albedo; one
+    # microfacet lobe under different Fresnel terms) are evaluated once in the kernel
+    # (MaterialBsdf.kernel_key) but still summed into their own channels.
+    spec = {
+        "+x": {"bsdf": "lambertian", "reflectance": 0.2},
+        "-x": {"bsdf": "lambertian", "reflectance": 0.9},
+        "+y": {"bsdf": "beckmann", "roughness": 0.2, "reflectance": {"conductor": "Al"}},
+        "-y": {"bsdf": "beckmann", "roughness": 0.2, "reflectance": 0.5},
+        "*": {"bsdf": "lambertian", "reflectance": 0.5},
+    }
+    target = cube(1.0, {p: material_from_spec(p.replace("+", "p"), s) for p, s in spec.items()})
+    caster = MitsubaCaster(target, VARIANT)
+    sun, obs = _geometry(10, seed=6)
+    w_kernel, _, pitch, layout = geometric_weights(target, sun, obs, caster, RESOLUTION_PX)
+    w_numpy = _numpy_path(monkeypatch, target, sun, obs, caster, RESOLUTION_PX)
+    assert len(single_kernel._groups(layout, main=True)) == 2  # Lambert, the one lobe
+    assert np.all(np.any(w_numpy > 0, axis=0))  # every material's channel
+    assert np.all(np.abs(w_kernel - w_numpy) <= _tolerance(w_numpy, pitch**2))

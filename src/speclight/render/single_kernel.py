@@ -170,7 +170,10 @@ class SingleKernel:
         one = 2.0**FRACTION_BITS
         limit = self.max_weight * one
 
+        misfit = dr.zeros(mi.Bool, dr.width(e))  # a weight the sums cannot hold
+
         def add(channel: Any, weight: Any, active: Any) -> None:
+            nonlocal misfit
             v = weight * one
             fits = dr.abs(v) < limit  # False for NaN too
             hi = dr.floor(v * (1.0 / _WORD))
@@ -178,23 +181,54 @@ class SingleKernel:
             index = base + channel
             dr.scatter_reduce(dr.ReduceOp.Add, high, mi.Int64(hi), index, active & fits)
             dr.scatter_reduce(dr.ReduceOp.Add, low, mi.Int64(lo), index, active & fits)
-            dr.scatter_reduce(dr.ReduceOp.Add, bad, 1, e, active & ~fits)
+            misfit = misfit | (active & ~fits)
 
-        for k, bsdf in enumerate(layout.bsdfs):
-            mine = lit & (mat == k)
-            add(k, bsdf.main_weight(cos_i, cos_o, cos_h, cos_d, mirror_ok, ops), mine)
-            if k in layout.block:
-                for node, weight in bsdf.block_entries(cos_i, cos_o, cos_h, cos_d, ops):
-                    add(layout.block[k] + node, weight, mine)
-            if k in layout.grad:
+        def lanes(ks: list[int]) -> Any:
+            """The lit pixels of materials ``ks``."""
+            mine = mat == ks[0]
+            for k in ks[1:]:
+                mine = mine | (mat == k)
+            return lit & mine
+
+        def per_material(channel: dict[int, int]) -> Any:
+            """Each lane's channel from a material -> channel table."""
+            table = np.zeros(len(layout.bsdfs), np.uint32)
+            for k, c in channel.items():
+                table[k] = c
+            return dr.gather(mi.UInt32, mi.UInt32(table), mat)
+
+        for ks in _groups(layout, main=True):
+            bsdf, mine = layout.bsdfs[ks[0]], lanes(ks)
+            add(mat, bsdf.main_weight(cos_i, cos_o, cos_h, cos_d, mirror_ok, ops), mine)
+            if ks[0] in layout.grad:
                 dw = bsdf.roughness_derivative(cos_i, cos_o, cos_h, ops)
-                add(layout.grad[k], dw, mine)
+                add(per_material(layout.grad), dw, mine)
+        for ks in _groups(layout, main=False):
+            bsdf, mine = layout.bsdfs[ks[0]], lanes(ks)
+            start = per_material(layout.block)
+            for node, weight in bsdf.block_entries(cos_i, cos_o, cos_h, cos_d, ops):
+                add(start + node, weight, mine)
+        dr.scatter_reduce(dr.ReduceOp.Add, bad, 1, e, misfit)
         dr.eval(high, low, bad)
         if np.any(np.asarray(bad)):
             return None
         hi = np.asarray(high, dtype=np.float64) * (_WORD / one)
         lo = np.asarray(low, dtype=np.float64) / one
         return (hi + lo).reshape(b, n_ch)
+
+
+def _groups(layout: ChannelLayout, main: bool) -> list[list[int]]:
+    """The materials whose main weights (and roughness derivatives), or whose block entries
+    (``main`` False: materials with a block only), are one function of the cosines
+    (:meth:`~speclight.render.bsdfs.MaterialBsdf.kernel_key`): the kernel evaluates each
+    group once over the pixels of all its materials."""
+    groups: dict[Any, list[int]] = {}
+    for k, bsdf in enumerate(layout.bsdfs):
+        if main:
+            groups.setdefault((bsdf.kernel_key(), k in layout.grad), []).append(k)
+        elif k in layout.block:
+            groups.setdefault(bsdf.kernel_key(block=True), []).append(k)
+    return list(groups.values())
 
 
 __all__ = ["FRACTION_BITS", "SingleKernel", "kernel_supported"]

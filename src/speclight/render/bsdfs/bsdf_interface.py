@@ -12,7 +12,7 @@ their parameters and the modes each supports is :mod:`speclight.target.bsdf_mode
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Hashable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -62,6 +62,13 @@ class MaterialBsdf:
     ) -> F64:  # pragma: no cover - every model defines it
         """Per-pixel weight [sr-1] of the main channel: ``f cos_i`` over its factor."""
         raise NotImplementedError
+
+    def kernel_key(self, block: bool = False) -> Hashable:
+        """Models (materials) with equal keys have the same main weight and roughness
+        derivative (``block``: the same block entries) as functions of the cosines, so that
+        the single mode's kernel evaluates them once for all their pixels; by default each
+        material is its own."""
+        return id(self)
 
     def in_kernel(self) -> bool:
         """True when the single mode's Dr.Jit kernel evaluates the model (its weights

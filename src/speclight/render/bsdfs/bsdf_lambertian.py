@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Hashable
 from typing import Any
 
 import numpy as np
@@ -28,6 +29,9 @@ class LambertianBsdf(MaterialBsdf):
         ops: ShadingOps = NUMPY_OPS,
     ) -> F64:
         return cos_i / np.pi
+
+    def kernel_key(self, block: bool = False) -> Hashable:
+        return "lambertian"  # the albedo is in the factor
 
     def main_factor(self, cos_half_phase: F64, wavelength_nm: F64) -> F64:
         return reflectance_factor(self.material.reflectance, len(cos_half_phase), wavelength_nm)

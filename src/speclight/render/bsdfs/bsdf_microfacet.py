@@ -10,6 +10,7 @@ reflectance given as numbers (Mitsuba's ``material='none'``).
 
 from __future__ import annotations
 
+from collections.abc import Hashable
 from typing import Any, Literal, cast
 
 import numpy as np
@@ -68,6 +69,9 @@ class MicrofacetBsdf(MaterialBsdf):
         ops: ShadingOps = NUMPY_OPS,
     ) -> F64:
         return microfacet_weight(cos_i, cos_o, cos_h, self.alpha, self.distribution, ops)
+
+    def kernel_key(self, block: bool = False) -> Hashable:
+        return ("microfacet", self.distribution, self.alpha)  # F is in the factor
 
     def main_factor(self, cos_half_phase: F64, wavelength_nm: F64) -> F64:
         return fresnel_factor(self.material.reflectance, cos_half_phase, wavelength_nm)

@@ -16,7 +16,7 @@ plugins per group of bins, :mod:`.path_plastic`).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Hashable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -81,6 +81,10 @@ class PlasticBsdf(MaterialBsdf):
             return mirror_ok / SUN_SOLID_ANGLE_SR
         alpha = float(self.material.roughness or 0.0)
         return microfacet_weight(cos_i, cos_o, cos_h, alpha, "beckmann", ops)
+
+    def kernel_key(self, block: bool = False) -> Hashable:
+        # the coat's lobe depends on its roughness only; every base bins alike
+        return "plastic base" if block else ("plastic coat", self.material.roughness)
 
     def main_factor(self, cos_half_phase: F64, wavelength_nm: F64) -> F64:
         eta = self.material.reflectance.eta(wavelength_nm).real

@@ -8,6 +8,7 @@ mode uses Mitsuba's ``conductor`` (a point Sun never reaches the observer throug
 
 from __future__ import annotations
 
+from collections.abc import Hashable
 from typing import Any
 
 from speclight.render.bsdfs.bsdf_interface import (
@@ -37,6 +38,9 @@ class SpecularBsdf(MaterialBsdf):
         ops: ShadingOps = NUMPY_OPS,
     ) -> F64:
         return mirror_ok / SUN_SOLID_ANGLE_SR
+
+    def kernel_key(self, block: bool = False) -> Hashable:
+        return "mirror"  # the reflectance is in the factor
 
     def main_factor(self, cos_half_phase: F64, wavelength_nm: F64) -> F64:
         return fresnel_factor(self.material.reflectance, cos_half_phase, wavelength_nm)
