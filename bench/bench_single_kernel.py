@@ -35,8 +35,8 @@ import numpy as np
 from speclight.render import RenderSession, render_intensity
 from speclight.scenario.builtin_examples import example_text
 from speclight.scenario.load import parse_scenario
-from speclight.simulate.geometry_stage import scenario_geometry
-from speclight.simulate.reflection import build_target
+from speclight.simulation.geometry_stage import scenario_geometry
+from speclight.simulation.reflection import build_target
 from speclight.target.parts import Target
 
 WAVELENGTH_NM = np.arange(300.0, 1241.0, 5.0)  # 189 bins

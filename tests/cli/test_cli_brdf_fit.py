@@ -16,7 +16,7 @@ from typer.testing import CliRunner
 
 from speclight.cli import app
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 runner = CliRunner()
 ALBEDO = 0.3

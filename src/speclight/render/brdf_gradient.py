@@ -1,4 +1,5 @@
-"""Roughness derivatives of the microfacet terms of :mod:`speclight.render.brdf`, analytic.
+"""Roughness derivatives of the microfacet terms of :mod:`speclight.target.microfacet_terms`,
+analytic.
 
 Same formulas, same clipping (Walter, Marschner, Li & Torrance 2007, EGSR,
 doi:10.2312/EGWR/EGSR07/195-206; t = tan^2 of the angle to the normal, ``a`` the roughness):
@@ -23,14 +24,14 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.render.brdf import microfacet_d, smith_g1
+from speclight.target.microfacet_terms import microfacet_d, smith_g1
 
 F64 = NDArray[np.float64]
 Kind = Literal["beckmann", "ggx"]
 
 
 def microfacet_d_dalpha(cos_h: Any, alpha: float, kind: Kind, ops: Any = np) -> Any:
-    """dD/dalpha [sr-1] of :func:`~speclight.render.brdf.microfacet_d` (module doc)."""
+    """dD/dalpha [sr-1] of :func:`~speclight.target.microfacet_terms.microfacet_d` (module doc)."""
     c2 = ops.clip(cos_h, 1e-12, 1.0) ** 2
     tan2 = (1.0 - c2) / c2
     d = microfacet_d(cos_h, alpha, kind, ops)
@@ -40,7 +41,7 @@ def microfacet_d_dalpha(cos_h: Any, alpha: float, kind: Kind, ops: Any = np) -> 
 
 
 def smith_g1_dalpha(cos_v: Any, alpha: float, kind: Kind, ops: Any = np) -> Any:
-    """dG1/dalpha [1] of :func:`~speclight.render.brdf.smith_g1` (module doc)."""
+    """dG1/dalpha [1] of :func:`~speclight.target.microfacet_terms.smith_g1` (module doc)."""
     c = ops.clip(cos_v, 1e-12, 1.0)
     tan = ops.sqrt(ops.maximum(1.0 - c * c, 0.0)) / c
     if kind == "beckmann":
@@ -58,7 +59,7 @@ def smith_g1_dalpha(cos_v: Any, alpha: float, kind: Kind, ops: Any = np) -> Any:
 def microfacet_weight_dalpha(
     cos_i: Any, cos_o: Any, cos_h: Any, alpha: float, kind: Kind, ops: Any = np
 ) -> Any:
-    """d/dalpha of :func:`~speclight.render.brdf.microfacet_weight` [sr-1]."""
+    """d/dalpha of :func:`~speclight.target.microfacet_terms.microfacet_weight` [sr-1]."""
     gi, go = smith_g1(cos_i, alpha, kind, ops), smith_g1(cos_o, alpha, kind, ops)
     dgi, dgo = smith_g1_dalpha(cos_i, alpha, kind, ops), smith_g1_dalpha(cos_o, alpha, kind, ops)
     d, dd = microfacet_d(cos_h, alpha, kind, ops), microfacet_d_dalpha(cos_h, alpha, kind, ops)

@@ -136,7 +136,7 @@ def drjit_ops(dr: Any, float_type: Any, index_type: Any) -> ShadingOps:
 
         @staticmethod
         def microfacet(cos_i: Any, cos_o: Any, cos_h: Any, alpha: float, kind: str) -> Any:
-            from speclight.render.brdf import microfacet_weight  # one copy of the terms
+            from speclight.target.microfacet_terms import microfacet_weight  # one copy of the terms
 
             ops = DrJitOps()
             weight = microfacet_weight(cos_i, cos_o, cos_h, alpha, kind, ops)  # type: ignore[arg-type]

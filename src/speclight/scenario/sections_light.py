@@ -451,7 +451,7 @@ class Atmosphere(Strict):
     @property
     def params(self) -> Any:
         """The validated :class:`speclight.atmosphere.params.AtmosphereParams` (paths as
-        written; :func:`speclight.simulate.radiometry.atmosphere_params` resolves them)."""
+        written; :func:`speclight.simulation.radiometry.atmosphere_params` resolves them)."""
         return self._params
 
 

@@ -10,7 +10,7 @@ speclight needs (STYLE.md item 13, as colour's method registries and pvlib's
 * rendering (:mod:`speclight.render.bsdfs`, one module per model): which render modes
   support it, in which its polarisation is modelled, how the single mode splits it into
   channels (geometric weight times spectral factor), which engines it needs;
-* the output's provenance (:mod:`speclight.simulate.input_hashes`): which parameters name a
+* the output's provenance (:mod:`speclight.simulation.input_hashes`): which parameters name a
   file whose bytes are hashed (:func:`bsdf_file_parameters`);
 * messages and ``docs/scenario.md`` (its model table is checked against this one).
 

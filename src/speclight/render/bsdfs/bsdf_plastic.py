@@ -22,7 +22,6 @@ from typing import Any
 
 import numpy as np
 
-from speclight.render.brdf import microfacet_weight
 from speclight.render.bsdfs.bsdf_interface import (
     F64,
     MaterialBsdf,
@@ -36,6 +35,7 @@ from speclight.render.bsdfs.path_coat import coat_tables, coated_diffuse
 from speclight.render.bsdfs.path_plastic import base_for_mitsuba
 from speclight.render.kernel_ops import NUMPY_OPS, ShadingOps
 from speclight.render.shading import SUN_SOLID_ANGLE_SR
+from speclight.target.microfacet_terms import microfacet_weight
 from speclight.target.optical_constants import fresnel_reflectance
 
 #: Cosine nodes per axis of the base's (cos theta_i, cos theta_o) binning grid.

@@ -70,8 +70,8 @@ class ArrayOps:
     @staticmethod
     def microfacet(cos_i: Any, cos_o: Any, cos_h: Any, alpha: float, kind: str) -> Any:
         """``D G1(i) G1(o) / (4 cos_i cos_o)`` [sr-1] (Walter et al. 2007; the terms of the
-        ``ggx`` and ``beckmann`` models, :mod:`speclight.render.brdf`)."""
-        from speclight.render.brdf import microfacet_weight  # one copy of the terms
+        ``ggx`` and ``beckmann`` models, :mod:`speclight.target.microfacet_terms`)."""
+        from speclight.target.microfacet_terms import microfacet_weight  # one copy of the terms
 
         weight = microfacet_weight(cos_i, cos_o, cos_h, alpha, kind)  # type: ignore[arg-type]
         return weight / np.clip(cos_i, 1e-12, None)
