@@ -18,13 +18,21 @@ each pixel's weight equals the numpy path's to float64 rounding; the pixel and s
 are the numpy path's to the bit (the same float64 arithmetic rounded to float32).
 
 **Deterministic sums.** Atomic float additions would sum in an order that depends on the
-threads' schedule. Each weight is instead rounded to a fixed-point number of
-:data:`FRACTION_BITS` fractional bits [sr-1] held in two 64-bit integers (high and low
-32 bits of the scaled value) and summed with integer atomics, which are exact and so
-independent of order: the channel sums are bit-for-bit reproducible on any thread count,
-within 2^-49 sr-1 of the exact sum per pixel (1e-15 of a diffuse pixel's weight). A weight
-too large for the format (above ``2^47 / pixels`` sr-1, e.g. 2e9 sr-1 at 256 px) or not
-finite sends its batch through the numpy path.
+threads' schedule. The sums are instead fixed point, made exact with integer atomics and so
+independent of the order (bit-for-bit reproducible on any thread count), in two passes over
+the stored shading cosines (the rays are cast once):
+
+1. the largest |weight| of every (epoch, channel) sum, by an atomic maximum of the high 32
+   bits of its float64 (a maximum is order-independent too);
+2. every weight times the power of two 2^k of its sum (exact) that puts that largest
+   weight below 2^bits (:func:`fraction_bits`: 76 at 256 px), rounded to a whole number
+   held in two 64-bit integers (the high part, the low 32 bits), summed with integer atomics.
+
+Each pixel's weight is rounded to at most 2^-bits of its sum's largest weight, so a sum is
+within ``pixels * 2^-bits`` of that weight of the exact sum (2^-60 at 256 px, below
+float64's 2^-53): float64-relative precision per (epoch, channel) at any magnitude, the
+far tails of a Beckmann lobe (1e-12 sr-1) or a nearly dark epoch as well as a glint. A weight that is not finite sends its batch
+through the numpy path (which gives the same infinity or NaN).
 """
 
 from __future__ import annotations
@@ -43,8 +51,6 @@ from speclight.render.variant import activate
 from speclight.target.parts import Target
 
 F64 = NDArray[np.float64]
-#: Fractional bits of the fixed-point channel sums (module doc).
-FRACTION_BITS = 48
 _WORD = 2.0**32
 
 
@@ -84,8 +90,8 @@ class SingleKernel:
         self.x, self.y = mi.Float64(x), mi.Float64(y)
         self.face_part = mi.UInt32(caster.face_part) if len(caster.face_part) else None
         self.part_mat = mi.UInt32(np.asarray(layout.part_mat))
-        #: Largest |weight| [sr-1] the fixed-point sums hold (module doc).
-        self.max_weight = 2.0 ** (95 - FRACTION_BITS) / max(self.pixels, 1)
+        #: Bits of each fixed-point sum below its largest weight (module doc).
+        self.fraction_bits = fraction_bits(self.pixels)
 
     def _epoch(self, values: F64, e: Any) -> list[Any]:
         """The three components of per-epoch vectors ``values`` (b, 3) at every ray."""
@@ -158,30 +164,12 @@ class SingleKernel:
             part = dr.select(si.shape == mi.ShapePtr(shape), k, part)
         return part
 
-    def _sums(self, b: int, e: Any, mat: Any, lit: Any, cosines: tuple[Any, ...]) -> F64 | None:
-        """Every channel's weights of the lit pixels, summed per epoch (fixed point)."""
+    def _entries(self, mat: Any, lit: Any, cosines: tuple[Any, ...]) -> list[tuple[Any, Any, Any]]:
+        """Every lane's (channel, weight [sr-1], active) of every model's channels: main
+        weights, roughness derivatives, block entries (lazy Dr.Jit expressions)."""
         mi, dr, layout, ops = self.mi, self.dr, self.layout, self.ops
-        n_ch = layout.n_channels
         cos_i, cos_o, cos_h, cos_d, mirror_ok = cosines
-        high = dr.zeros(mi.Int64, b * n_ch)
-        low = dr.zeros(mi.Int64, b * n_ch)
-        bad = dr.zeros(mi.UInt32, b)
-        base = e * n_ch
-        one = 2.0**FRACTION_BITS
-        limit = self.max_weight * one
-
-        misfit = dr.zeros(mi.Bool, dr.width(e))  # a weight the sums cannot hold
-
-        def add(channel: Any, weight: Any, active: Any) -> None:
-            nonlocal misfit
-            v = weight * one
-            fits = dr.abs(v) < limit  # False for NaN too
-            hi = dr.floor(v * (1.0 / _WORD))
-            lo = dr.round(v - hi * _WORD)
-            index = base + channel
-            dr.scatter_reduce(dr.ReduceOp.Add, high, mi.Int64(hi), index, active & fits)
-            dr.scatter_reduce(dr.ReduceOp.Add, low, mi.Int64(lo), index, active & fits)
-            misfit = misfit | (active & ~fits)
+        entries: list[tuple[Any, Any, Any]] = []
 
         def lanes(ks: list[int]) -> Any:
             """The lit pixels of materials ``ks``."""
@@ -199,22 +187,72 @@ class SingleKernel:
 
         for ks in _groups(layout, main=True):
             bsdf, mine = layout.bsdfs[ks[0]], lanes(ks)
-            add(mat, bsdf.main_weight(cos_i, cos_o, cos_h, cos_d, mirror_ok, ops), mine)
+            weight = bsdf.main_weight(cos_i, cos_o, cos_h, cos_d, mirror_ok, ops)
+            entries.append((mat, weight, mine))
             if ks[0] in layout.grad:
                 dw = bsdf.roughness_derivative(cos_i, cos_o, cos_h, ops)
-                add(per_material(layout.grad), dw, mine)
+                entries.append((per_material(layout.grad), dw, mine))
         for ks in _groups(layout, main=False):
             bsdf, mine = layout.bsdfs[ks[0]], lanes(ks)
             start = per_material(layout.block)
             for node, weight in bsdf.block_entries(cos_i, cos_o, cos_h, cos_d, ops):
-                add(start + node, weight, mine)
-        dr.scatter_reduce(dr.ReduceOp.Add, bad, 1, e, misfit)
-        dr.eval(high, low, bad)
-        if np.any(np.asarray(bad)):
+                entries.append((start + node, weight, mine))
+        return entries
+
+    def _sums(self, b: int, e: Any, mat: Any, lit: Any, cosines: tuple[Any, ...]) -> F64 | None:
+        """Every channel's weights of the lit pixels, summed per epoch in fixed point
+        relative to each sum's largest weight (module doc); None for a weight not finite."""
+        mi, dr = self.mi, self.dr
+        n_ch = self.layout.n_channels
+        entries = [(e * n_ch + c, w, a) for c, w, a in self._entries(mat, lit, cosines)]
+        # pass 1: the largest |weight| of every (epoch, channel), as the high 32 bits of its
+        # float64 (sign, 11 exponent bits, 20 mantissa bits: ordered as the magnitudes are)
+        peak = dr.zeros(mi.UInt32, b * n_ch)
+        for index, weight, active in entries:
+            bits = dr.reinterpret_array(mi.UInt64, dr.abs(weight)) >> 32
+            dr.scatter_reduce(dr.ReduceOp.Max, peak, mi.UInt32(bits), index, active)
+        dr.schedule(*cosines, mat, lit)  # kept for pass 2: the rays are cast once
+        dr.eval(peak)
+        shift = scale_exponents(np.asarray(peak), self.fraction_bits)
+        if shift is None:
             return None
-        hi = np.asarray(high, dtype=np.float64) * (_WORD / one)
-        lo = np.asarray(low, dtype=np.float64) / one
-        return (hi + lo).reshape(b, n_ch)
+        # pass 2: every weight times 2^shift of its sum (exact), rounded to a whole number
+        # held in two words (the high part's floor and the low 32 bits), integer atomics
+        high = dr.zeros(mi.Int64, b * n_ch)
+        low = dr.zeros(mi.Int64, b * n_ch)
+        shifts = mi.Int32(shift)
+        for index, weight, active in entries:
+            k = dr.gather(mi.Int32, shifts, index, active)
+            half = k >> 1  # two factors: 2^k alone leaves float64's range
+            v = weight * self._power_of_two(half) * self._power_of_two(k - half)
+            hi = dr.floor(v * (1.0 / _WORD))
+            lo = dr.round(v - hi * _WORD)
+            dr.scatter_reduce(dr.ReduceOp.Add, high, mi.Int64(hi), index, active)
+            dr.scatter_reduce(dr.ReduceOp.Add, low, mi.Int64(lo), index, active)
+        dr.eval(high, low)
+        whole = np.asarray(high, dtype=np.float64) * _WORD + np.asarray(low, dtype=np.float64)
+        return np.ldexp(whole, -shift).reshape(b, n_ch)
+
+    def _power_of_two(self, k: Any) -> Any:
+        """2^k as float64 for whole ``k`` in [-1022, 1023] (its exponent bits)."""
+        mi, dr = self.mi, self.dr
+        return dr.reinterpret_array(mi.Float64, mi.UInt64(mi.Int64(k + 1023)) << 52)
+
+
+def fraction_bits(pixels: int) -> int:
+    """Bits of a fixed-point sum over ``pixels`` below its largest weight (module doc): the
+    sum of the high words of up to 4 entries per pixel and channel stays below 2^62."""
+    return 94 - int(np.ceil(np.log2(4 * max(pixels, 1))))
+
+
+def scale_exponents(peak_bits: NDArray[np.uint32], bits: int) -> NDArray[np.int32] | None:
+    """The power of two ``k`` per sum that scales its weights below 2^``bits``, from the high
+    32 bits of the largest |weight| (``peak_bits``); None where that weight is not finite
+    (exponent bits all ones: infinity or NaN)."""
+    exponent = (peak_bits >> 20).astype(np.int32)  # biased: |w| < 2^(exponent - 1022)
+    if np.any(exponent == 2047):
+        return None
+    return (bits + 1022 - exponent).astype(np.int32)
 
 
 def _groups(layout: ChannelLayout, main: bool) -> list[list[int]]:
@@ -231,4 +269,4 @@ def _groups(layout: ChannelLayout, main: bool) -> list[list[int]]:
     return list(groups.values())
 
 
-__all__ = ["FRACTION_BITS", "SingleKernel", "kernel_supported"]
+__all__ = ["SingleKernel", "fraction_bits", "kernel_supported", "scale_exponents"]
