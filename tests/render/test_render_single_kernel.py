@@ -68,9 +68,7 @@ def _magnitudes(monkeypatch: pytest.MonkeyPatch, target, sun, obs, caster, **kw)
     with monkeypatch.context() as m:
         m.setattr(single_module, "kernel_supported", lambda *a: False)
         keep = range(len(sun))
-        w, kept, _, layout = geometric_weights(
-            target, sun, obs, caster, RESOLUTION_PX, keep=keep, **kw
-        )
+        w, kept, _, _ = geometric_weights(target, sun, obs, caster, RESOLUTION_PX, keep=keep, **kw)
     out = np.zeros_like(w)
     for e, pix in kept.items():
         np.add.at(out[e], pix.channel, np.abs(pix.weight))
@@ -91,7 +89,7 @@ def test_kernel_channel_sums_equal_the_numpy_path(monkeypatch):
     target = box_wing(_materials())
     caster = MitsubaCaster(target, VARIANT)
     sun, obs = _geometry(12, seed=4)
-    w_kernel, _, pitch, layout = geometric_weights(target, sun, obs, caster, RESOLUTION_PX)
+    w_kernel, _, _, layout = geometric_weights(target, sun, obs, caster, RESOLUTION_PX)
     w_numpy = _numpy_path(monkeypatch, target, sun, obs, caster, RESOLUTION_PX)
     kernel = single_kernel.SingleKernel(target, caster, layout, RESOLUTION_PX)
     assert kernel.channel_sums(sun, obs) is not None  # the kernel's sums, not numpy's
@@ -111,9 +109,7 @@ def test_kernel_on_a_sphere_with_roughness_derivatives(monkeypatch):
     caster = MitsubaCaster(target, VARIANT)
     sun, obs = _geometry(6, seed=9)
     layout = ChannelLayout(target, [0])
-    w_kernel, _, pitch, _ = geometric_weights(
-        target, sun, obs, caster, RESOLUTION_PX, layout=layout
-    )
+    w_kernel = geometric_weights(target, sun, obs, caster, RESOLUTION_PX, layout=layout)[0]
     w_numpy = _numpy_path(monkeypatch, target, sun, obs, caster, RESOLUTION_PX, layout=layout)
     kernel = single_kernel.SingleKernel(target, caster, layout, RESOLUTION_PX)
     assert kernel.channel_sums(sun, obs) is not None  # the kernel's sums, not numpy's
@@ -211,7 +207,7 @@ def test_materials_sharing_a_weight_function_are_summed_apart(monkeypatch):
     target = cube(1.0, {p: material_from_spec(p.replace("+", "p"), s) for p, s in spec.items()})
     caster = MitsubaCaster(target, VARIANT)
     sun, obs = _geometry(10, seed=6)
-    w_kernel, _, pitch, layout = geometric_weights(target, sun, obs, caster, RESOLUTION_PX)
+    w_kernel, _, _, layout = geometric_weights(target, sun, obs, caster, RESOLUTION_PX)
     w_numpy = _numpy_path(monkeypatch, target, sun, obs, caster, RESOLUTION_PX)
     assert len(single_kernel._groups(layout, main=True)) == 2  # Lambert, the one lobe
     assert np.all(np.any(w_numpy > 0, axis=0))  # every material's channel
