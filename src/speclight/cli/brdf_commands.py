@@ -38,7 +38,7 @@ def brdf_fit(
     ] = "schlick",
     min_brdf: Annotated[
         float,
-        typer.Option("--min-brdf", help="Leave out samples at or below this BRDF [sr-1]."),
+        typer.Option("--min-brdf", help="Leave out samples at or below this BRDF \\[sr-1]."),
     ] = 0.0,
     plot_file: Plot = None,
     force: Force = False,

@@ -55,7 +55,7 @@ def spin_axis(
     output: Annotated[str, output_option("FILE", "Output NetCDF (AXIS.nc).")] = "axis.nc",
     period_s: Annotated[
         float | None,
-        typer.Option("--period-s", help="Rotation period [s] (default: the scenario's)."),
+        typer.Option("--period-s", help="Rotation period \\[s] (default: the scenario's)."),
     ] = None,
     grid_deg: Annotated[
         float, typer.Option("--grid-deg", help="RA/Dec grid step in deg, 0.01..90.")
@@ -205,11 +205,11 @@ def period(
     ] = None,
     min_period_s: Annotated[
         float | None,
-        typer.Option("--min-period-s", help="Shortest period searched [s] (default 2 K dt)."),
+        typer.Option("--min-period-s", help="Shortest period searched \\[s] (default 2 K dt)."),
     ] = None,
     max_period_s: Annotated[
         float | None,
-        typer.Option("--max-period-s", help="Longest period searched [s] (default span/3)."),
+        typer.Option("--max-period-s", help="Longest period searched \\[s] (default span/3)."),
     ] = None,
     harmonics: Annotated[
         int, typer.Option("--harmonics", help="Harmonics K of the periodogram's model.")
