@@ -29,6 +29,16 @@ CASES: list[tuple[str, str, dict[str, Any]]] = [
     ("box-wing-laser", "box-wing-laser", {}),
     ("calsphere", "calsphere", {}),
     ("lcs1", "lcs1", {}),
+    ("cube-materials", "cube-materials", {}),
+    ("cube-materials-laser", "cube-materials-laser", {}),
+    ("geo-arrays", "geo-arrays", {}),
+    ("gnss-meo", "gnss-meo", {}),
+    ("starlink-v1.5", "starlink-v1.5", {}),
+    (
+        "box-wing-polarized",
+        "box-wing",
+        {"time.stop": "2019-08-30T02:20:09Z", "render.polarization": True},
+    ),
     (
         "box-wing-images",
         "box-wing",
