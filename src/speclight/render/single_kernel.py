@@ -33,8 +33,8 @@ within ``pixels * 2^-bits`` of that weight of the exact sum (2^-60 at 256 px, be
 float64's 2^-53): float64-relative precision per (epoch, channel) at any magnitude, the
 far tails of a Beckmann lobe (1e-12 sr-1) or a nearly dark epoch as well as a glint. Below
 float64's smallest normal number (2.2e-308) Dr.Jit's ``exp`` returns 0 where numpy's returns
-a subnormal: such weights count as 0 here. A weight that is not finite sends its batch through the numpy path (which gives the same
-infinity or NaN).
+a subnormal: such weights count as 0 here. A weight that is not finite sends its batch
+through the numpy path (which gives the same infinity or NaN).
 """
 
 from __future__ import annotations
