@@ -230,3 +230,60 @@ def test_single_and_path_agree_on_a_plate(form, example, white_rgl):
 def test_every_model_has_a_renderer():
     # the render side's table and the registry name the same models (forms)
     assert set(RENDERERS) == {form.label for form in BSDF_FORMS}
+
+
+#: The single mode's kernel (speclight.render.single_kernel) evaluates each model's weights
+#: with Dr.Jit's functions where the numpy path uses numpy's: the same formulas on the same
+#: float64 cosines, but exp, log2, pow and acos are Dr.Jit's own (each within ~1 ulp of
+#: libm's); a weight goes through at most ~8 such rounded steps, each of which can double
+#: an ulp: 16 ulp of the largest weight (measured: at most 2.3 ulp, for every model).
+KERNEL_ULPS = 16 * np.finfo(float).eps
+
+
+def _kernel_ops():
+    """Dr.Jit's float64 ops of a vectorised variant (the kernel's), or skip."""
+    variants = [v for v in available_variants() if v.startswith(("llvm_", "cuda_"))]
+    if not variants:
+        pytest.skip("the kernel needs a vectorised Mitsuba variant")
+    from speclight.render.kernel_ops import drjit_ops
+    from speclight.render.variant import activate
+
+    mi = activate(next(v for v in variants if v.endswith("_rgb")))
+    import drjit as dr
+
+    return mi, drjit_ops(dr, mi.Float64, mi.UInt32)
+
+
+@pytest.mark.parametrize(("form", "example"), _cases("kernel"))
+def test_kernel_weights_equal_the_numpy_weights(form, example, white_rgl):
+    # Every registered model's per-pixel weights (main channel, block entries, roughness
+    # derivative) evaluated in the single mode's Dr.Jit kernel equal numpy's, at random
+    # shading geometry and at mirror pairs (glints, the peak of every lobe).
+    m = _material(form, example, white_rgl)
+    bsdf = material_bsdf(m, "single")
+    if not bsdf.in_kernel():  # RGL: Mitsuba's plugin, on the numpy path (render/rgl.py)
+        assert form is MEASURED_RGL
+        return
+    mi, ops = _kernel_ops()
+    rng = np.random.default_rng(3)
+    s = np.concatenate([_directions(rng, 400), _directions(rng, 50)])
+    o = np.concatenate([_directions(rng, 400), s[400:] * [-1.0, -1.0, 1.0]])
+    h = (s + o) / np.linalg.norm(s + o, axis=1, keepdims=True)
+    cos = (s[:, 2], o[:, 2], h[:, 2], np.einsum("nk,nk->n", s, h))
+    mirror_ok = (np.einsum("nk,nk->n", o * [-1.0, -1.0, 1.0], s) >= SUN_COS).astype(float)
+    jit = [mi.Float64(c) for c in cos]
+
+    def same(numpy_w, kernel_w):
+        a, b = np.broadcast_to(numpy_w, len(s)), np.asarray(kernel_w, dtype=float)
+        assert np.all(np.abs(a - b) <= KERNEL_ULPS * np.abs(a).max())
+
+    same(bsdf.main_weight(*cos, mirror_ok), bsdf.main_weight(*jit, mi.Float64(mirror_ok), ops))
+    entries = bsdf.block_entries(*cos)
+    kernel_entries = bsdf.block_entries(*jit, ops)
+    assert len(entries) == len(kernel_entries) and bool(entries) == (bsdf.block_size() > 0)
+    for (node, w), (k_node, k_w) in zip(entries, kernel_entries, strict=True):
+        assert np.array_equal(np.broadcast_to(node, len(s)), np.broadcast_to(k_node, len(s)))
+        same(w, k_w)
+    grad = bsdf.roughness_derivative(*cos[:3])
+    if grad is not None:
+        same(grad, bsdf.roughness_derivative(*jit[:3], ops))

@@ -19,7 +19,7 @@ slope is not): a kink of the model itself, not of this derivative.
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -30,38 +30,40 @@ F64 = NDArray[np.float64]
 Kind = Literal["beckmann", "ggx"]
 
 
-def microfacet_d_dalpha(cos_h: F64, alpha: float, kind: Kind) -> F64:
+def microfacet_d_dalpha(cos_h: Any, alpha: float, kind: Kind, ops: Any = np) -> Any:
     """dD/dalpha [sr-1] of :func:`~speclight.target.microfacet_terms.microfacet_d` (module doc)."""
-    c2 = np.clip(cos_h, 1e-12, 1.0) ** 2
+    c2 = ops.clip(cos_h, 1e-12, 1.0) ** 2
     tan2 = (1.0 - c2) / c2
-    d = microfacet_d(cos_h, alpha, kind)
+    d = microfacet_d(cos_h, alpha, kind, ops)
     if kind == "beckmann":
         return d * (2.0 * tan2 / alpha**3 - 2.0 / alpha)
     return d * (2.0 / alpha - 4.0 * alpha / (alpha * alpha + tan2))
 
 
-def smith_g1_dalpha(cos_v: F64, alpha: float, kind: Kind) -> F64:
+def smith_g1_dalpha(cos_v: Any, alpha: float, kind: Kind, ops: Any = np) -> Any:
     """dG1/dalpha [1] of :func:`~speclight.target.microfacet_terms.smith_g1` (module doc)."""
-    c = np.clip(cos_v, 1e-12, 1.0)
-    tan = np.sqrt(np.maximum(1.0 - c * c, 0.0)) / c
+    c = ops.clip(cos_v, 1e-12, 1.0)
+    tan = ops.sqrt(ops.maximum(1.0 - c * c, 0.0)) / c
     if kind == "beckmann":
-        b = 1.0 / np.maximum(alpha * tan, 1e-30)
+        b = 1.0 / ops.maximum(alpha * tan, 1e-30)
         p, dp = 3.535 * b + 2.181 * b * b, 3.535 + 4.362 * b
         q, dq = 1.0 + 2.276 * b + 2.577 * b * b, 2.276 + 5.154 * b
         dg_db = (dp * q - p * dq) / (q * q)
-        dg = np.where(b < 1.6, dg_db * (-b / alpha), 0.0)
+        dg = ops.where(b < 1.6, dg_db * (-b / alpha), 0.0)
     else:
-        s = np.sqrt(1.0 + (alpha * tan) ** 2)
+        s = ops.sqrt(1.0 + (alpha * tan) ** 2)
         dg = -2.0 * alpha * tan * tan / (s * (1.0 + s) ** 2)
-    return np.where(cos_v > 0, dg, 0.0)
+    return ops.where(cos_v > 0, dg, 0.0)
 
 
-def microfacet_weight_dalpha(cos_i: F64, cos_o: F64, cos_h: F64, alpha: float, kind: Kind) -> F64:
+def microfacet_weight_dalpha(
+    cos_i: Any, cos_o: Any, cos_h: Any, alpha: float, kind: Kind, ops: Any = np
+) -> Any:
     """d/dalpha of :func:`~speclight.target.microfacet_terms.microfacet_weight` [sr-1]."""
-    gi, go = smith_g1(cos_i, alpha, kind), smith_g1(cos_o, alpha, kind)
-    dgi, dgo = smith_g1_dalpha(cos_i, alpha, kind), smith_g1_dalpha(cos_o, alpha, kind)
-    d, dd = microfacet_d(cos_h, alpha, kind), microfacet_d_dalpha(cos_h, alpha, kind)
-    return (dd * gi * go + d * (dgi * go + gi * dgo)) / (4.0 * np.clip(cos_o, 1e-12, None))
+    gi, go = smith_g1(cos_i, alpha, kind, ops), smith_g1(cos_o, alpha, kind, ops)
+    dgi, dgo = smith_g1_dalpha(cos_i, alpha, kind, ops), smith_g1_dalpha(cos_o, alpha, kind, ops)
+    d, dd = microfacet_d(cos_h, alpha, kind, ops), microfacet_d_dalpha(cos_h, alpha, kind, ops)
+    return (dd * gi * go + d * (dgi * go + gi * dgo)) / (4.0 * ops.maximum(cos_o, 1e-12))
 
 
 __all__ = ["microfacet_d_dalpha", "microfacet_weight_dalpha", "smith_g1_dalpha"]

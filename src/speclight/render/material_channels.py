@@ -38,14 +38,16 @@ def rays_per_batch(materials: tuple[Material, ...] | list[Material]) -> int:
 
 
 class ChannelLayout:
-    """Channel layout: main channel m for material m, then a block per plastic or RGL material.
+    """Channel layout: main channel m for material m, then a block per plastic or RGL material,
+    then one roughness-derivative channel per material of ``rough`` (indices).
 
-    Blocks (:func:`speclight.render.material_block_size`) carry what does not
+    Blocks (:meth:`~speclight.render.bsdfs.MaterialBsdf.block_size`) carry what does not
     factorise: K*K channels of a plastic's diffuse base, one channel per wavelength node of an
-    RGL file.
+    RGL file. A derivative channel carries d(main weight)/d(roughness)
+    (:mod:`speclight.render.single_gradient`).
     """
 
-    def __init__(self, target: Target) -> None:
+    def __init__(self, target: Target, rough: list[int] | tuple[int, ...] = ()) -> None:
         self.mats = list(target.materials)
         #: Each material's evaluator (an InputError for a model the single mode lacks).
         self.bsdfs: list[MaterialBsdf] = [material_bsdf(m, "single") for m in self.mats]
@@ -57,6 +59,11 @@ class ChannelLayout:
             if extra:
                 self.block[k] = c
                 c += extra
+        #: The derivative channel of each differentiated material.
+        self.grad: dict[int, int] = {}
+        for k in rough:
+            self.grad[k] = c
+            c += 1
         self.n_channels = c
         #: (C,) True for the channels of light from outside a measured table's support.
         self.outside = np.zeros(c, dtype=bool)
@@ -87,6 +94,13 @@ def pixel_contributions(
             rows.append(sel[r])
             chans.append(layout.block[k] + c)
             weights.append(bw)
+    for k, channel in layout.grad.items():
+        sel = np.flatnonzero(mat == k)
+        dw = layout.bsdfs[k].roughness_derivative(cos_i[sel], cos_o[sel], cos_h[sel])
+        assert dw is not None  # the gradient render checked the material
+        rows.append(sel)
+        chans.append(np.full(sel.size, channel))
+        weights.append(dw)
     if not rows:
         return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
     return np.concatenate(rows), np.concatenate(chans), np.concatenate(weights)

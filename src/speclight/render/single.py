@@ -28,6 +28,8 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from functools import partial
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,9 +38,10 @@ from speclight.render import material_channels as channels
 from speclight.render.camera import image_axes, primary_rays
 from speclight.render.material_channels import ChannelLayout, pixel_contributions
 from speclight.render.polarization import check_polarizable
-from speclight.render.raycast import Caster
+from speclight.render.raycast import Caster, MitsubaCaster
 from speclight.render.result import RenderImage
 from speclight.render.shading import dot_rows, half_vectors, mirror_in_sun
+from speclight.render.single_kernel import SingleKernel, kernel_supported
 from speclight.target.parts import Target
 
 F64 = NDArray[np.float64]
@@ -69,77 +72,122 @@ def geometric_weights(
     on_batch: Callable[[int], None] | None = None,
     on_hits: Callable[..., None] | None = None,
     layout: ChannelLayout | None = None,
-    contributions: Callable[..., tuple[I64, I64, F64]] = pixel_contributions,
     on_shading: Callable[..., None] | None = None,
 ) -> tuple[F64, dict[int, _Kept], float, ChannelLayout]:
     """Channel weights w (N, C) [m² sr-1], kept pixel data, pixel pitch [m] and the layout.
 
-    ``on_hits(epochs, origin, direction, hits, caster)``, if given, is called after each
-    batch's primary ray cast with the batch's epoch indices (so that other lights, e.g.
-    lasers for ranging, reuse the rays: :mod:`speclight.render.laser_returns`).
-    ``layout`` and ``contributions`` (same arguments as :func:`pixel_contributions`) add
-    channels of their own, e.g. roughness derivatives (:mod:`speclight.render.single_gradient`).
+    With a Mitsuba caster the sums are made in Dr.Jit (:mod:`speclight.render.single_kernel`)
+    and only the kept epochs' pixels go through numpy; otherwise (the numpy caster, RGL
+    materials, ``on_hits``, ``on_shading``) every batch does.
     ``on_shading(epochs, material, cos_i, cos_o, cos_h, cos_d, pixel_area_m2)``, if given,
     receives every lit, visible hit of a batch (its epoch index, material index and cosines)
     and the pixel area, e.g. to evaluate other BRDFs on the same hits
     (:mod:`speclight.estimate.surface_fit.surface_records`).
+    ``on_hits(epochs, origin, direction, hits, caster)``, if given, is called after each
+    batch's primary ray cast with the batch's epoch indices (so that other lights, e.g.
+    lasers for ranging, reuse the rays: :mod:`speclight.render.laser_returns`). ``layout``
+    may add channels of its own (roughness derivatives, :mod:`speclight.render.single_gradient`).
     """
     layout = ChannelLayout(target) if layout is None else layout
-    centre, radius = target.bounding_sphere()
+    radius = target.bounding_sphere()[1]
     n_ep, n_ch = len(sun_dir), layout.n_channels
     pixels = resolution_px * resolution_px
-    batch = max(1, rays_per_batch // pixels)
+    batch = max(1, min(rays_per_batch // pixels, (2**32 - 1) // max(n_ch, 1)))
     keep_set = set(keep)
     w = np.zeros((n_ep, n_ch))
     kept: dict[int, _Kept] = {}
     pixel_area = (2.0 * radius / resolution_px) ** 2
+    kernel = None
+    numpy_only = on_hits is not None or on_shading is not None  # they need every hit
+    if not numpy_only and isinstance(caster, MitsubaCaster) and kernel_supported(caster, layout):
+        kernel = SingleKernel(target, caster, layout, resolution_px)
     for a in range(0, n_ep, batch):
         s, o = sun_dir[a : a + batch], obs_dir[a : a + batch]
         b = len(s)
-        origin, direction, pixel_area = primary_rays(centre, radius, o, resolution_px)
-        hits = caster.intersect(origin, direction)
-        if on_hits is not None:
-            on_hits(np.arange(a, a + b), origin, direction, hits, caster)
-        ep = np.repeat(np.arange(b), pixels)
-        n = hits.normal
-        cos_o = np.einsum("mk,mk->m", n, o[ep])
-        flip = np.where(cos_o < 0, -1.0, 1.0)  # thin sheets reflect on both faces
-        n = n * flip[:, None]
-        cos_o = cos_o * flip
-        cos_i = np.einsum("mk,mk->m", n, s[ep])
-        idx = np.flatnonzero(hits.hit & (cos_i > 0) & (cos_o > 0))
-        pos = origin[idx] + hits.t_m[idx, None] * direction[idx]
-        idx = idx[~caster.occluded(pos, s[ep[idx]], n[idx])]
-        e_idx = ep[idx]
-        half = half_vectors(s, o)
-        cos_h = dot_rows(n[idx], half[e_idx])
-        cos_d = dot_rows(s, half)[e_idx]
-        mirror_ok = mirror_in_sun(n[idx], cos_o[idx], o[e_idx], s[e_idx])
-        mat = layout.part_mat[hits.part[idx]]
-        if on_shading is not None:
-            on_shading(a + e_idx, mat, cos_i[idx], cos_o[idx], cos_h, cos_d, pixel_area)
-        rows, chans, px_w = contributions(
-            layout, mat, cos_i[idx], cos_o[idx], cos_h, cos_d, mirror_ok
-        )
-        flat = e_idx[rows] * n_ch + chans
-        w[a : a + b] = (np.bincount(flat, px_w, minlength=b * n_ch) * pixel_area).reshape(b, n_ch)
-        for e in keep_set.intersection(range(a, a + b)):
-            j = e - a
-            sel = e_idx[rows] == j
-            right, up = image_axes(o[j : j + 1])
-            sl = slice(j * pixels, (j + 1) * pixels)
-            kept[e] = _Kept(
-                pixel=idx[rows[sel]] - j * pixels,
-                channel=chans[sel],
-                weight=px_w[sel] * pixel_area,
-                part=hits.part[sl].copy(),
-                depth_m=hits.t_m[sl] - 2.0 * radius,
-                right=right[0],
-                up=up[0],
-            )
+        sums = None if kernel is None else kernel.channel_sums(s, o)
+        mine = sorted(keep_set.intersection(range(a, a + b)))
+        if sums is None:
+            w[a : a + b], pix = _numpy_batch(
+                target, s, o, caster, resolution_px, layout, [e - a for e in mine],
+                None if on_hits is None else partial(on_hits, np.arange(a, a + b)),
+                None if on_shading is None else partial(_shift_epochs, on_shading, a),
+            )  # fmt: skip
+            kept.update({a + j: kp for j, kp in pix.items()})
+        else:
+            w[a : a + b] = sums * pixel_area
+            for e in mine:  # the kept images' pixels: numpy, one epoch at a time
+                kept[e] = _numpy_batch(
+                    target, sun_dir[e : e + 1], obs_dir[e : e + 1], caster, resolution_px,
+                    layout, [0],
+                )[1][0]  # fmt: skip
         if on_batch is not None:
             on_batch(b)
     return w, kept, float(np.sqrt(pixel_area)), layout
+
+
+def _shift_epochs(on_shading: Callable[..., None], first: int, epochs: I64, *rest: Any) -> None:
+    """``on_shading`` with the batch's epoch indices made the run's (``first`` added)."""
+    on_shading(first + epochs, *rest)
+
+
+def _numpy_batch(
+    target: Target,
+    s: F64,
+    o: F64,
+    caster: Caster,
+    resolution_px: int,
+    layout: ChannelLayout,
+    keep: list[int],
+    on_hits: Callable[..., None] | None = None,
+    on_shading: Callable[..., None] | None = None,
+) -> tuple[F64, dict[int, _Kept]]:
+    """Channel weights (b, C) [m² sr-1] of a batch of epochs in numpy (any caster), and the
+    pixel data of its epochs ``keep`` (indices into the batch)."""
+    centre, radius = target.bounding_sphere()
+    b, n_ch = len(s), layout.n_channels
+    pixels = resolution_px * resolution_px
+    origin, direction, pixel_area = primary_rays(centre, radius, o, resolution_px)
+    hits = caster.intersect(origin, direction)
+    if on_hits is not None:
+        on_hits(origin, direction, hits, caster)
+    ep = np.repeat(np.arange(b), pixels)
+    n = hits.normal
+    cos_o = np.einsum("mk,mk->m", n, o[ep])
+    flip = np.where(cos_o < 0, -1.0, 1.0)  # thin sheets reflect on both faces
+    n = n * flip[:, None]
+    cos_o = cos_o * flip
+    cos_i = np.einsum("mk,mk->m", n, s[ep])
+    idx = np.flatnonzero(hits.hit & (cos_i > 0) & (cos_o > 0))
+    pos = origin[idx] + hits.t_m[idx, None] * direction[idx]
+    idx = idx[~caster.occluded(pos, s[ep[idx]], n[idx])]
+    e_idx = ep[idx]
+    half = half_vectors(s, o)
+    cos_h = dot_rows(n[idx], half[e_idx])
+    cos_d = dot_rows(s, half)[e_idx]
+    mirror_ok = mirror_in_sun(n[idx], cos_o[idx], o[e_idx], s[e_idx])
+    mat = layout.part_mat[hits.part[idx]]
+    if on_shading is not None:
+        on_shading(e_idx, mat, cos_i[idx], cos_o[idx], cos_h, cos_d, pixel_area)
+    rows, chans, px_w = pixel_contributions(
+        layout, mat, cos_i[idx], cos_o[idx], cos_h, cos_d, mirror_ok
+    )
+    flat = e_idx[rows] * n_ch + chans
+    w = np.asarray(np.bincount(flat, px_w, minlength=b * n_ch) * pixel_area, dtype=float)
+    kept: dict[int, _Kept] = {}
+    for j in keep:
+        sel = e_idx[rows] == j
+        right, up = image_axes(o[j : j + 1])
+        sl = slice(j * pixels, (j + 1) * pixels)
+        kept[j] = _Kept(
+            pixel=idx[rows[sel]] - j * pixels,
+            channel=chans[sel],
+            weight=px_w[sel] * pixel_area,
+            part=hits.part[sl].copy(),
+            depth_m=hits.t_m[sl] - 2.0 * radius,
+            right=right[0],
+            up=up[0],
+        )
+    return w.reshape(b, n_ch), kept
 
 
 def render_single(

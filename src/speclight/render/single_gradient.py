@@ -10,7 +10,8 @@ factor (the Fresnel term at the half angle) does not. So
 over the pixels of material k, with the analytic derivative of
 :func:`speclight.render.brdf_gradient.microfacet_weight_dalpha`. It is computed in the same
 pass as the intensity: one extra channel per differentiated material, accumulated beside the
-others (:func:`~speclight.render.single.geometric_weights`), so that it costs a fraction of
+others (:class:`~speclight.render.material_channels.ChannelLayout`'s derivative channels,
+summed in the single mode's kernel or its numpy path), so that it costs a fraction of
 a render, not the two renders of a central difference.
 
 Materials: those whose model gives the derivative
@@ -28,51 +29,18 @@ from numpy.typing import NDArray
 from speclight.errors import InputError
 from speclight.render import material_channels as channels
 from speclight.render.bsdfs import material_bsdf
-from speclight.render.material_channels import ChannelLayout, pixel_contributions
+from speclight.render.material_channels import ChannelLayout
 from speclight.render.raycast import Caster
 from speclight.render.single import channel_sum, geometric_weights
 from speclight.target.materials import Material
 from speclight.target.parts import Target
 
 F64 = NDArray[np.float64]
-I64 = NDArray[np.int64]
 
 
 def gradient_problem(m: Material) -> str:
     """Why the roughness derivative of material ``m`` is not available ("" when it is)."""
     return material_bsdf(m, "single").gradient_problem()
-
-
-class _GradientLayout(ChannelLayout):
-    """The render's channels, then one d/dalpha channel per differentiated material."""
-
-    def __init__(self, target: Target, rough: list[int]) -> None:
-        super().__init__(target)
-        self.grad: dict[int, int] = {}
-        for k in rough:
-            self.grad[k] = self.n_channels
-            self.n_channels += 1
-
-
-def _contributions(
-    layout: _GradientLayout,
-    mat: I64,
-    cos_i: F64,
-    cos_o: F64,
-    cos_h: F64,
-    cos_d: F64,
-    mirror_ok: F64,
-) -> tuple[I64, I64, F64]:
-    rows, chans, weights = pixel_contributions(layout, mat, cos_i, cos_o, cos_h, cos_d, mirror_ok)
-    extra_rows, extra_chans, extra_w = [rows], [chans], [weights]
-    for k, channel in layout.grad.items():
-        sel = np.flatnonzero(mat == k)
-        dw = layout.bsdfs[k].roughness_derivative(cos_i[sel], cos_o[sel], cos_h[sel])
-        assert dw is not None  # gradient_problem() was checked
-        extra_rows.append(sel)
-        extra_chans.append(np.full(sel.size, channel))
-        extra_w.append(dw)
-    return np.concatenate(extra_rows), np.concatenate(extra_chans), np.concatenate(extra_w)
 
 
 def render_single_gradient(
@@ -113,7 +81,7 @@ def render_single_gradient(
         if problem:
             raise InputError(f"no roughness derivative: {problem}", field="target.materials")
         index.append(k)
-    layout = _GradientLayout(target, index)
+    layout = ChannelLayout(target, index)
     w, _, _, _ = geometric_weights(
         target,
         sun_dir,
@@ -122,7 +90,6 @@ def render_single_gradient(
         resolution_px,
         rays_per_batch=channels.rays_per_batch(target.materials),
         layout=layout,
-        contributions=_contributions,
     )
     total, main, _, _ = channel_sum(w, layout, sun_dir, obs_dir, wavelength_nm)
     intensity = irradiance * total

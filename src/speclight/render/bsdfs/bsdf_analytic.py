@@ -20,6 +20,7 @@ from speclight.render.bsdfs.bsdf_interface import (
     normalised_reflectance,
     spectrum_grid,
 )
+from speclight.render.kernel_ops import NUMPY_OPS, ShadingOps
 from speclight.target.brdf_fit.form_coefficients import evaluate
 
 
@@ -32,9 +33,17 @@ class AnalyticBsdf(MaterialBsdf):
         assert c is not None  # the registry requires them
         return dict(c)
 
-    def main_weight(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mirror_ok: F64) -> F64:
-        f = evaluate(self.material.bsdf, self.coefficients, cos_i, cos_o, cos_h, cos_d)
-        return np.asarray(f * cos_i, dtype=float)
+    def main_weight(
+        self,
+        cos_i: F64,
+        cos_o: F64,
+        cos_h: F64,
+        cos_d: F64,
+        mirror_ok: F64,
+        ops: ShadingOps = NUMPY_OPS,
+    ) -> F64:
+        f = evaluate(self.material.bsdf, self.coefficients, cos_i, cos_o, cos_h, cos_d, ops)
+        return f * cos_i if ops.jit else np.asarray(f * cos_i, dtype=float)
 
     def spectral_ratio(self, wavelength_nm: F64) -> F64:
         """``R(lambda) / R(coefficients.wavelength_nm)`` (L,) [1]."""

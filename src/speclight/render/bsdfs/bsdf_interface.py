@@ -12,7 +12,7 @@ their parameters and the modes each supports is :mod:`speclight.target.bsdf_mode
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Hashable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
+from speclight.render.kernel_ops import NUMPY_OPS, ShadingOps
 from speclight.render.polarization import linear_factor
 from speclight.target.materials import Material
 from speclight.target.reflectance import Reflectance
@@ -35,6 +36,11 @@ class MaterialBsdf:
     light and view directions with the normal, ``cos_h`` of the half vector with the normal,
     ``cos_d`` of the light with the half vector; ``mirror_ok`` is 1 where the mirror
     direction of the view falls inside the solar disk.
+
+    The per-pixel weights (:meth:`main_weight`, :meth:`block_entries`,
+    :meth:`roughness_derivative`) take the array functions ``ops``
+    (:mod:`speclight.render.kernel_ops`): numpy's by default, Dr.Jit's in the single mode's
+    kernel (:mod:`speclight.render.single_kernel`), so one written formula serves both.
     """
 
     def __init__(self, material: Material) -> None:
@@ -46,10 +52,28 @@ class MaterialBsdf:
         return False
 
     def main_weight(
-        self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mirror_ok: F64
+        self,
+        cos_i: F64,
+        cos_o: F64,
+        cos_h: F64,
+        cos_d: F64,
+        mirror_ok: F64,
+        ops: ShadingOps = NUMPY_OPS,
     ) -> F64:  # pragma: no cover - every model defines it
         """Per-pixel weight [sr-1] of the main channel: ``f cos_i`` over its factor."""
         raise NotImplementedError
+
+    def kernel_key(self, block: bool = False) -> Hashable:
+        """Models (materials) with equal keys have the same main weight and roughness
+        derivative (``block``: the same block entries) as functions of the cosines, so that
+        the single mode's kernel evaluates them once for all their pixels; by default each
+        material is its own."""
+        return id(self)
+
+    def in_kernel(self) -> bool:
+        """True when the single mode's Dr.Jit kernel evaluates the model (its weights
+        written against ``ops``); False sends a target with it down the numpy path."""
+        return True
 
     def main_factor(
         self, cos_half_phase: F64, wavelength_nm: F64
@@ -75,10 +99,24 @@ class MaterialBsdf:
         cannot be read: the run reports that file itself)."""
         return 0
 
+    def block_entries(
+        self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, ops: ShadingOps = NUMPY_OPS
+    ) -> list[tuple[Any, Any]]:
+        """The block's (channel within the block, weight [sr-1]) per pixel, a fixed number
+        of such pairs for every pixel (none without a block)."""
+        return []
+
     def block_weights(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64) -> tuple[I64, I64, F64]:
-        """(row into the inputs, channel within the block, weight [sr-1]) of the block."""
-        empty = np.zeros(0, np.int64)
-        return empty, empty, np.zeros(0)
+        """(row into the inputs, channel within the block, weight [sr-1]) of the block:
+        :meth:`block_entries` flattened pixel by pixel."""
+        entries = self.block_entries(cos_i, cos_o, cos_h, cos_d)
+        if not entries:
+            empty = np.zeros(0, np.int64)
+            return empty, empty, np.zeros(0)
+        chans = np.stack([np.broadcast_to(c, np.shape(cos_i)) for c, _ in entries], axis=1)
+        weights = np.stack([w for _, w in entries], axis=1)
+        rows = np.repeat(np.arange(len(cos_i)), len(entries))
+        return rows, chans.ravel().astype(np.int64), weights.ravel()
 
     def block_factor(self, wavelength_nm: F64) -> F64:
         """Spectral factors (block_size, L) [1] of the block channels."""
@@ -126,7 +164,9 @@ class MaterialBsdf:
             field=f"target.materials.{m.name}.bsdf",
         )
 
-    def roughness_derivative(self, cos_i: F64, cos_o: F64, cos_h: F64) -> F64 | None:
+    def roughness_derivative(
+        self, cos_i: F64, cos_o: F64, cos_h: F64, ops: ShadingOps = NUMPY_OPS
+    ) -> F64 | None:
         """d(main weight)/d(roughness) [sr-1] per pixel, or None (see :meth:`gradient_problem`)."""
         return None
 

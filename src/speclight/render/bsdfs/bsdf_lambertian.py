@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Hashable
 from typing import Any
 
 import numpy as np
@@ -12,13 +13,25 @@ from speclight.render.bsdfs.bsdf_interface import (
     reflectance_factor,
     reflectance_spectrum,
 )
+from speclight.render.kernel_ops import NUMPY_OPS, ShadingOps
 
 
 class LambertianBsdf(MaterialBsdf):
     """One channel: ``cos(theta_i) / pi`` times the albedo; unpolarising."""
 
-    def main_weight(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mirror_ok: F64) -> F64:
+    def main_weight(
+        self,
+        cos_i: F64,
+        cos_o: F64,
+        cos_h: F64,
+        cos_d: F64,
+        mirror_ok: F64,
+        ops: ShadingOps = NUMPY_OPS,
+    ) -> F64:
         return cos_i / np.pi
+
+    def kernel_key(self, block: bool = False) -> Hashable:
+        return "lambertian"  # the albedo is in the factor
 
     def main_factor(self, cos_half_phase: F64, wavelength_nm: F64) -> F64:
         return reflectance_factor(self.material.reflectance, len(cos_half_phase), wavelength_nm)

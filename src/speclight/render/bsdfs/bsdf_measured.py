@@ -26,8 +26,38 @@ from numpy.typing import NDArray
 from speclight.errors import InputError
 from speclight.render import rgl
 from speclight.render.bsdfs.bsdf_interface import F64, I64, MaterialBsdf, normalised_reflectance
-from speclight.target.brdf_table import DEFAULT_EXTENSION, MeasuredBRDF, load_brdf_table
+from speclight.render.kernel_ops import NUMPY_OPS, ShadingOps
+from speclight.target.brdf_fit.form_coefficients import evaluate
+from speclight.target.brdf_table import (
+    DEFAULT_EXTENSION,
+    GRID_D_DEG,
+    GRID_H_DEG,
+    MeasuredBRDF,
+    load_brdf_table,
+)
 from speclight.target.rgl_file import load_rgl_info
+
+
+def table_lookup(ops: ShadingOps, grid: Any, cos_h: Any, cos_d: Any) -> Any:
+    """Bilinear lookup [grid's unit] of a (theta_h, theta_d) grid flattened row-major (a
+    numpy array, or the kernel's Dr.Jit copy) at the shading cosines: the interpolation of
+    :class:`~speclight.target.brdf_table.MeasuredBRDF`, written against ``ops`` for the
+    kernel (the contract test holds the two together)."""
+    n_d = len(GRID_D_DEG)
+    th = ops.arccos(ops.clip(cos_h, -1.0, 1.0)) * (180.0 / np.pi)
+    td = ops.arccos(ops.clip(cos_d, -1.0, 1.0)) * (180.0 / np.pi)
+    h = ops.clip(th, 0.0, 90.0) / (GRID_H_DEG[1] - GRID_H_DEG[0])
+    d = ops.clip(td, 0.0, 90.0) / (GRID_D_DEG[1] - GRID_D_DEG[0])
+    i0 = ops.minimum(ops.floor(h), len(GRID_H_DEG) - 2)
+    j0 = ops.minimum(ops.floor(d), n_d - 2)
+    fh, fd = h - i0, d - j0
+    at = ops.index(i0 * n_d + j0)
+    return (
+        (1 - fh) * (1 - fd) * ops.gather(grid, at)
+        + fh * (1 - fd) * ops.gather(grid, at + n_d)
+        + (1 - fh) * fd * ops.gather(grid, at + 1)
+        + fh * fd * ops.gather(grid, at + (n_d + 1))
+    )
 
 
 class MeasuredTableBsdf(MaterialBsdf):
@@ -39,8 +69,20 @@ class MeasuredTableBsdf(MaterialBsdf):
         m = self.material
         return load_brdf_table(str(m.brdf_table), m.extension or DEFAULT_EXTENSION)
 
-    def main_weight(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mirror_ok: F64) -> F64:
-        return self.table.table_part(cos_h, cos_d) * cos_i
+    def main_weight(
+        self,
+        cos_i: F64,
+        cos_o: F64,
+        cos_h: F64,
+        cos_d: F64,
+        mirror_ok: F64,
+        ops: ShadingOps = NUMPY_OPS,
+    ) -> F64:
+        if not ops.jit:
+            return self.table.table_part(cos_h, cos_d) * cos_i
+        t = self.table
+        inside = table_lookup(ops, ops.array(t.support.ravel()), cos_h, cos_d)
+        return inside * table_lookup(ops, ops.array(t.values.ravel()), cos_h, cos_d) * cos_i
 
     def _ratio(self, wavelength_nm: F64) -> F64:
         m = self.material
@@ -60,10 +102,16 @@ class MeasuredTableBsdf(MaterialBsdf):
     ) -> int:
         return 1
 
-    def block_weights(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64) -> tuple[I64, I64, F64]:
-        rows = np.arange(len(cos_i))
-        outside = self.table.extension_part(cos_i, cos_o, cos_h, cos_d)
-        return rows, np.zeros(len(cos_i), np.int64), outside * cos_i
+    def block_entries(
+        self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, ops: ShadingOps = NUMPY_OPS
+    ) -> list[tuple[Any, Any]]:
+        t = self.table
+        if not ops.jit:
+            return [(0, t.extension_part(cos_i, cos_o, cos_h, cos_d) * cos_i)]
+        out = 1.0 - table_lookup(ops, ops.array(t.support.ravel()), cos_h, cos_d)
+        name, coefficients = t.extension
+        f = evaluate(name, coefficients, cos_i, cos_o, cos_h, cos_d, ops)
+        return [(0, ops.where(out > 0, out * f, 0.0) * cos_i)]
 
     def outside_support(self) -> NDArray[np.bool_]:
         return np.ones(1, dtype=bool)
@@ -73,9 +121,21 @@ class MeasuredTableBsdf(MaterialBsdf):
 
 
 class MeasuredRglBsdf(MaterialBsdf):
-    """No main channel; a block of one channel per wavelength node of the file."""
+    """No main channel; a block of one channel per wavelength node of the file (Mitsuba's
+    plugin evaluates it, outside the single mode's kernel)."""
 
-    def main_weight(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mirror_ok: F64) -> F64:
+    def in_kernel(self) -> bool:
+        return False
+
+    def main_weight(
+        self,
+        cos_i: F64,
+        cos_o: F64,
+        cos_h: F64,
+        cos_d: F64,
+        mirror_ok: F64,
+        ops: ShadingOps = NUMPY_OPS,
+    ) -> F64:
         return np.zeros_like(cos_i)
 
     def main_factor(self, cos_half_phase: F64, wavelength_nm: F64) -> F64:

@@ -10,6 +10,7 @@ scaled by a reflectance given as numbers (Mitsuba's ``material='none'``).
 
 from __future__ import annotations
 
+from collections.abc import Hashable
 from typing import Any, Literal, cast
 
 import numpy as np
@@ -24,6 +25,7 @@ from speclight.render.bsdfs.bsdf_interface import (
     reflectance_spectrum,
     spectrum_grid,
 )
+from speclight.render.kernel_ops import NUMPY_OPS, ShadingOps
 from speclight.target.microfacet_terms import microfacet_weight
 from speclight.target.reflectance import Reflectance
 
@@ -57,8 +59,19 @@ class MicrofacetBsdf(MaterialBsdf):
     def alpha(self) -> float:
         return float(self.material.roughness or 0.0)
 
-    def main_weight(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mirror_ok: F64) -> F64:
-        return microfacet_weight(cos_i, cos_o, cos_h, self.alpha, self.distribution)
+    def main_weight(
+        self,
+        cos_i: F64,
+        cos_o: F64,
+        cos_h: F64,
+        cos_d: F64,
+        mirror_ok: F64,
+        ops: ShadingOps = NUMPY_OPS,
+    ) -> F64:
+        return microfacet_weight(cos_i, cos_o, cos_h, self.alpha, self.distribution, ops)
+
+    def kernel_key(self, block: bool = False) -> Hashable:
+        return ("microfacet", self.distribution, self.alpha)  # F is in the factor
 
     def main_factor(self, cos_half_phase: F64, wavelength_nm: F64) -> F64:
         return fresnel_factor(self.material.reflectance, cos_half_phase, wavelength_nm)
@@ -74,10 +87,12 @@ class MicrofacetBsdf(MaterialBsdf):
         }
         return inner | fresnel_path_parameters(self.material.reflectance, lo_nm, hi_nm)
 
-    def roughness_derivative(self, cos_i: F64, cos_o: F64, cos_h: F64) -> F64 | None:
+    def roughness_derivative(
+        self, cos_i: F64, cos_o: F64, cos_h: F64, ops: ShadingOps = NUMPY_OPS
+    ) -> F64 | None:
         if not self.material.roughness:
             return None
-        return microfacet_weight_dalpha(cos_i, cos_o, cos_h, self.alpha, self.distribution)
+        return microfacet_weight_dalpha(cos_i, cos_o, cos_h, self.alpha, self.distribution, ops)
 
     def gradient_problem(self) -> str:
         return "" if self.material.roughness else super().gradient_problem()

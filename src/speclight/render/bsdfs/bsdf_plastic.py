@@ -16,7 +16,7 @@ plugins per group of bins, :mod:`.path_plastic`).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Hashable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -24,7 +24,6 @@ import numpy as np
 
 from speclight.render.bsdfs.bsdf_interface import (
     F64,
-    I64,
     MaterialBsdf,
     finite_cosines,
     fresnel_linear_factor,
@@ -34,6 +33,7 @@ from speclight.render.bsdfs.bsdf_interface import (
 from speclight.render.bsdfs.coat_optics import coat_transmittance
 from speclight.render.bsdfs.path_coat import coat_tables, coated_diffuse
 from speclight.render.bsdfs.path_plastic import base_for_mitsuba
+from speclight.render.kernel_ops import NUMPY_OPS, ShadingOps
 from speclight.render.shading import SUN_SOLID_ANGLE_SR
 from speclight.target.microfacet_terms import microfacet_weight
 from speclight.target.optical_constants import fresnel_reflectance
@@ -47,23 +47,19 @@ def plastic_nodes() -> F64:
     return np.linspace(0.0, 1.0, PLASTIC_NODES)
 
 
-def bilinear_nodes(cos_i: F64, cos_o: F64) -> tuple[I64, F64]:
-    """Flat node indices (P, 4) and weights (P, 4) of points on the (cos_i, cos_o) grid."""
+def bilinear_nodes(cos_i: Any, cos_o: Any, ops: ShadingOps = NUMPY_OPS) -> list[tuple[Any, Any]]:
+    """(flat node index, weight) of the four corners of points on the (cos_i, cos_o) grid."""
     k = PLASTIC_NODES - 1
-    x, y = np.clip(cos_i, 0, 1) * k, np.clip(cos_o, 0, 1) * k
-    i0, j0 = np.minimum(x.astype(int), k - 1), np.minimum(y.astype(int), k - 1)
+    x, y = ops.clip(cos_i, 0.0, 1.0) * k, ops.clip(cos_o, 0.0, 1.0) * k
+    i0, j0 = ops.minimum(ops.floor(x), k - 1), ops.minimum(ops.floor(y), k - 1)
     fx, fy = x - i0, y - j0
-    idx = np.stack(
-        [
-            i0 * (k + 1) + j0,
-            (i0 + 1) * (k + 1) + j0,
-            i0 * (k + 1) + j0 + 1,
-            (i0 + 1) * (k + 1) + j0 + 1,
-        ],
-        axis=1,
-    )
-    w = np.stack([(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy], axis=1)
-    return idx, w
+    base = ops.index(i0 * (k + 1) + j0)  # whole numbers below 2^24: exact in any float
+    return [
+        (base, (1 - fx) * (1 - fy)),
+        (base + (k + 1), fx * (1 - fy)),
+        (base + 1, (1 - fx) * fy),
+        (base + (k + 2), fx * fy),
+    ]
 
 
 class PlasticBsdf(MaterialBsdf):
@@ -72,11 +68,23 @@ class PlasticBsdf(MaterialBsdf):
     def mirror_lobe(self) -> bool:
         return self.material.roughness is None  # a smooth coat
 
-    def main_weight(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mirror_ok: F64) -> F64:
+    def main_weight(
+        self,
+        cos_i: F64,
+        cos_o: F64,
+        cos_h: F64,
+        cos_d: F64,
+        mirror_ok: F64,
+        ops: ShadingOps = NUMPY_OPS,
+    ) -> F64:
         if self.mirror_lobe():
             return mirror_ok / SUN_SOLID_ANGLE_SR
         alpha = float(self.material.roughness or 0.0)
-        return microfacet_weight(cos_i, cos_o, cos_h, alpha, "beckmann")
+        return microfacet_weight(cos_i, cos_o, cos_h, alpha, "beckmann", ops)
+
+    def kernel_key(self, block: bool = False) -> Hashable:
+        # the coat's lobe depends on its roughness only; every base bins alike
+        return "plastic base" if block else ("plastic coat", self.material.roughness)
 
     def main_factor(self, cos_half_phase: F64, wavelength_nm: F64) -> F64:
         eta = self.material.reflectance.eta(wavelength_nm).real
@@ -95,10 +103,11 @@ class PlasticBsdf(MaterialBsdf):
     ) -> int:
         return PLASTIC_NODES**2
 
-    def block_weights(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64) -> tuple[I64, I64, F64]:
-        idx, bw = bilinear_nodes(cos_i, cos_o)
-        rows = np.repeat(np.arange(len(cos_i)), 4)
-        return rows, idx.ravel(), (bw * (cos_i / np.pi)[:, None]).ravel()
+    def block_entries(
+        self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, ops: ShadingOps = NUMPY_OPS
+    ) -> list[tuple[Any, Any]]:
+        diffuse = cos_i / np.pi
+        return [(node, w * diffuse) for node, w in bilinear_nodes(cos_i, cos_o, ops)]
 
     def block_factor(self, wavelength_nm: F64) -> F64:
         m = self.material

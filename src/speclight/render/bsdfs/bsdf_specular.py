@@ -8,6 +8,7 @@ mode uses Mitsuba's ``conductor`` (a point Sun never reaches the observer throug
 
 from __future__ import annotations
 
+from collections.abc import Hashable
 from typing import Any
 
 from speclight.render.bsdfs.bsdf_interface import (
@@ -17,6 +18,7 @@ from speclight.render.bsdfs.bsdf_interface import (
     fresnel_linear_factor,
 )
 from speclight.render.bsdfs.bsdf_microfacet import fresnel_path_parameters
+from speclight.render.kernel_ops import NUMPY_OPS, ShadingOps
 from speclight.render.shading import SUN_SOLID_ANGLE_SR
 
 
@@ -26,8 +28,19 @@ class SpecularBsdf(MaterialBsdf):
     def mirror_lobe(self) -> bool:
         return True
 
-    def main_weight(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64, mirror_ok: F64) -> F64:
+    def main_weight(
+        self,
+        cos_i: F64,
+        cos_o: F64,
+        cos_h: F64,
+        cos_d: F64,
+        mirror_ok: F64,
+        ops: ShadingOps = NUMPY_OPS,
+    ) -> F64:
         return mirror_ok / SUN_SOLID_ANGLE_SR
+
+    def kernel_key(self, block: bool = False) -> Hashable:
+        return "mirror"  # the reflectance is in the factor
 
     def main_factor(self, cos_half_phase: F64, wavelength_nm: F64) -> F64:
         return fresnel_factor(self.material.reflectance, cos_half_phase, wavelength_nm)

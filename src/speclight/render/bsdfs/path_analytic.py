@@ -21,12 +21,11 @@ from typing import Any
 import numpy as np
 
 from speclight.render.bsdfs.bsdf_interface import F64, irregular_spectrum
+from speclight.render.kernel_ops import drjit_ops
 from speclight.target.brdf_fit.analytic_forms import ArrayOps
 from speclight.target.brdf_fit.form_coefficients import evaluate
 
 _CLASSES: dict[str, Any] = {}
-LOG10_2 = float(np.log10(2.0))
-LOG2_10 = float(np.log2(10.0))
 
 
 def sampling_lobe(model: str, c: dict[str, Any]) -> tuple[float, float]:
@@ -59,35 +58,10 @@ def analytic_bsdf(
 
 
 def _ops(mi: Any, dr: Any) -> ArrayOps:
-    class DrJitOps(ArrayOps):
-        @staticmethod
-        def sqrt(x: Any) -> Any:
-            return dr.sqrt(x)
+    """Dr.Jit's array functions (:func:`~speclight.render.kernel_ops.drjit_ops`), with the
+    microfacet lobe from Mitsuba's ``MicrofacetDistribution`` (module doc)."""
 
-        @staticmethod
-        def clip(x: Any, low: float, high: float) -> Any:
-            return dr.clip(x, low, high)
-
-        @staticmethod
-        def maximum(x: Any, y: Any) -> Any:
-            return dr.maximum(x, y)
-
-        @staticmethod
-        def minimum(x: Any, y: Any) -> Any:
-            return dr.minimum(x, y)
-
-        @staticmethod
-        def power(x: Any, y: Any) -> Any:
-            return dr.power(x, y)
-
-        @staticmethod
-        def log10(x: Any) -> Any:
-            return dr.log2(x) * LOG10_2
-
-        @staticmethod
-        def exp10(x: Any) -> Any:
-            return dr.exp2(x * LOG2_10)
-
+    class DrJitOps(type(drjit_ops(dr, mi.Float, mi.UInt32))):  # type: ignore[misc]
         @staticmethod
         def microfacet(cos_i: Any, cos_o: Any, cos_h: Any, alpha: float, kind: str) -> Any:
             kinds = {"ggx": mi.MicrofacetType.GGX, "beckmann": mi.MicrofacetType.Beckmann}
