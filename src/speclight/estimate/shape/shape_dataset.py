@@ -44,6 +44,8 @@ def verdict(run: ShapeRun) -> str:
     )
     if run.mirror_reported:
         parts.append("the mirror pole fits as well")
+    elif not run.mirror_is_minimum:
+        parts.append("the mirror pole is not a minimum")
     for m in run.equivalent_minima:
         parts.append(f"the pole ({m.lambda_deg:.0f}, {m.beta_deg:.0f}) fits as well")
     return "; ".join(parts)
@@ -180,6 +182,7 @@ def _attrs(run: ShapeRun, obj_file: str | None) -> dict[str, Any]:
         "chi2": b.chi2,
         "residual_scale": c.residual_scale,
         "mirror_chi2": run.mirror.chi2,
+        "mirror_is_minimum": int(run.mirror_is_minimum),
         "shape_p_value": run.shape_p,
         "shape_constrained": int(run.shape_constrained),
         "pole_constrained": int(run.pole_constrained),
