@@ -81,7 +81,26 @@ def test_convex_body_recovered(tmp_path, bodies, body):
         angular_distance_deg(found, mirror) < POLE_TOLERANCE_DEG and run.mirror_reported
     )
     assert run.shape_constrained and run.pole_constrained
+    _check_solutions(run)
     if near_truth:  # the mirror solution's shape is the mirror image
         normals = run.model.normals
         true_egi = mesh_egi(vertices, faces, normals)
         assert egi_difference(run.best.areas, true_egi, normals, EGI_FWHM_DEG) < EGI_TOLERANCE
+
+
+def _check_solutions(run):
+    """What the run reports is consistent: the best has the lowest chi-square of all its
+    solutions, no two solutions share a minimum (30 deg), and the mirror solution is at
+    the best's mirror pole when it is a minimum (the mirror start could before end back in
+    the best's own minimum and be reported as its mirror)."""
+    sols = [run.best, run.mirror, *run.others]
+    assert all(run.best.chi2 <= s.chi2 for s in sols)
+    distinct = [run.best, *([run.mirror] if run.mirror_is_minimum else []), *run.others]
+    poles = [pole_vector(s.lambda_deg, s.beta_deg) for s in distinct]
+    for i in range(len(poles)):
+        for j in range(i):
+            assert angular_distance_deg(poles[i], poles[j]) >= 30.0
+    target = pole_vector(run.best.lambda_deg + 180.0, run.best.beta_deg)
+    assert (
+        angular_distance_deg(pole_vector(run.mirror.lambda_deg, run.mirror.beta_deg), target) < 30.0
+    )

@@ -115,7 +115,7 @@ def levenberg_marquardt(
             lam *= nu
             nu *= 2.0
             if lam > MAX_DAMPING:
-                return LmResult(x, cost, r, jac, it, True, evaluations)
+                return LmResult(x, cost, r, jac, it - 1, True, evaluations)
         predicted = float(step @ (lam * diag * step - grad))
         rho = (cost - new_cost) / predicted if predicted > 0 else 1.0
         gain = (cost - new_cost) / cost if cost > 0 else 0.0

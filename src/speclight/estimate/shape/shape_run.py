@@ -178,20 +178,28 @@ def resolve_law(options: ShapeOptions, inputs: ShapeInput) -> ScatteringLaw:
 def _refine_fine(
     model: ConvexModel, coarse: ConvexModel, sol: ConvexSolution, free_pole: bool = True
 ) -> ConvexSolution:
-    """Refit ``sol`` on the fine facets, each starting from its nearest coarse facet's area
-    divided by the number of fine facets per coarse one."""
+    """Refit ``sol`` on the fine facets from its pole and period, twice: the areas starting
+    from its nearest coarse facet's area (divided by the number of fine facets per coarse
+    one), and from a sphere; the lower chi-square is kept. The coarse start is blocky (each
+    coarse facet's area on every fine facet around it), and on DAMIT's example data (43
+    Ariadne) the sphere start ended lower in fewer steps (3182 against 3193 after 150 steps),
+    as Kaasalainen, Torppa & Muinonen 2001 (sec. 2.3) found the sphere start as good as any."""
     nearest = np.argmax(model.normals @ coarse.normals.T, axis=1)
     ratio = len(model.normals) / len(coarse.normals)
-    g = sol.theta[N_ROTATION:][nearest] - np.log(ratio)
-    return fit_convex(
-        model,
-        sol.lambda_deg,
-        sol.beta_deg,
-        sol.period_h,
-        log_areas=g,
-        free_pole=free_pole,
-        max_iterations=REFINE_ITERATIONS,
-    )
+    starts = (sol.theta[N_ROTATION:][nearest] - np.log(ratio), None)
+    fits = [
+        fit_convex(
+            model,
+            sol.lambda_deg,
+            sol.beta_deg,
+            sol.period_h,
+            log_areas=g,
+            free_pole=free_pole,
+            max_iterations=REFINE_ITERATIONS,
+        )
+        for g in starts
+    ]
+    return min(fits, key=lambda f: f.chi2)
 
 
 def _mirror(
@@ -200,14 +208,18 @@ def _mirror(
     """The solution at the mirror pole ``(lambda + 180, beta)`` of ``best`` and whether it
     is a minimum: a refined minimum near it (:func:`.pole_search.nearest_solution`), else a
     fit from it (areas and period first, the pole held, then everything free); when that
-    fit leaves the mirror pole for another minimum, the fit with the pole held there."""
+    fit leaves the mirror pole for another minimum, or ends in the best's own (for a pole
+    near the ecliptic pole the mirror is close to it), the fit with the pole held there."""
     lam, bet = best.lambda_deg + 180.0, best.beta_deg
     found = nearest_solution(others, lam, bet)
     if found is not None:
         return found, True
     held = fit_convex(coarse, lam, bet, best.period_h, free_pole=False)
     free = _refine_fine(fine, coarse, held)
-    if pole_distance_deg(free, lam, bet) < DISTINCT_DEG:
+    if (
+        pole_distance_deg(free, lam, bet) < DISTINCT_DEG
+        and pole_distance_deg(free, best.lambda_deg, best.beta_deg) >= DISTINCT_DEG
+    ):
         return free, True
     return _refine_fine(fine, coarse, held, free_pole=False), False
 
