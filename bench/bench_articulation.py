@@ -16,8 +16,8 @@ import numpy as np
 
 import speclight
 from speclight.render.articulated import pose_groups
-from speclight.simulate.geometry_stage import scenario_geometry
-from speclight.simulate.reflection import build_joints, build_target, render_reflection
+from speclight.simulation.geometry_stage import scenario_geometry
+from speclight.simulation.reflection import build_joints, build_target, render_reflection
 
 BASE = {
     "time.start": "2024-03-20T23:56:00Z",

@@ -13,13 +13,16 @@ from pathlib import Path
 
 import numpy as np
 
-from speclight.estimate.period_io import SECONDS_PER_BAND_FREQUENCY, SECONDS_PER_TERM
-from speclight.estimate.periodogram import BandSeries, multiband_power
-from speclight.estimate.spin_axis import grid_terms, radec_grid
-from speclight.estimate.spin_axis_limits import SECONDS_PER_CELL_GEOMETRY, SECONDS_PER_LOOKUP
-from speclight.estimate.spin_axis_lookup import EpochGeometry, spin_frame_map
-from speclight.render.map_geometry import healpix_directions
-from speclight.render.map_lookup import MapHeader, ReflectivityMap
+from speclight.estimate.period.period_run import SECONDS_PER_BAND_FREQUENCY, SECONDS_PER_TERM
+from speclight.estimate.period.periodogram import BandSeries, multiband_power
+from speclight.estimate.spin_axis.spin_axis_core import grid_terms, radec_grid
+from speclight.estimate.spin_axis.spin_axis_limits import (
+    SECONDS_PER_CELL_GEOMETRY,
+    SECONDS_PER_LOOKUP,
+)
+from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, spin_frame_map
+from speclight.maps.map_geometry import healpix_directions
+from speclight.maps.map_lookup import MapHeader, ReflectivityMap
 
 
 def periodogram() -> None:

@@ -21,7 +21,7 @@ import numpy as np
 
 from speclight.estimate import FitResult, MeasuredLightCurve, fit_scenario
 from speclight.scenario import LoadedScenario, example_text, load_example, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 CUBE = Path(__file__).parent.parent / "tests" / "estimate" / "data" / "spinning_cube.yaml"
 COLUMNS = ["R", "G", "B", "SPAD-950", "SPAD-650", "SPAD-420"]  # Table 2's order

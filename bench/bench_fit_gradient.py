@@ -39,7 +39,7 @@ import numpy as np
 
 from speclight.estimate import MeasuredLightCurve, fit_scenario
 from speclight.scenario import parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 CUBE = Path(__file__).parent.parent / "tests" / "estimate" / "data" / "spinning_cube.yaml"
 ONE = '"*": {bsdf: beckmann, roughness: 0.12, reflectance: 0.6}'
@@ -90,7 +90,7 @@ def run(truth: list[float], start: list[float], method: str, lc: MeasuredLightCu
 
 def _time_pass(loaded: object, rough: list[str], alpha: list[float]) -> tuple[float, float, Any]:
     """Seconds of one simulation on a fixed geometry and of one render pass (warm)."""
-    from speclight.estimate.roughness_gradient import RoughnessRates
+    from speclight.estimate.fitting.roughness_gradient import RoughnessRates
 
     first = simulate(loaded)  # type: ignore[arg-type]
     use = np.ones(first.geometry.t_s.size, bool)

@@ -11,7 +11,7 @@ import time
 import yaml
 
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate.geometry_stage import scenario_geometry
+from speclight.simulation.geometry_stage import scenario_geometry
 
 ATTITUDES = {
     "spin": {

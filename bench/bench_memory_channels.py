@@ -5,7 +5,7 @@ up-front estimate, with and without its channel weights.
 
 The box-wing example's 10-minute window at ``STEP_S`` (0.06 s: 9,984 epochs); prints the
 process's peak RSS (``ru_maxrss``) after the dataset is serialised and the estimate of
-``speclight.simulate.memory``. One run per fresh process (BENCHMARKS.md, Memory).
+``speclight.simulation.memory``. One run per fresh process (BENCHMARKS.md, Memory).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import yaml
 
 from speclight.io.netcdf import dataset_bytes
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import memory, simulate
+from speclight.simulation import memory, simulate
 
 MIB = 1024**2
 

@@ -15,7 +15,7 @@ import yaml
 
 from speclight.io.netcdf import dataset_bytes
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 WINDOW_S = 259_200.0  # three days
 

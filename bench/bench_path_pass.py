@@ -36,8 +36,8 @@ from speclight.render import render_intensity
 from speclight.render.path_scene import build_scene, set_epoch
 from speclight.render.session import RenderSession
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate.geometry_stage import scenario_geometry
-from speclight.simulate.reflection import build_target
+from speclight.simulation.geometry_stage import scenario_geometry
+from speclight.simulation.reflection import build_target
 from speclight.target import Material, Reflectance, Target
 from speclight.wavelength_grid import grid_bin_bounds_nm
 

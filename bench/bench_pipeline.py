@@ -15,7 +15,7 @@ import time
 import yaml
 
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 
 def _run(text: str) -> float:

@@ -27,14 +27,14 @@ from speclight.illumination import solar_irradiance_W_m2_nm
 from speclight.render import render_intensity
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
-from speclight.simulate.geometry_stage import scenario_geometry
-from speclight.simulate.radiometry import (
+from speclight.simulation.geometry_stage import scenario_geometry
+from speclight.simulation.radiometry import (
     atmosphere_transmission,
     instrument_response,
     wavelength_grid_nm,
 )
-from speclight.simulate.ranging_stage import laser_ranging, prepare_ranging
-from speclight.simulate.reflection import build_target
+from speclight.simulation.ranging_stage import laser_ranging, prepare_ranging
+from speclight.simulation.reflection import build_target
 
 SLR = {"latitude_deg": 48.7822, "longitude_deg": 9.1967, "altitude_m": 355.0}
 
@@ -57,7 +57,7 @@ def scenario(n_epochs: int, bistatic: bool) -> Any:
 
 
 def sun_render(loaded: Any, geo: Any, wl: np.ndarray, on_hits: Any = None) -> Any:
-    """The render call of ``simulate.reflection.render_reflection`` (sunlit epochs)."""
+    """The render call of ``simulation.reflection.render_reflection`` (sunlit epochs)."""
     sc = loaded.scenario
     idx = np.flatnonzero(geo.observable & (geo.sunlit_fraction > 0))
     solar = solar_irradiance_W_m2_nm(wl, geo.sun_distance_m / AU_M)

@@ -46,16 +46,16 @@ from pathlib import Path
 
 import numpy as np
 
-from speclight.estimate.reflectivity_map import reflectivity_map
 from speclight.illumination import solar_irradiance_W_m2_nm
+from speclight.maps.map_geometry import sun_observer
+from speclight.maps.map_lookup import load_map
+from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.render import render_intensity
-from speclight.render.map_geometry import sun_observer
-from speclight.render.map_lookup import load_map
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
-from speclight.simulate.radiometry import wavelength_grid_nm
-from speclight.simulate.ranging_stage import prepare_ranging
-from speclight.simulate.reflection import build_target
+from speclight.simulation import simulate
+from speclight.simulation.radiometry import wavelength_grid_nm
+from speclight.simulation.ranging_stage import prepare_ranging
+from speclight.simulation.reflection import build_target
 
 
 def _scenario(

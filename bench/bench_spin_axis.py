@@ -33,15 +33,15 @@ import tempfile
 import time
 from pathlib import Path
 
-from speclight.estimate.reflectivity_map import reflectivity_map
-from speclight.estimate.spin_axis import grid_errors, radec_grid, spin_axis_search
-from speclight.estimate.spin_axis_io import inertial_epochs, spin_axis_measured
-from speclight.estimate.spin_axis_lookup import load_band_map, spin_frame_map
-from speclight.estimate.unmix_inputs import read_reflectance_factors
+from speclight.estimate.inputs.reflectance_factors import read_reflectance_factors
+from speclight.estimate.spin_axis.spin_axis_core import grid_errors, radec_grid, spin_axis_search
+from speclight.estimate.spin_axis.spin_axis_lookup import load_band_map, spin_frame_map
+from speclight.estimate.spin_axis.spin_axis_run import inertial_epochs, spin_axis_measured
 from speclight.io.netcdf import dataset_bytes
+from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.scenario import example_text, load_scenario
-from speclight.simulate import simulate
-from speclight.simulate.geometry_stage import scenario_geometry
+from speclight.simulation import simulate
+from speclight.simulation.geometry_stage import scenario_geometry
 
 
 def _text(px: int, render: str | None = None, example: str = "box-wing") -> str:

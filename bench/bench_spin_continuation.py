@@ -4,8 +4,9 @@ Run: ``.venv/bin/python bench/bench_spin_continuation.py [--case rendered|map]
 [--variants NAME,...]``
 
 The problem, the optimum, the starts (same seed, same draws) and the success criterion of
-``bench/bench_spin_refine.py``. Variants (:mod:`speclight.estimate.spin_axis_continuation`,
-:func:`speclight.estimate.spin_axis_refine.refine_staged`): the ``--refine`` methods by
+``bench/bench_spin_refine.py``. Variants
+(:mod:`speclight.estimate.spin_axis.spin_axis_continuation`,
+:func:`speclight.estimate.spin_axis.spin_axis_refine.refine_staged`): the ``--refine`` methods by
 their names (``gradient``, ``slsqp``, ``gradient-continuation``: here, an nside-8 map,
 the same as ``map:2x8/4x8``); ``map:S1/S2/...``: L-BFGS-B on the map degraded to each
 stage in turn, each stage ``NSIDExROLLS``, then on the real map; ``time:S1/S2``: the light
@@ -31,9 +32,9 @@ from pathlib import Path
 
 import numpy as np
 
-from speclight.estimate.spin_axis import angular_distance_deg
-from speclight.estimate.spin_axis_continuation import Stage
-from speclight.estimate.spin_axis_refine import (
+from speclight.estimate.spin_axis.spin_axis_continuation import Stage
+from speclight.estimate.spin_axis.spin_axis_core import angular_distance_deg
+from speclight.estimate.spin_axis.spin_axis_refine import (
     REFINE_METHODS,
     Refined,
     refine_candidate,

@@ -46,17 +46,17 @@ from pathlib import Path
 
 import numpy as np
 
-from speclight.estimate.reflectivity_map import reflectivity_map
-from speclight.estimate.spin_axis import angular_distance_deg, spin_axis_search
-from speclight.estimate.spin_axis_gradient import SpinMisfit
-from speclight.estimate.spin_axis_io import inertial_epochs
-from speclight.estimate.spin_axis_lookup import load_band_map, spin_frame_map
-from speclight.estimate.spin_axis_refine import REFINE_METHODS, refine_candidate
-from speclight.estimate.unmix_inputs import read_reflectance_factors
+from speclight.estimate.inputs.reflectance_factors import read_reflectance_factors
+from speclight.estimate.spin_axis.spin_axis_core import angular_distance_deg, spin_axis_search
+from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
+from speclight.estimate.spin_axis.spin_axis_lookup import load_band_map, spin_frame_map
+from speclight.estimate.spin_axis.spin_axis_refine import REFINE_METHODS, refine_candidate
+from speclight.estimate.spin_axis.spin_axis_run import inertial_epochs
 from speclight.io.netcdf import dataset_bytes
+from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.scenario import example_text, load_scenario
-from speclight.simulate import simulate
-from speclight.simulate.geometry_stage import scenario_geometry
+from speclight.simulation import simulate
+from speclight.simulation.geometry_stage import scenario_geometry
 
 TRUTH = (30.0, 45.0, 0.0)
 BOUND = 0.05

@@ -1,8 +1,8 @@
 """Unmixing benchmark: run ``python bench/bench_unmix.py [--epochs N]`` and read the printout.
 
 Synthetic mixtures of 4 random endmember signatures over 10 bands with Gaussian noise
-(10,000 epochs by default): the time of :func:`speclight.estimate.unmixing.unmix` for every
-method and of :func:`speclight.estimate.endmembers.extract_endmembers` for every method
+(10,000 epochs by default): the time of :func:`speclight.estimate.spectra.unmixing.unmix` for every
+method and of :func:`speclight.estimate.spectra.endmembers.extract_endmembers` for every method
 (best of three runs each). The issue's target: every unmixing method under 1 s.
 """
 
@@ -17,8 +17,8 @@ from functools import partial
 
 import numpy as np
 
-from speclight.estimate.endmembers import extract_endmembers
-from speclight.estimate.unmixing import unmix
+from speclight.estimate.spectra.endmembers import extract_endmembers
+from speclight.estimate.spectra.unmixing import unmix
 
 TARGET_S = 1.0
 

@@ -124,7 +124,8 @@ def main() -> None:
             ),
             (
                 "python + import of what unmix imports",
-                "import speclight.cli, speclight.estimate.unmix_io, speclight.io.netcdf, h5netcdf",
+                "import speclight.cli, speclight.estimate.spectra.unmix_run, speclight.io.netcdf, "
+                "h5netcdf",
             ),
         ):
             t_import = best_of(

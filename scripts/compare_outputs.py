@@ -67,7 +67,7 @@ def _set(tree: dict[str, Any], dotted: str, value: Any) -> None:
 def run(out: Path) -> None:
     from speclight.scenario.builtin_examples import example_text
     from speclight.scenario.load import parse_scenario
-    from speclight.simulate import simulate
+    from speclight.simulation import simulate
 
     out.mkdir(parents=True, exist_ok=True)
     only = set(sys.argv[3:])

@@ -42,9 +42,9 @@ from speclight.estimate import (
     read_reflectance_factors,
     true_contributions,
 )
-from speclight.estimate.ground_truth import matched_angles_deg, unmix_accuracy
+from speclight.estimate.spectra.ground_truth import matched_angles_deg, unmix_accuracy
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 from speclight.target.material_tables import MATERIAL_TABLES, material_table_path
 
 NAMES = list(MATERIAL_TABLES)  # aluminium, kapton_mli, solar_cell, white_paint

@@ -79,7 +79,16 @@ def page() -> str:
         lines.append(f"| `{name}` | {dims or '(scalar)'} | {info.units} | {meaning} |")
     for name, dims in schema.BOUNDS.items():
         lines.append(f"| `{name}` | {', '.join(dims)} | (its coordinate's) | cell bounds |")
-    lines += ["", "## `flags` bits", "", "| bit | meaning |", "|---|---|"]
+    dtype = schema.np.dtype(schema.FLAG_DTYPE).name
+    lines += [
+        "",
+        "## `flags` bits",
+        "",
+        f"`flags` is {dtype}.",
+        "",
+        "| bit | meaning |",
+        "|---|---|",
+    ]
     for bit, meaning in schema.FLAG_MEANINGS.items():
         lines.append(f"| {bit} | `{meaning}` |")
     return "\n".join(lines) + "\n"

@@ -29,5 +29,10 @@ if [[ ! -f $stamp || "$(cat "$stamp")" != "$want" ]]; then
     echo "setup: installing speclight[$extras] into .venv (first time takes a few minutes)" >&2
     .venv/bin/python -m pip install -q --disable-pip-version-check --upgrade pip >/dev/null
     .venv/bin/python -m pip install -q --disable-pip-version-check -e ".[$extras]"
+    if [[ $extras == *dev* ]]; then
+        # lumos-sat, a test oracle only (tests/target/test_brdf_forms_lumos.py): its pins
+        # (numpy~=1.24, astropy~=5.2) conflict with ours; the BRDF functions used need numpy only
+        .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps "lumos-sat==1.0.9"
+    fi
     echo "$want" >"$stamp"
 fi

@@ -25,7 +25,7 @@ from speclight.scenario import LoadedScenario, example_names, load_scenario, par
 from speclight.scenario.overrides import with_overrides
 
 if TYPE_CHECKING:
-    from speclight.simulate.pipeline import SimulationResult
+    from speclight.simulation.pipeline import SimulationResult
 
 ScenarioLike = LoadedScenario | str | os.PathLike[str] | Mapping[str, Any]
 
@@ -112,7 +112,7 @@ def simulate(
         attribute is the scenario that ran), ``.notes`` (what a user should read, e.g.
         epochs below the horizon) and ``.geometry``.
     """
-    from speclight.simulate.pipeline import simulate as run
+    from speclight.simulation.pipeline import simulate as run
 
     loaded = load(scenario)
     if overrides:

@@ -16,6 +16,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 T, TW, TB, TXYZ = ("time",), ("time", "wavelength"), ("time", "band"), ("time", "xyz")
 TL = ("time", "laser")
 IMG = ("image_time", "y", "x")
@@ -89,6 +91,16 @@ VARIABLES: dict[str, VariableInfo] = {
         ("time", "wxyz"), "1", "body-to-GCRS rotation quaternion, scalar first (w, x, y, z)"
     ),
     "flags": V(T, "1", "why an epoch is not fully observable (bit mask)"),
+    "outside_support_fraction": V(
+        T,
+        "1",
+        "fraction of the reflected sunlight from outside measured BRDF tables' support",
+        comment="light that lab-table materials reflect where their table has no samples, "
+        "from the analytic model fitted to the table (target.materials.*.extension; "
+        "docs/brdf-models.md), over all the sunlight the target reflects (Earthshine not "
+        "counted), integrated over the wavelength grid; 0 without lab tables and in path "
+        "mode; flag bit outside_measured_support above 0.5",
+    ),
     # where to point (speclight.orbit.sky_position)
     "sun_elevation_site": V(
         T,
@@ -362,7 +374,8 @@ COORDINATES: dict[str, dict[str, str]] = {
 #: CF boundary variables (no attributes of their own: they take their coordinate's units).
 BOUNDS: dict[str, tuple[str, ...]] = {"range_bin_bounds": ("range_bin", "nv")}
 
-# Bits of the ``flags`` variable (CF flag_masks / flag_meanings).
+# Bits of the ``flags`` variable (CF flag_masks / flag_meanings), of type FLAG_DTYPE.
+FLAG_DTYPE = np.uint16
 FLAG_ORBIT_FAILED = 1
 FLAG_BELOW_MIN_ELEVATION = 2
 FLAG_IN_SHADOW = 4
@@ -374,6 +387,10 @@ FLAG_LASER_BELOW_HORIZON = 32
 FLAG_ATTITUDE_UNDEFINED = 64
 #: The Sun is above ``observer.max_sun_elevation_deg`` at the site: no dark sky.
 FLAG_DAYLIGHT = 128
+#: More than :data:`OUTSIDE_SUPPORT_FLAG_FRACTION` of the reflected sunlight came from
+#: outside measured BRDF tables' support (``outside_support_fraction``).
+FLAG_OUTSIDE_SUPPORT = 256
+OUTSIDE_SUPPORT_FLAG_FRACTION = 0.5
 
 FLAG_MEANINGS = {
     FLAG_ORBIT_FAILED: "orbit_failed",
@@ -384,6 +401,7 @@ FLAG_MEANINGS = {
     FLAG_LASER_BELOW_HORIZON: "laser_below_horizon",
     FLAG_ATTITUDE_UNDEFINED: "attitude_undefined",
     FLAG_DAYLIGHT: "daylight",
+    FLAG_OUTSIDE_SUPPORT: "outside_measured_support",
 }
 #: Epochs with any of these bits have no measurement of the Sun's reflection.
 NOT_OBSERVABLE = (
@@ -394,6 +412,15 @@ NOT_OBSERVABLE = (
     | FLAG_ATTITUDE_UNDEFINED
     | FLAG_DAYLIGHT
 )
+
+
+def flag_attributes() -> dict[str, Any]:
+    """CF ``flag_masks`` and ``flag_meanings`` of the ``flags`` variable."""
+    masks = np.array(sorted(FLAG_MEANINGS), dtype=FLAG_DTYPE)
+    return {
+        "flag_masks": masks,
+        "flag_meanings": " ".join(FLAG_MEANINGS[int(m)] for m in masks),
+    }
 
 
 def attrs(name: str) -> dict[str, str]:

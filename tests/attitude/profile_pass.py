@@ -9,7 +9,7 @@ from skyfield.api import EarthSatellite
 from speclight.orbit import load_timescale, time_from_utc
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
-from speclight.simulate.geometry_stage import Geometry, scenario_geometry
+from speclight.simulation.geometry_stage import Geometry, scenario_geometry
 
 #: The box-wing example's pass (Calsphere 2's element set over Stuttgart), every 30 s.
 PASS_TIME = {"start": "2019-08-30T02:20:00Z", "stop": "2019-08-30T02:29:00Z", "step_s": 30.0}

@@ -22,7 +22,7 @@ from speclight.orbit import load_ephemeris
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
 from speclight.schema import FLAG_ATTITUDE_UNDEFINED, NOT_OBSERVABLE
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 RES_PX = 256
 

@@ -20,7 +20,7 @@ from speclight.attitude.quaternion_table import read_attitude_table, slerp_table
 from speclight.errors import InputError
 from speclight.scenario import parse_scenario
 from speclight.schema import FLAG_ATTITUDE_UNDEFINED
-from speclight.simulate.geometry_stage import scenario_geometry
+from speclight.simulation.geometry_stage import scenario_geometry
 
 #: Round-off of unit quaternions through a few trigonometric products.
 ROUNDOFF = 1e-13

@@ -14,7 +14,7 @@ from speclight.attitude import quat_to_matrix, spin_attitude, unit_vector_from_r
 from speclight.errors import InputError
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
-from speclight.simulate.geometry_stage import attitude_quaternions
+from speclight.simulation.geometry_stage import attitude_quaternions
 
 #: Round-off on O(1) direction cosines.
 ROUNDOFF = 1e-13

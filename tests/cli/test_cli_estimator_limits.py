@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from speclight.cli import _flag_names, app
+from speclight.cli import app
+from speclight.cli.flags import flag_names as _flag_names
 from speclight.errors import InputError
 from speclight.scenario import example_text
 

@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 from speclight.cli import app
 from speclight.io.netcdf import write_dataset
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 runner = CliRunner()
 SPEC_KEYS = {"bands", "roughness", "rms_percent_of_mean", "rms_percent_of_total", "n_epochs",

@@ -17,9 +17,9 @@ import yaml
 from typer.testing import CliRunner
 
 from speclight.cli import app
-from speclight.io.pass_table import COLUMNS, utc_text
 from speclight.scenario import example_text, load_example
-from speclight.simulate.pass_search import scenario_passes
+from speclight.simulation.pass_search import scenario_passes
+from speclight.simulation.pass_table import COLUMNS, utc_text
 
 runner = CliRunner()
 WINDOW = ["--start", "2020-02-29T18:00:00Z", "--end", "2020-03-01T12:00:00Z"]

@@ -89,7 +89,7 @@ def test_bad_input_is_one_line_and_exit_2(tmp_path: Path, case: str) -> None:
         "nside": "--nside = 12 must be a power of 2",
         "csv": "give --scenario",
         "no-direction": "no phase_vector_body",
-        "source": "unknown source 'moon'",
+        "source": "--source = 'moon'",
         "exists": "exists",
         "band": "unknown band 'X'",
         "nan-direction": "the map would be empty: measured 2020-",

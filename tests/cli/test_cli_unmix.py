@@ -210,7 +210,7 @@ def test_csv_rates_with_scenario_give_the_grey_factor_in_every_band(
     # its simulated rates, written as a MEASURED CSV, must come back as one factor per epoch
     # equal in all bands and equal to simulate's own reflectance_factor.
     from speclight.scenario import load_scenario
-    from speclight.simulate import simulate
+    from speclight.simulation import simulate
 
     data = yaml.safe_load(example_text("calsphere"))
     data["time"] = {"start": "2020-02-29T21:17:00Z", "stop": "2020-02-29T21:17:20Z", "step_s": 5.0}

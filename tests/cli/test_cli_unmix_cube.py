@@ -27,8 +27,15 @@ from typer.testing import CliRunner
 
 from speclight.cli import app
 from speclight.estimate import spectral_angle_rad
-from speclight.estimate.ground_truth import fractions, material_signatures, true_contributions
-from speclight.estimate.source_spectrum import coaxial_laser_source_W_m2_nm, laser_lines_per_nm
+from speclight.estimate.inputs.source_spectrum import (
+    coaxial_laser_source_W_m2_nm,
+    laser_lines_per_nm,
+)
+from speclight.estimate.spectra.ground_truth import (
+    fractions,
+    material_signatures,
+    true_contributions,
+)
 from speclight.scenario import example_text, parse_scenario
 from speclight.target import Reflectance
 from speclight.target.material_tables import MATERIAL_TABLES, material_table_path
@@ -153,7 +160,7 @@ def test_extracted_laser_signatures_against_the_truth(tmp_path: Path, simulated:
     [
         ("cube-materials-laser", "sun", "NaN at every epoch (no Sun light); try --source laser"),
         ("cube-materials", "laser", "has no laser_reflectance_factor(time, band)"),
-        ("cube-materials", "lazer", "unknown source 'lazer' (choices: sun, laser)"),
+        ("cube-materials", "lazer", "--source = 'lazer': unknown source (choices: sun, laser)"),
     ],
 )
 def test_a_source_the_data_lack_is_refused(

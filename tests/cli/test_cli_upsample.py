@@ -24,7 +24,8 @@ from speclight.scenario import example_text
 
 runner = CliRunner()
 OPTICS = 0.8
-#: What upsampling promises to reproduce (speclight.estimate.upsampling.ALBEDO_CLIP is 1e-4).
+#: What upsampling promises to reproduce
+#: (speclight.estimate.spectra.upsampling.ALBEDO_CLIP is 1e-4).
 ALBEDO_TOLERANCE = 1e-3
 BANDS = [f"G-{c:g}/{SIGMA_NM:g}" for c in CENTRES_NM]
 

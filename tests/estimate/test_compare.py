@@ -14,12 +14,12 @@ from skyfield.api import EarthSatellite, wgs84
 from speclite.filters import load_filter
 
 from speclight.errors import InputError
-from speclight.estimate.compare import compare
-from speclight.estimate.observations import read_observations
+from speclight.estimate.comparison.compare_run import compare
+from speclight.estimate.inputs.observations import read_observations
 from speclight.illumination.solar import solar_table
 from speclight.orbit.timescale import load_ephemeris, load_timescale
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 STUTTGART = (48.7822, 9.1967, 355.0)
 ZIMMERWALD = (46.8772, 7.4652, 951.0)  # ILRS station 7810 (a second site ~250 km away)
@@ -294,10 +294,10 @@ def test_observed_positions_give_a_nadir_attitude_its_velocity(tmp_path) -> None
 
 def test_too_many_sites_to_finish_in_a_day_are_refused(tmp_path, monkeypatch) -> None:
     # one simulation per site: with 50 000 s per site (in place of the 1 s lower bound),
-    # two sites are 27.8 h, over the one-day limit of estimate/limits.py
+    # two sites are 27.8 h, over the one-day limit of estimate/inputs/cost_limits.py
     import importlib
 
-    module = importlib.import_module("speclight.estimate.compare")
+    module = importlib.import_module("speclight.estimate.comparison.compare_run")
     monkeypatch.setattr(module, "SECONDS_PER_SITE", 50_000.0)
     loaded = parse_scenario(_scenario(tmp_path).read_text())
     rows = [f"{EPOCHS[0]}Z,10.0,0.05,G-600/40,{lat},{lon},{alt}"

@@ -1,4 +1,4 @@
-"""Confusion matrix, errors, spectral angle, reference units (speclight.estimate.accuracy).
+"""Confusion matrix, errors, spectral angle, reference units (speclight.estimate.spectra.accuracy).
 
 References: hand-worked cases (the numbers are derived in the comments), and the spectral
 angle's definition (Kruse et al. 1993, doi:10.1016/0034-4257(93)90013-N).
@@ -18,8 +18,8 @@ from speclight.estimate import (
     spectral_angle_rad,
     true_contributions,
 )
-from speclight.estimate.accuracy import match_by_angle, merge_columns
-from speclight.estimate.ground_truth import matched_angles_deg
+from speclight.estimate.spectra.accuracy import match_by_angle, merge_columns
+from speclight.estimate.spectra.ground_truth import matched_angles_deg
 
 ROUNDING = 1e-12
 

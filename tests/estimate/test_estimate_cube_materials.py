@@ -6,7 +6,7 @@ and no plastic coat, whose coat does not scale with a reflectance), and a single
 has no interreflections, so each material's share of the band reflectance factor is exactly
 ``F_k(t, j) = g_k(t) s_kj(t)``, with the band signature ``s_kj(t)`` the band average of its
 reflectance weighted by the detected photons of the source at epoch t (the Sun or the laser
-lines, times the atmosphere; :mod:`speclight.estimate.ground_truth`). Hence:
+lines, times the atmosphere; :mod:`speclight.estimate.spectra.ground_truth`). Hence:
 
 1. the shares are the per-epoch signatures times one number each, to rounding;
 2. unmixing each epoch with its own signatures recovers the true fractions to rounding
@@ -26,12 +26,16 @@ import pytest
 import yaml
 
 from speclight.estimate import confusion_matrix, unmix
-from speclight.estimate.ground_truth import fractions, material_signatures, true_contributions
-from speclight.estimate.source_spectrum import mean_source_W_m2_nm
+from speclight.estimate.inputs.source_spectrum import mean_source_W_m2_nm
+from speclight.estimate.spectra.ground_truth import (
+    fractions,
+    material_signatures,
+    true_contributions,
+)
 from speclight.illumination.laser import gaussian_line_per_nm
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
-from speclight.simulate.ranging_stage import SUPPORT_THRESHOLD
+from speclight.simulation import simulate
+from speclight.simulation.ranging_stage import SUPPORT_THRESHOLD
 from speclight.target import Reflectance
 from speclight.target.material_tables import MATERIAL_TABLES, material_table_path
 
@@ -64,7 +68,7 @@ def _case(name: str):
                 for la in loaded.scenario.illumination.lasers
             ]
         )
-        # the pipeline keeps each line on its support (simulate/ranging_stage.py)
+        # the pipeline keeps each line on its support (simulation/ranging_stage.py)
         lines = np.where(lines > SUPPORT_THRESHOLD * lines.max(axis=1, keepdims=True), lines, 0)
         # lasers at the observer's site: the uplink has the downlink's transmission T, so
         # each line at the target is beam x shape x T with laser_irradiance its sum over

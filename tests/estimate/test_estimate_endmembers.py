@@ -1,4 +1,4 @@
-"""Endmember extraction (``speclight.estimate.endmembers``) against independent references.
+"""Endmember extraction (``speclight.estimate.spectra.endmembers``) against independent references.
 
 * ATGP: a hand-made data set whose projection sequence is worked out on paper, and the
   published algorithm (Ren & Chang 2003, doi:10.1109/TAES.2003.1261119, eq. for the
@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from speclight.errors import InputError
-from speclight.estimate.endmembers import extract_endmembers
+from speclight.estimate.spectra.endmembers import extract_endmembers
 
 #: Round-off allowance for exact cases [m2 sr-1].
 EXACT = 1e-12

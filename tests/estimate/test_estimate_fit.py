@@ -9,8 +9,8 @@ known parameters of simulated noisy data.
 import numpy as np
 import pytest
 
-from speclight.estimate.fit import fit_scales, shot_noise_sigma
-from speclight.estimate.roughness_fit import fit_roughness
+from speclight.estimate.fitting.fit import fit_scales, shot_noise_sigma
+from speclight.estimate.fitting.roughness_fit import fit_roughness
 
 
 def test_scales_match_a_hand_worked_weighted_least_squares_case():

@@ -15,10 +15,10 @@ import yaml
 
 from speclight.errors import InputError
 from speclight.estimate import fit_scenario, read_measured
-from speclight.estimate.measured import MeasuredLightCurve
+from speclight.estimate.inputs.measured import MeasuredLightCurve
 from speclight.io.netcdf import write_dataset
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 DATA = Path(__file__).parent / "data"
 
@@ -49,7 +49,7 @@ def test_lambertian_sphere_albedo_073_is_recovered_in_every_band_from_04(tmp_pat
     assert np.all(error < 4 * fit.albedo_std), (fit.albedo, fit.albedo_std)
     assert np.all(fit.albedo_std < 0.005)  # 7 bands x 200 bright epochs pin it tightly
     # binned to 10 s: every bin that holds a used epoch (model and measurements averaged
-    # over the same epochs, estimate/fit_bins.py), a partial one at each end of the stretch
+    # over the same epochs, estimate/fitting/fit_bins.py), a partial one at each end of the stretch
     binned = fit_scenario(parse_scenario(_calsphere(0.4), source="start"), measured, bin_s=10.0)
     assert binned.converged, binned.message
     assert 15 <= binned.n_epochs <= fit.n_epochs // 10 + 2

@@ -1,11 +1,15 @@
-"""Small helpers of speclight.estimate.ground_truth on hand-worked cases (the confusion
+"""Small helpers of speclight.estimate.spectra.ground_truth on hand-worked cases (the confusion
 matrix and spectral-angle cases are in test_estimate_accuracy.py)."""
 
 import numpy as np
 import pytest
 
 from speclight.errors import InputError
-from speclight.estimate.ground_truth import fractions, material_signatures, true_contributions
+from speclight.estimate.spectra.ground_truth import (
+    fractions,
+    material_signatures,
+    true_contributions,
+)
 
 
 def test_signatures_of_a_grey_and_a_step_spectrum():

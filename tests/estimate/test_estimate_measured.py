@@ -10,10 +10,10 @@ import xarray as xr
 import yaml
 
 from speclight.errors import InputError
-from speclight.estimate.measured import bin_light_curve, measured_from_dataset, read_measured
+from speclight.estimate.inputs.measured import bin_light_curve, measured_from_dataset, read_measured
 from speclight.io.netcdf import write_dataset
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 CSV = """# a camera and a SPAD
 time,B,R,R_sigma
@@ -147,7 +147,7 @@ def test_binning_averages_rates_and_combines_sigmas(tmp_path):
         ["2020-01-01T00:00:01", "2020-01-01T00:00:03", "2020-01-01T00:00:04.5"], "datetime64[ns]"
     )
     np.testing.assert_array_equal(binned.time_utc, expected)
-    with pytest.raises(InputError, match="--bin-s"):
+    with pytest.raises(InputError, match="bin_s = "):  # the Python parameter, not the flag
         bin_light_curve(lc, 0.0)
 
 

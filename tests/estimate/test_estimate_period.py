@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from speclight.estimate.period_decision import rotation_period
-from speclight.estimate.period_fap import bootstrap_maxima
-from speclight.estimate.periodogram import (
+from speclight.estimate.period.period_decision import rotation_period
+from speclight.estimate.period.period_fap import bootstrap_maxima
+from speclight.estimate.period.periodogram import (
     BandSeries,
     frequency_grid,
     harmonic_chi2,
@@ -16,7 +16,7 @@ from speclight.estimate.periodogram import (
     multiband_power,
     refine_peak,
 )
-from speclight.estimate.synodic import sidereal_period
+from speclight.estimate.period.synodic import sidereal_period
 
 
 def _series(t_s, values, sigma):

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 from speclight.errors import InputError
-from speclight.estimate.period_io import estimate_period
+from speclight.estimate.period.period_run import estimate_period
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
-from speclight.simulate.pipeline import simulate
+from speclight.simulation.pipeline import simulate
 
 TRUE_PERIOD_S = 120.0
 
@@ -48,9 +48,9 @@ def test_laser_source_needs_laser_returns(tmp_path):
     csv = tmp_path / "lc.csv"
     t = np.datetime64("2020-01-01T00:00:00") + np.arange(30) * np.timedelta64(1, "s")
     csv.write_text("time,B\n" + "".join(f"{x}Z,{10 + k % 3}\n" for k, x in enumerate(t)))
-    with pytest.raises(InputError, match="--source laser reads the laser return rates"):
+    with pytest.raises(InputError, match="source='laser' reads the laser return rates"):
         estimate_period(csv, source="laser")
-    with pytest.raises(InputError, match="--source = 'moon'"):
+    with pytest.raises(InputError, match="source = 'moon'"):
         estimate_period(csv, source="moon")
     with pytest.raises(InputError, match="synodic = 'always'"):
         estimate_period(csv, synodic="always")  # type: ignore[arg-type]

@@ -18,13 +18,13 @@ import numpy as np
 import yaml
 from astropy_healpix import xyz_to_healpix
 
-from speclight.estimate.endmember_spectra import endmembers_from_scenario
-from speclight.estimate.ground_truth import fractions
-from speclight.estimate.reflection_map_io import reflection_map_measured
-from speclight.estimate.unmix_inputs import read_reflectance_factors
+from speclight.estimate.inputs.reflectance_factors import read_reflectance_factors
+from speclight.estimate.reflection_maps.reflection_map_run import reflection_map_measured
+from speclight.estimate.spectra.endmember_spectra import endmembers_from_scenario
+from speclight.estimate.spectra.ground_truth import fractions
 from speclight.io.netcdf import dataset_bytes
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 NSIDE = 2  # 48 pixels: several epochs in most, so that the covariance term is not zero
 #: Float64 rounding through the render, band sums and small least-squares systems.

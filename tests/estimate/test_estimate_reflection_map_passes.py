@@ -20,10 +20,10 @@ import pytest
 import yaml
 from astropy_healpix import healpix_to_xyz, xyz_to_healpix
 
-from speclight.estimate.reflection_map_io import reflection_map_measured
+from speclight.estimate.reflection_maps.reflection_map_run import reflection_map_measured
 from speclight.io.netcdf import dataset_bytes
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 #: Pixel quadrature of a 256 px sphere (tests/simulate/test_simulate_reflectance_factor.py).
 SPHERE_RTOL = 5e-3

@@ -1,4 +1,4 @@
-"""Linear unmixing (``speclight.estimate.unmixing``) against references it did not produce.
+"""Linear unmixing (``speclight.estimate.spectra.unmixing``) against references it did not produce.
 
 * hand-worked 2- and 3-band cases solved on paper (orthogonal signatures, the Euclidean
   projection onto the simplex of Duchi et al. 2008, doi:10.1145/1390156.1390191);
@@ -18,8 +18,8 @@ import pytest
 from scipy.optimize import nnls as scipy_nnls
 
 from speclight.errors import InputError
-from speclight.estimate import unmixing as unmix_module
-from speclight.estimate.unmixing import unmix
+from speclight.estimate.spectra import unmixing as unmix_module
+from speclight.estimate.spectra.unmixing import unmix
 
 #: Round-off allowance for exact cases [m2 sr-1 or 1]: a few ulps of O(1) numbers.
 EXACT = 1e-12

@@ -67,5 +67,5 @@ def test_options_are_checked_before_reading(tmp_path: Path) -> None:
         unmix_measured(missing)
     with pytest.raises(InputError, match="unknown extraction 'atgq'; did you mean 'atgp'"):
         unmix_measured(missing, extract="atgq", n=2)
-    with pytest.raises(InputError, match="use it with --extract"):
+    with pytest.raises(InputError, match="use it with `extract`"):
         unmix_measured(missing, endmembers=["x.csv"], n=2)

@@ -24,7 +24,7 @@ import pytest
 from scipy.optimize import linprog
 
 from speclight.errors import InputError
-from speclight.estimate.upsampling import (
+from speclight.estimate.spectra.upsampling import (
     ALBEDO_CLIP,
     band_albedo,
     inverse_sigmoid,

@@ -1,4 +1,5 @@
-"""``fit --bin-s``: measurements and model averaged over the same epochs (estimate/fit_bins.py).
+"""``fit --bin-s``: measurements and model averaged over the same epochs
+(estimate/fitting/fit_bins.py).
 
 References: bin averages worked by hand; the reflectance a spinning cube was simulated with
 (0.6), recovered from bins as long as a quarter turn, where the light curve goes through a
@@ -13,10 +14,10 @@ import pytest
 
 from speclight.errors import InputError
 from speclight.estimate import fit_scenario
-from speclight.estimate.fit_bins import EpochBins
-from speclight.estimate.measured import MeasuredLightCurve
+from speclight.estimate.fitting.fit_bins import EpochBins
+from speclight.estimate.inputs.measured import MeasuredLightCurve
 from speclight.scenario import parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 DATA = Path(__file__).parent / "data"
 T0 = np.datetime64("2020-01-01T00:00:00", "ns")

@@ -21,10 +21,9 @@ import yaml
 
 from speclight.errors import InputError
 from speclight.estimate import fit_scenario
-from speclight.estimate.gradient_fit import fit_roughness_gradient, projected_residuals
-from speclight.estimate.measured import MeasuredLightCurve
-from speclight.estimate.roughness_gradient import RoughnessRates
-from speclight.render.brdf import microfacet_d, microfacet_weight, smith_g1
+from speclight.estimate.fitting.gradient_fit import fit_roughness_gradient, projected_residuals
+from speclight.estimate.fitting.roughness_gradient import RoughnessRates
+from speclight.estimate.inputs.measured import MeasuredLightCurve
 from speclight.render.brdf_gradient import (
     microfacet_d_dalpha,
     microfacet_weight_dalpha,
@@ -32,7 +31,8 @@ from speclight.render.brdf_gradient import (
 )
 from speclight.scenario import example_text, parse_scenario
 from speclight.scenario.overrides import replace_fields
-from speclight.simulate import simulate
+from speclight.simulation import simulate
+from speclight.target.microfacet_terms import microfacet_d, microfacet_weight, smith_g1
 
 DATA = Path(__file__).parent / "data"
 ONE = '"*": {bsdf: beckmann, roughness: 0.12, reflectance: 0.6}'
@@ -205,7 +205,7 @@ def test_gradient_method_refusals_name_the_reason():
     truth = simulate(parse_scenario(_cube(), source="truth")).dataset
     lc = _measured(truth)
     loaded = parse_scenario(_cube(), source="start")
-    with pytest.raises(InputError, match=r"--method = 'newton': give one of slsqp, gradient"):
+    with pytest.raises(InputError, match=r"method = 'newton': give one of slsqp, gradient"):
         fit_scenario(loaded, lc, free=("albedo", "roughness"), method="newton")
     path = replace_fields(loaded, {"render.mode": "path"})
     with pytest.raises(InputError, match="single-scattering render only"):

@@ -22,12 +22,12 @@ import pytest
 import yaml
 
 from speclight.estimate import fit_scenario
-from speclight.estimate.measured import MeasuredLightCurve
-from speclight.estimate.roughness_gradient import RoughnessRates
+from speclight.estimate.fitting.roughness_gradient import RoughnessRates
+from speclight.estimate.inputs.measured import MeasuredLightCurve
 from speclight.render.articulated import pose_groups
 from speclight.scenario import example_text, parse_scenario
 from speclight.scenario.overrides import replace_fields
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 DATA = Path(__file__).parent / "data"
 ARRAY = {"bsdf": "ggx", "roughness": 0.1, "reflectance": 0.3}

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from speclight.errors import InputError
-from speclight.estimate.observations import read_observations
+from speclight.estimate.inputs.observations import read_observations
 
 
 def _file(tmp_path: Path, text: str) -> Path:

@@ -17,8 +17,8 @@ from astropy.timeseries import LombScargle
 
 from speclight.errors import InputError
 from speclight.estimate import estimate_period
-from speclight.estimate.period_io import _nulls_for_nan
-from speclight.estimate.periodogram import BandSeries, multiband_power
+from speclight.estimate.period.period_run import _nulls_for_nan
+from speclight.estimate.period.periodogram import BandSeries, multiband_power
 
 START = np.datetime64("2020-02-29T21:16:00", "s")
 

@@ -11,13 +11,13 @@ from map_scenarios import SPHERE_TARGET, write_scenario
 
 from speclight import instrument
 from speclight.errors import InputError
-from speclight.estimate.reflectivity_map import reflectivity_map
 from speclight.illumination import solar_irradiance_W_m2_nm
+from speclight.maps.map_geometry import sun_observer
+from speclight.maps.map_lookup import load_map, read_header
+from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.render import available_variants
-from speclight.render.map_geometry import sun_observer
-from speclight.render.map_lookup import load_map, read_header
-from speclight.simulate import simulate
-from speclight.simulate.radiometry import instrument_response, wavelength_grid_nm
+from speclight.simulation import simulate
+from speclight.simulation.radiometry import instrument_response, wavelength_grid_nm
 
 RHO, RADIUS_M = 0.6, 1.7
 #: 256 px: the single-mode sphere test's accuracy (0.5 %, pixel sampling < 0.2 %).

@@ -110,7 +110,7 @@ def test_map_mode_needs_map_file(tmp_path):
 
 
 def test_map_mode_refuses_an_unfinished_map(scenario, tmp_path):
-    from speclight.estimate.reflectivity_map import reflectivity_map
+    from speclight.maps.writer.reflectivity_map_run import reflectivity_map
     from speclight.scenario import load_scenario
 
     run = reflectivity_map(

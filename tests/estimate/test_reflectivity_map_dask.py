@@ -23,11 +23,11 @@ from map_scenarios import write_scenario
 from typer.testing import CliRunner
 
 from speclight.cli import app
-from speclight.estimate.reflectivity_map import reflectivity_map
+from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.scale import open_executor
 
 # the module (speclight.estimate exports its function under the same name)
-refmap = import_module("speclight.estimate.reflectivity_map")
+refmap = import_module("speclight.maps.writer.reflectivity_map_run")
 
 #: (example, map options): a passive map (phase angles x rolls) and a laser map whose phase
 #: angle 0 carries the coaxial range offsets and histograms.

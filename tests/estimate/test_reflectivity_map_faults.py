@@ -19,10 +19,10 @@ from zarr.storage import _local as zarr_local
 
 from speclight.cli import app
 from speclight.errors import InputError
-from speclight.estimate import reflectivity_map_limits as limits
-from speclight.estimate.reflectivity_map import reflectivity_map
 from speclight.io.output import OutputWriteError
-from speclight.render.map_lookup import load_map
+from speclight.maps.map_lookup import load_map
+from speclight.maps.writer import map_limits as limits
+from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 
 OPTIONS = {"directions": 12, "phase_angles_deg": [0.0, 60.0], "rolls": 2, "chunk": 4}
 
@@ -118,7 +118,7 @@ def test_a_chunk_above_the_memory_limit_is_refused_with_the_largest_that_fits(re
         <= limit
         < limits.chunk_bytes(loaded, fits + 1, geoms)
     )
-    assert message.startswith("--chunk: --chunk = 1000000: a chunk renders 1000000 directions")
+    assert message.startswith("chunk: chunk = 1000000: a chunk renders 1000000 directions")
     assert "GiB of memory, more than the limit" in message
 
 

@@ -20,13 +20,13 @@ import numpy as np
 import pytest
 from map_scenarios import write_scenario
 
-from speclight.estimate.reflectivity_map import reflectivity_map
 from speclight.illumination import solar_irradiance_W_m2_nm
+from speclight.maps.map_geometry import sun_observer
+from speclight.maps.map_lookup import load_map
+from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.render import render_intensity
-from speclight.render.map_geometry import sun_observer
-from speclight.render.map_lookup import load_map
-from speclight.simulate.radiometry import wavelength_grid_nm
-from speclight.simulate.reflection import build_target
+from speclight.simulation.radiometry import wavelength_grid_nm
+from speclight.simulation.reflection import build_target
 
 N, RES_PX = 300, 32
 BOUNDS = {  # (median, 95th percentile): measured maximum over seeds x 1.25

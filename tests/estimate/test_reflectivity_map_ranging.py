@@ -16,11 +16,11 @@ import zarr
 from map_scenarios import SPHERE_TARGET, write_scenario
 
 from speclight.errors import InputError
-from speclight.estimate.reflectivity_map import reflectivity_map
 from speclight.illumination import solar_irradiance_W_m2_nm
 from speclight.instrument.photometry import photon_kernel
-from speclight.render.map_lookup import load_map
-from speclight.simulate.radiometry import instrument_response, wavelength_grid_nm
+from speclight.maps.map_lookup import load_map
+from speclight.maps.writer.reflectivity_map_run import reflectivity_map
+from speclight.simulation.radiometry import instrument_response, wavelength_grid_nm
 
 RHO, RADIUS_M = 0.6, 1.7
 

@@ -1,4 +1,4 @@
-"""Can a scenario be the measured target? (estimate/scenario_match.py)
+"""Can a scenario be the measured target? (estimate/inputs/geometry_match.py)
 
 Reference: skyfield's topocentric direction of the calsphere example's element set (its own
 SGP4 and frames, not speclight's): where skyfield sees the satellite, a measurement recorded
@@ -16,7 +16,7 @@ import xarray as xr
 from skyfield.api import EarthSatellite, wgs84
 
 from speclight.errors import InputError
-from speclight.estimate.scenario_match import catalogue_number, check_scenario_sees
+from speclight.estimate.inputs.geometry_match import catalogue_number, check_scenario_sees
 from speclight.orbit.timescale import load_timescale, time_from_utc
 from speclight.scenario import example_text, parse_scenario
 

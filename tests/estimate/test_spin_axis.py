@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from speclight.errors import InputError
-from speclight.estimate.spin_axis import (
+from speclight.estimate.spin_axis.spin_axis_core import (
     angular_distance_deg,
     check_search_options,
     local_minima,
@@ -23,9 +23,9 @@ from speclight.estimate.spin_axis import (
     radec_grid,
     spin_axis_search,
 )
-from speclight.estimate.spin_axis_lookup import EpochGeometry, spin_frame_map
-from speclight.render.map_geometry import healpix_directions
-from speclight.render.map_lookup import MapHeader, ReflectivityMap
+from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, spin_frame_map
+from speclight.maps.map_geometry import healpix_directions
+from speclight.maps.map_lookup import MapHeader, ReflectivityMap
 
 
 def _misfit(p: np.ndarray, y: np.ndarray) -> float:

@@ -22,12 +22,12 @@ from map_scenarios import map_scenario_text
 from typer.testing import CliRunner
 
 from speclight.cli import app
-from speclight.estimate.reflectivity_map import reflectivity_map
-from speclight.estimate.spin_axis import angular_distance_deg
-from speclight.estimate.spin_axis_io import spin_axis_measured
+from speclight.estimate.spin_axis.spin_axis_core import angular_distance_deg
+from speclight.estimate.spin_axis.spin_axis_run import spin_axis_measured
 from speclight.io.netcdf import dataset_bytes
+from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.scenario import example_text, load_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 GRID_DEG, PHASES = 10.0, 36
 runner = CliRunner()

@@ -21,8 +21,7 @@ from astropy_healpix import healpy as hp
 from test_spin_axis import _body_directions
 from test_spin_axis_grid import _geometry, _map
 
-from speclight.estimate.spin_axis import angular_distance_deg, spin_axis_search
-from speclight.estimate.spin_axis_continuation import (
+from speclight.estimate.spin_axis.spin_axis_continuation import (
     SmoothedMisfit,
     Stage,
     coarsen_map,
@@ -30,11 +29,12 @@ from speclight.estimate.spin_axis_continuation import (
     gaussian_smoother,
     stage_model,
 )
-from speclight.estimate.spin_axis_gradient import SpinMisfit
-from speclight.estimate.spin_axis_lookup import EpochGeometry, spin_frame_map
-from speclight.estimate.spin_axis_ranging import RangingTerm
-from speclight.estimate.spin_axis_refine import refine_candidate, refine_staged
-from speclight.render.map_geometry import healpix_directions
+from speclight.estimate.spin_axis.spin_axis_core import angular_distance_deg, spin_axis_search
+from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
+from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, spin_frame_map
+from speclight.estimate.spin_axis.spin_axis_ranging import RangingTerm
+from speclight.estimate.spin_axis.spin_axis_refine import refine_candidate, refine_staged
+from speclight.maps.map_geometry import healpix_directions
 
 
 def test_coarsened_map_averages_the_children() -> None:

@@ -1,6 +1,7 @@
 """Analytic derivatives of the spin-axis misfit and the gradient-based refinement.
 
-References: the misfit of :func:`speclight.estimate.spin_axis.exact_misfit` (the spin model
+References: the misfit of :func:`speclight.estimate.spin_axis.spin_axis_misfit.exact_misfit` (the
+spin model
 through the package's quaternions, not the tangent-plane parametrisation differentiated
 here); central finite differences of the same misfit; and a pass made with a known axis,
 phase and period on a map in closed form (tests/estimate/test_spin_axis.py), recovered from
@@ -17,11 +18,15 @@ from test_spin_axis import _body_directions, _closed_form_map, _rates
 from test_spin_axis_grid import _geometry, _map
 
 from speclight.errors import InputError
-from speclight.estimate.spin_axis import angular_distance_deg, exact_misfit, spin_axis_search
-from speclight.estimate.spin_axis_gradient import SpinMisfit
-from speclight.estimate.spin_axis_lookup import EpochGeometry, spin_frame_map
-from speclight.estimate.spin_axis_ranging import RangingTerm
-from speclight.estimate.spin_axis_refine import check_refine_options, refine_candidate
+from speclight.estimate.spin_axis.spin_axis_core import (
+    angular_distance_deg,
+    exact_misfit,
+    spin_axis_search,
+)
+from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
+from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, spin_frame_map
+from speclight.estimate.spin_axis.spin_axis_ranging import RangingTerm
+from speclight.estimate.spin_axis.spin_axis_refine import check_refine_options, refine_candidate
 
 BODY_AXES = [None, [0.0, 1.0, 0.0]]
 

@@ -1,11 +1,11 @@
-"""The fast grid pass (:mod:`speclight.estimate.spin_axis_grid`) against a straightforward
+"""The fast grid pass (:mod:`speclight.estimate.spin_axis.spin_axis_grid`) against a straightforward
 float64 computation, one candidate at a time, on tiny grids.
 
 The reference does not share the fast path's machinery: each candidate's attitude comes from
 the spin model (:func:`speclight.attitude.spin.spin_attitude`, quaternions), each epoch's
-phase vector, phase angle and roll from :func:`speclight.render.map_geometry.map_coordinates`
+phase vector, phase angle and roll from :func:`speclight.maps.map_geometry.map_coordinates`
 in the spin frame, the cell from the layout documented on
-:class:`speclight.estimate.spin_axis_lookup.SpinFrameMap` (nearest polar and azimuth cell,
+:class:`speclight.estimate.spin_axis.spin_axis_lookup.SpinFrameMap` (nearest polar and azimuth cell,
 linear in phase angle and roll), and the misfit from its definition (mean over epochs and
 bands of the squared difference of the light curves each divided by its mean; the ranging
 term: the squared offset differences over the measured epochs and bands divided by their
@@ -28,12 +28,16 @@ import pytest
 
 from speclight.attitude.quaternion import quat_to_matrix
 from speclight.attitude.spin import spin_attitude
-from speclight.estimate.spin_axis import radec_grid
-from speclight.estimate.spin_axis_grid import grid_pass
-from speclight.estimate.spin_axis_lookup import EpochGeometry, SpinFrameMap, spin_frame_map
-from speclight.estimate.spin_axis_ranging import RangingTerm
-from speclight.render.map_geometry import healpix_directions, map_coordinates
-from speclight.render.map_lookup import MapHeader, ReflectivityMap, phase_angle_weights
+from speclight.estimate.spin_axis.spin_axis_core import radec_grid
+from speclight.estimate.spin_axis.spin_axis_grid import grid_pass
+from speclight.estimate.spin_axis.spin_axis_lookup import (
+    EpochGeometry,
+    SpinFrameMap,
+    spin_frame_map,
+)
+from speclight.estimate.spin_axis.spin_axis_ranging import RangingTerm
+from speclight.maps.map_geometry import healpix_directions, map_coordinates
+from speclight.maps.map_lookup import MapHeader, ReflectivityMap, phase_angle_weights
 
 EPS32 = float(np.finfo(np.float32).eps)
 N_T, N_PHASES, GRID_DEG, PERIOD_S = 40, 12, 45.0, 47.0

@@ -14,14 +14,18 @@ import numpy as np
 import pytest
 
 from speclight.errors import InputError
-from speclight.estimate import spin_axis as sa
-from speclight.estimate.spin_axis import check_measured_curves, spin_axis_search
-from speclight.estimate.spin_axis_limits import check_search_cost, search_cost
-from speclight.estimate.spin_axis_lookup import EpochGeometry, cell_deg_for, spin_frame_map
-from speclight.estimate.spin_axis_ranging import check_ranging_weight
-from speclight.estimate.spin_axis_refine import Refined
-from speclight.render.map_geometry import healpix_directions
-from speclight.render.map_lookup import MapHeader, ReflectivityMap
+from speclight.estimate.spin_axis import spin_axis_core as sa
+from speclight.estimate.spin_axis.spin_axis_core import check_measured_curves, spin_axis_search
+from speclight.estimate.spin_axis.spin_axis_limits import check_search_cost, search_cost
+from speclight.estimate.spin_axis.spin_axis_lookup import (
+    EpochGeometry,
+    cell_deg_for,
+    spin_frame_map,
+)
+from speclight.estimate.spin_axis.spin_axis_ranging import check_ranging_weight
+from speclight.estimate.spin_axis.spin_axis_refine import Refined
+from speclight.maps.map_geometry import healpix_directions
+from speclight.maps.map_lookup import MapHeader, ReflectivityMap
 
 
 def _map(zero_band: bool = False) -> ReflectivityMap:
@@ -58,7 +62,7 @@ def test_a_map_that_predicts_no_light_is_refused() -> None:
 
 
 def test_a_refinement_that_ends_non_finite_falls_back_to_the_best_cell(monkeypatch) -> None:
-    import speclight.estimate.spin_axis_refine as refine
+    import speclight.estimate.spin_axis.spin_axis_refine as refine
 
     def broken(*args, **kwargs) -> Refined:
         return Refined(np.nan, np.nan, np.nan, np.nan, np.nan, 7, 0)

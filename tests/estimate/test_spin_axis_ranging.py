@@ -17,16 +17,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from speclight.estimate.spin_axis import angular_distance_deg, spin_axis_search
-from speclight.estimate.spin_axis_lookup import EpochGeometry, spin_frame_map
-from speclight.estimate.spin_axis_ranging import (
+from speclight.estimate.spin_axis.spin_axis_core import angular_distance_deg, spin_axis_search
+from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, spin_frame_map
+from speclight.estimate.spin_axis.spin_axis_ranging import (
     RangingTerm,
     offsets_from_channels,
     resolve_weight,
     term_from_offsets,
 )
-from speclight.render.map_geometry import healpix_directions
-from speclight.render.map_lookup import MapHeader, ReflectivityMap
+from speclight.maps.map_geometry import healpix_directions
+from speclight.maps.map_lookup import MapHeader, ReflectivityMap
 
 RA, DEC = 70.0, 25.0  # the truth; its reverse is RA 250, Dec -25
 

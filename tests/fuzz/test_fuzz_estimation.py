@@ -49,11 +49,11 @@ from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from speclight.cli import app
-from speclight.estimate.reflectivity_map import reflectivity_map
 from speclight.io.netcdf import dataset_bytes
+from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.orbit import iers_files, timescale
 from speclight.scenario import example_text, load_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 runner = CliRunner()
 EXAMPLES = int(os.environ.get("SPECLIGHT_FUZZ_EXAMPLES", "0"))

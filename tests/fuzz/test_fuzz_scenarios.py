@@ -36,13 +36,13 @@ from typer.testing import CliRunner
 from speclight.cli import app
 from speclight.errors import InputError
 from speclight.scenario import example_names, example_text, load_scenario
-from speclight.simulate.geometry_stage import scenario_geometry
-from speclight.simulate.radiometry import (
+from speclight.simulation.geometry_stage import scenario_geometry
+from speclight.simulation.radiometry import (
     atmosphere_transmission,
     instrument_response,
     wavelength_grid_nm,
 )
-from speclight.simulate.reflection import build_target
+from speclight.simulation.reflection import build_target
 
 EXAMPLES = {name: yaml.safe_load(example_text(name)) for name in example_names()}
 #: A scenario's own time grid is used up to this many epochs; beyond, three epochs 30 s apart.

@@ -16,7 +16,7 @@ from speclight.instrument import (
     vega_v_magnitude,
 )
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate.radiometry import instrument_response
+from speclight.simulation.radiometry import instrument_response
 
 GRID_NM = np.arange(300.0, 1241.0, 5.0)
 H, C, K_B = 6.62607015e-34, 299792458.0, 1.380649e-23  # SI 2019 exact constants

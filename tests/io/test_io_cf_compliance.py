@@ -19,8 +19,8 @@ import yaml
 from speclight import schema
 from speclight.io import write_dataset
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
-from speclight.simulate.input_hashes import sha256_of
+from speclight.simulation import simulate
+from speclight.simulation.input_hashes import sha256_of
 
 #: Checker findings that are CF recommendations speclight does not follow, with the reason.
 ACCEPTED = {

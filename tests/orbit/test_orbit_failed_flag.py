@@ -1,7 +1,7 @@
 """A bad record of an orbit table ends as the ``orbit_failed`` flag of its epochs.
 
 The pipeline's geometry stage turns the readers' ok mask into ``FLAG_ORBIT_FAILED``
-(``speclight.simulate.geometry_stage``); these tests run that stage on a tiny window.
+(``speclight.simulation.geometry_stage``); these tests run that stage on a tiny window.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import yaml
 import speclight
 from speclight import schema as v
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate.geometry_stage import scenario_geometry
+from speclight.simulation.geometry_stage import scenario_geometry
 
 SAMPLE_CPF = Path(speclight.__file__).parent / "data/cpf/lcs1_20201127_speclight_sgp4.cpf"
 HOLE_CSV = Path(__file__).parent / "data" / "lcs1_itrf_6h_hole.csv"

@@ -35,7 +35,7 @@ from speclight.errors import InputError
 from speclight.orbit import load_timescale, time_from_utc
 from speclight.orbit.oem import oem_position_gcrs_m, read_oem
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate.geometry_stage import scenario_geometry
+from speclight.simulation.geometry_stage import scenario_geometry
 
 TLE = yaml.safe_load(example_text("box-wing"))["orbit"]["tle"].strip().split("\n")
 #: Written-to-1-mm positions through degree-5 Hermite; the measured error is < 0.2 mm.

@@ -22,8 +22,8 @@ from speclight import schema as v
 from speclight.orbit.pass_finder import Pass
 from speclight.orbit.timescale import load_ephemeris, load_timescale, time_from_utc
 from speclight.scenario import LoadedScenario, load_example
-from speclight.simulate.geometry_stage import scenario_geometry
-from speclight.simulate.pass_search import TOLERANCE_S, scenario_passes
+from speclight.simulation.geometry_stage import scenario_geometry
+from speclight.simulation.pass_search import TOLERANCE_S, scenario_passes
 
 #: skyfield's find_events locates events to half a second (its ``half_second`` epsilon).
 FIND_EVENTS_EPSILON_S = 0.5

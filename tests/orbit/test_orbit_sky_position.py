@@ -19,7 +19,7 @@ import speclight
 from speclight.constants import C_M_S
 from speclight.orbit.timescale import load_ephemeris, load_timescale, time_from_utc
 from speclight.scenario import LoadedScenario, load_example
-from speclight.simulate.geometry_stage import scenario_geometry
+from speclight.simulation.geometry_stage import scenario_geometry
 
 ARCSEC = 1.0 / 3600.0
 #: Fastest barycentric speed of the Earth (perihelion, 30.29 km/s) [m s-1].

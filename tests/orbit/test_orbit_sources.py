@@ -20,8 +20,8 @@ from speclight.orbit.orbit_sources import (
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
 from speclight.scenario.sections_geometry import Orbit
-from speclight.simulate.geometry_stage import scenario_geometry
-from speclight.simulate.input_hashes import input_files
+from speclight.simulation.geometry_stage import scenario_geometry
+from speclight.simulation.input_hashes import input_files
 
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "scenario.md"
 EPOCHS = np.array(["2019-08-30T02:20:00"], dtype="datetime64[ns]")

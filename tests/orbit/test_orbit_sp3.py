@@ -28,7 +28,7 @@ from speclight.errors import InputError
 from speclight.orbit import load_timescale, time_from_utc
 from speclight.orbit.sp3 import read_sp3, sp3_position_gcrs_m
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate.geometry_stage import scenario_geometry
+from speclight.simulation.geometry_stage import scenario_geometry
 
 TOL_M = 1e-2
 GPS_MINUS_UTC = np.timedelta64(18, "s")

@@ -13,7 +13,7 @@ from speclight.plot import plot_files
 from speclight.plot.chain import band_electron_spectra
 from speclight.scenario.builtin_examples import load_example
 from speclight.scenario.load import parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 pytest.importorskip("matplotlib")
 

@@ -18,14 +18,14 @@ from speclight.render.session import RenderSession
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
 from speclight.schema import FLAG_LASER_BELOW_HORIZON
-from speclight.simulate.geometry_stage import scenario_geometry
-from speclight.simulate.radiometry import (
+from speclight.simulation.geometry_stage import scenario_geometry
+from speclight.simulation.radiometry import (
     atmosphere_transmission,
     instrument_response,
     wavelength_grid_nm,
 )
-from speclight.simulate.ranging_stage import laser_ranging, prepare_ranging
-from speclight.simulate.reflection import build_target
+from speclight.simulation.ranging_stage import laser_ranging, prepare_ranging
+from speclight.simulation.reflection import build_target
 
 H, C = 6.62607015e-34, 299_792_458.0  # CODATA 2018, exact
 STUTTGART = {"latitude_deg": 48.7822, "longitude_deg": 9.1967, "altitude_m": 355.0}

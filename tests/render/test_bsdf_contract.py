@@ -31,7 +31,7 @@ from speclight.render.laser_multibounce import fcos_spectral
 from speclight.render.material_channels import ChannelLayout
 from speclight.render.shading import SUN_COS, SUN_SOLID_ANGLE_SR, sun_disk_sin2
 from speclight.target import Material, material_from_spec, plate
-from speclight.target.bsdf_models import BSDF_FORMS, MEASURED_RGL, MEASURED_TABLE, BsdfModel
+from speclight.target.bsdf_models import BSDF_FORMS, MEASURED_RGL, BsdfModel
 
 WAVELENGTH_NM = np.array([400.0, 550.0, 700.0, 900.0])
 VECTORISED = any(v.startswith(("llvm_", "cuda_")) for v in available_variants())
@@ -39,14 +39,7 @@ SPECTRAL = VECTORISED and any(
     v.startswith(("llvm_", "cuda_")) and v.endswith("_spectral") for v in available_variants()
 )
 #: Known failures, each with what it is and where it is followed up; strict: fixed, it fails.
-KNOWN = {
-    (MEASURED_TABLE.label, "white furnace"): (
-        "the shipped Starlink chassis table, extended from in-plane samples to all "
-        "geometries by f(theta_h, theta_d) with the nearest sample outside the measured "
-        "support, has a directional albedo of 1.3 at 30 deg incidence (1.75 at 15 deg; the "
-        "solar-array table 1.16 at 50 deg): the extension creates energy (issue 24, item 2)"
-    ),
-}
+KNOWN: dict[tuple[str, str], str] = {}
 
 
 def _cases(check: str, modes: tuple[str, ...] = ("single",)) -> list:

@@ -1,4 +1,4 @@
-"""Derivatives of the map interpolation (:mod:`speclight.render.map_lookup_grad`).
+"""Derivatives of the map interpolation (:mod:`speclight.maps.map_lookup_grad`).
 
 References: astropy-healpix's own ``bilinear_interpolation_weights`` (the weights our
 formulas reproduce, polar caps included), the map's own lookup
@@ -17,9 +17,9 @@ from astropy import units as u
 from astropy_healpix import bilinear_interpolation_weights
 from scipy.spatial.transform import Rotation
 
-from speclight.render.map_geometry import healpix_directions
-from speclight.render.map_lookup import MapHeader, ReflectivityMap
-from speclight.render.map_lookup_grad import healpix_weight_derivatives, intensity_jacobian
+from speclight.maps.map_geometry import healpix_directions
+from speclight.maps.map_lookup import MapHeader, ReflectivityMap
+from speclight.maps.map_lookup_grad import healpix_weight_derivatives, intensity_jacobian
 
 
 def _unit(rng: np.random.Generator, n: int) -> np.ndarray:

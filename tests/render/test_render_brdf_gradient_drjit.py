@@ -11,9 +11,9 @@ float32, hence the tolerance (1e-4 of the largest value, ~1000 float32 steps).
 import numpy as np
 import pytest
 
-from speclight.render.brdf import microfacet_weight
 from speclight.render.brdf_gradient import microfacet_weight_dalpha
 from speclight.render.variant import available_variants
+from speclight.target.microfacet_terms import microfacet_weight
 
 pytestmark = pytest.mark.skipif(
     "llvm_ad_rgb" not in available_variants(), reason="needs Mitsuba's llvm_ad_rgb (libLLVM)"

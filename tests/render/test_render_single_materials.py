@@ -72,9 +72,12 @@ def test_smooth_plastic_diffuse_base_off_the_glint():
 def test_measured_brdf_reproduces_in_plane_table_samples():
     # In the plane of incidence at sample angles the resampled table must return the
     # measured BRDF (Fankhauser et al. 2023, Starlink chassis at 532 nm): rows at theta_i=60 deg.
+    # Not the specular sample (theta_o = 60 deg): the peak is narrower than the sampling and
+    # lies outside the table's support (speclight.target.brdf_table), where its fitted
+    # extension holds (tests/render/test_bsdf_contract.py holds both to an albedo <= 1).
     text = ir.files("speclight").joinpath("data", "brdf", "starlink_v1p5_chassis_532nm.csv")
     tab = np.loadtxt(text.read_text().splitlines(), comments="#")
-    theta_o = np.array([60.0, 50.0, 40.0, 20.0, 0.0, -20.0, -60.0])
+    theta_o = np.array([50.0, 40.0, 20.0, 0.0, -20.0, -60.0])
     rows = [np.flatnonzero((tab[:, 0] == 60.0) & (tab[:, 2] == t))[0] for t in theta_o]
     ref = tab[rows, 4]
     ti = np.radians(60.0)

@@ -21,8 +21,8 @@ import xarray as xr
 from zarr.storage import _local as zarr_local
 
 from speclight.errors import InputError
+from speclight.io import store_io
 from speclight.io.output import OutputWriteError
-from speclight.scale import store_io
 from speclight.scale.executor import local_workers
 from speclight.scale.sweep_cases import plan_sweep
 from speclight.scale.sweep_file import MAX_CASES, load_sweep

@@ -26,7 +26,7 @@ from speclight.scale.sweep_cases import plan_sweep
 from speclight.scale.sweep_file import load_sweep
 from speclight.scale.sweep_run import run_case, run_sweep
 from speclight.scenario import parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 TLE = """CALSPHERE 4A
 1 01520U 65065H   20058.86916325  .00000035  00000-0  49354-4 0  9992

@@ -103,7 +103,7 @@ def test_largest_seeds_are_written_to_netcdf() -> None:
 
     from speclight.io.netcdf import dataset_bytes
     from speclight.scenario.sections_light import MAX_NOISE_SEED, MAX_RENDER_SEED
-    from speclight.simulate.dataset import global_attributes
+    from speclight.simulation.dataset import global_attributes
 
     d = _set(_example(), "render.seed", MAX_RENDER_SEED)
     loaded = parse_scenario(yaml.safe_dump(_set(d, "instrument.noise.seed", MAX_NOISE_SEED)))

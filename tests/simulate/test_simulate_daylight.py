@@ -15,12 +15,12 @@ import pytest
 import speclight
 from speclight import schema as v
 from speclight.scenario import load_example
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 NOON_PASS = {"time.start": "2020-03-01T08:17:00Z", "time.stop": "2020-03-01T08:29:00Z"}
 
 
-def _run(overrides: dict[str, object]) -> speclight.simulate.SimulationResult:
+def _run(overrides: dict[str, object]) -> speclight.simulation.SimulationResult:
     loaded = speclight.with_overrides(
         load_example("calsphere"), {"time.step_s": 60.0, "render.resolution_px": 32, **overrides}
     )

@@ -14,7 +14,7 @@ import yaml
 from speclight.render import material_contributions, render_intensity
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 from speclight.target import Material, Reflectance, target_from_spec
 
 GEOMETRY_VARS = ("range", "elevation", "phase_angle", "sunlit", "observer_direction_body")

@@ -8,8 +8,8 @@ import yaml
 
 from speclight.errors import InputError
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
-from speclight.simulate.geometry_stage import time_grid
+from speclight.simulation import simulate
+from speclight.simulation.geometry_stage import time_grid
 
 
 def _scenario(name: str = "lcs1", **changes: object) -> str:

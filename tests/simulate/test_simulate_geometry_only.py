@@ -12,7 +12,7 @@ from skyfield.api import EarthSatellite, load, wgs84
 
 from speclight.errors import InputError
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 #: Angle between speclight's and skyfield's target-to-observer directions [rad]: both run
 #: SGP4 on the same elements; their TEME -> GCRS rotations and Earth orientation agree to

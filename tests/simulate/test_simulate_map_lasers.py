@@ -23,10 +23,10 @@ import numpy as np
 import pytest
 
 from speclight.errors import InputError
-from speclight.estimate.reflectivity_map import reflectivity_map
+from speclight.maps.writer.reflectivity_map_run import reflectivity_map
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
-from speclight.simulate.map_ranging import compress_offsets
+from speclight.simulation import simulate
+from speclight.simulation.map_ranging import compress_offsets
 from speclight.wavelength_grid import grid_bin_bounds_nm
 
 RHO, RADIUS_M = 0.6, 1.7

@@ -1,4 +1,4 @@
-"""Up-front run limits (speclight.simulate.memory): a run that cannot fit in memory, or whose
+"""Up-front run limits (speclight.simulation.memory): a run that cannot fit in memory, or whose
 path-mode render would take days, is refused before any work with the estimate and the fields
 to reduce (issue 9, item 5). Reproducers: /work/shared/repro/fuzz/NNNN-*."""
 
@@ -13,8 +13,8 @@ import yaml
 
 from speclight.errors import InputError
 from speclight.scenario import LoadedScenario, example_text, parse_scenario
-from speclight.simulate import memory
-from speclight.simulate.pipeline import simulate
+from speclight.simulation import memory
+from speclight.simulation.pipeline import simulate
 
 GIB = 1024**3
 
@@ -32,7 +32,7 @@ def _loaded(name: str = "calsphere", **edits: Any) -> LoadedScenario:
 
 
 def test_epoch_count_is_the_time_grids() -> None:
-    from speclight.simulate.geometry_stage import time_grid
+    from speclight.simulation.geometry_stage import time_grid
 
     loaded = _loaded(time__step_s=0.7)
     assert memory.grid_epochs(loaded.scenario) == time_grid(loaded.scenario.time).size
@@ -85,7 +85,7 @@ def test_billion_wavelength_bins_are_refused_before_any_work() -> None:
 
 def test_day_long_path_render_is_refused_with_its_estimate() -> None:
     # 256 px x 65536 spp x 481 epochs: 481 x (0.02 s + 256^2 x 65536 / 1e7 s) = 2.07e5 s,
-    # about 57.4 h (the model of speclight.simulate.memory.path_render_seconds)
+    # about 57.4 h (the model of speclight.simulation.memory.path_render_seconds)
     loaded = _loaded(render__mode="path", render__samples_per_pixel=65536)
     with pytest.raises(InputError) as err:
         simulate(loaded)
@@ -126,7 +126,7 @@ def test_channel_count_is_the_renderers_layout(name: str) -> None:
     # count must be the one the single-mode renderer lays out (3,271 for the box-wing's three
     # plastics: 4 materials + 3 x 33^2 diffuse nodes)
     from speclight.render.material_channels import ChannelLayout
-    from speclight.simulate.reflection import build_target
+    from speclight.simulation.reflection import build_target
 
     loaded = _loaded(name)
     layout = ChannelLayout(build_target(loaded))
@@ -144,8 +144,8 @@ def test_plastic_targets_count_the_channel_weights_the_render_allocates() -> Non
 
     from speclight.render.raycast import NumpyCaster
     from speclight.render.single import render_single_polarized
-    from speclight.simulate.radiometry import wavelength_grid_nm
-    from speclight.simulate.reflection import build_target
+    from speclight.simulation.radiometry import wavelength_grid_nm
+    from speclight.simulation.reflection import build_target
 
     loaded = _loaded("box-wing", render__resolution_px=8)
     target = build_target(loaded)

@@ -31,7 +31,7 @@ CHILD = textwrap.dedent(
     from speclight.io.netcdf import write_dataset
     from speclight.plot import plot_files
     from speclight.scenario import example_text, parse_scenario
-    from speclight.simulate import simulate
+    from speclight.simulation import simulate
 
     out = Path(sys.argv[1])
     windows = {"calsphere": "2020-02-29T21:16:04Z", "box-wing-laser": "2019-08-30T02:20:02Z"}

@@ -15,7 +15,7 @@ import yaml
 
 from speclight.errors import InputError
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 #: Sums of 6 materials' shares against the total: float64 rounding of a few-term sum.
 SUM_RTOL = 1e-12

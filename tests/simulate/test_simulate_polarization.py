@@ -11,7 +11,7 @@ import yaml
 
 from speclight.errors import InputError
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 
 def _scenario(tmp_path, **render: object) -> dict:

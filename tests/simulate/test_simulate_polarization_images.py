@@ -12,7 +12,7 @@ import yaml
 
 from speclight.plot.images import image_dolp, images_figure
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 from speclight.target.optical_constants import refractive_index
 
 SAVED = [1, 3]

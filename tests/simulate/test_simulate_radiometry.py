@@ -8,7 +8,7 @@ import yaml
 
 from speclight.errors import InputError
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 H_C_J_M = 6.62607015e-34 * 2.99792458e8  # CODATA 2018 exact constants
 

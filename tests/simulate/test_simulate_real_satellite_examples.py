@@ -16,8 +16,8 @@ import pytest
 
 import speclight
 from speclight.scenario import load_example
-from speclight.simulate.geometry_stage import scenario_geometry
-from speclight.simulate.reflection import build_joints, build_target
+from speclight.simulation.geometry_stage import scenario_geometry
+from speclight.simulation.reflection import build_joints, build_target
 from speclight.target.articulation import posed_target
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -10,7 +10,7 @@ import numpy as np
 import yaml
 
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 #: Pixel quadrature of a 256 px sphere for phase angles up to ~120 deg (the sphere tests of
 #: tests/render: worst 0.19 % at 150 deg).

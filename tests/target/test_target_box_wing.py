@@ -8,7 +8,7 @@ import yaml
 from speclight.errors import InputError
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
-from speclight.simulate.reflection import build_target
+from speclight.simulation.reflection import build_target
 from speclight.target import Material, Reflectance, box_wing
 
 WHITE = Material("white", "lambertian", Reflectance.constant(1.0))

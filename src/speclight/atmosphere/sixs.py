@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.atmosphere.airmass import airmass
+from speclight.atmosphere.airmass_pressure import airmass
 from speclight.atmosphere.mapping import interpolate_in_airmass, log_transmission
 from speclight.atmosphere.params import AtmosphereParams
 from speclight.cache import cached_arrays

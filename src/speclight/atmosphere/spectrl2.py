@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.atmosphere.airmass import airmass, pressure_from_altitude
+from speclight.atmosphere.airmass_pressure import airmass, pressure_from_altitude
 from speclight.atmosphere.params import AtmosphereParams
 from speclight.errors import InputError
 from speclight.wavelength_grid import bin_average

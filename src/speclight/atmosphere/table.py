@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.atmosphere.airmass import airmass
+from speclight.atmosphere.airmass_pressure import airmass
 from speclight.atmosphere.mapping import interpolate_in_airmass, log_transmission
 from speclight.errors import InputError
 from speclight.instrument.tables import read_table, sort_unique, value_to_fraction, wavelength_to_nm

@@ -8,7 +8,7 @@ the rest of speclight needs (STYLE.md item 13, as colour's method registries):
   keys are sources, which options belong to which source, the message listing them all;
 * the geometry stage (:func:`orbit_trajectory`, the one front door): the reader and
   interpolator of each source;
-* the output's provenance (:mod:`speclight.simulate.input_hashes`, and the geometry cache
+* the output's provenance (:mod:`speclight.simulation.input_hashes`, and the geometry cache
   key of ``speclight sweep``): which keys name a file whose bytes are hashed;
 * messages, field descriptions and ``docs/scenario.md`` (a test checks the table there).
 

@@ -13,8 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from speclight.estimate.period_io import PeriodResult
-from speclight.estimate.periodogram import design_matrix, harmonic_chi2
+from speclight.estimate.period.period_run import PeriodResult
+from speclight.estimate.period.periodogram import design_matrix, harmonic_chi2
 from speclight.plot.style import new_figure
 
 #: Magnitude offset between bands in the folded panel, in units of the largest band's

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from speclight.estimate.upsampling import photon_weights
+from speclight.estimate.spectra.upsampling import photon_weights
 from speclight.plot.style import new_figure
 
 

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from speclight.estimate.upsample_io import ScenarioSpectrum
+from speclight.estimate.spectra.upsample_run import ScenarioSpectrum
 from speclight.plot.style import new_figure
 
 

@@ -4,7 +4,7 @@ Plain numpy arrays in and out: :mod:`.transmitter` (where a transmitter is seen 
 target), :mod:`.link` (uplink irradiance, downlink to the receiver's bands, histograms and
 centre-of-mass offsets), :mod:`.bins` (the range-offset bins). The light transport of laser
 light resolved in range lives in :mod:`speclight.render.laser_returns`, the pipeline glue in
-:mod:`speclight.simulate.ranging_stage`.
+:mod:`speclight.simulation.ranging_stage`.
 """
 
 from speclight.ranging.bins import RANGE_BINS, range_bin_edges_m

@@ -4,6 +4,7 @@ Mitsuba and Dr.Jit are imported lazily, only inside this subpackage, when a rend
 """
 
 from speclight.render.api import material_contributions, render_intensity
+from speclight.render.laser_returns import LaserLight, LaserReturns, render_laser_returns
 from speclight.render.result import RenderImage, RenderResult
 from speclight.render.session import RenderMode, RenderSession
 from speclight.render.variant import (
@@ -14,6 +15,8 @@ from speclight.render.variant import (
 )
 
 __all__ = [
+    "LaserLight",
+    "LaserReturns",
     "RenderImage",
     "RenderMode",
     "RenderResult",
@@ -24,4 +27,5 @@ __all__ = [
     "find_libllvm",
     "material_contributions",
     "render_intensity",
+    "render_laser_returns",
 ]

@@ -137,6 +137,7 @@ class _Rendered:
     variant: str
     stokes: F64 | None = None
     stokes_std: F64 | float | None = None
+    outside: F64 | None = None
 
 
 def _checked_session(
@@ -180,7 +181,7 @@ def _render_single(
     if multi and not session.variant.startswith(("llvm_", "cuda_")) and len(v) > 1:
         # Dr.Jit variants already use every core; the numpy caster runs one process per
         # worker on contiguous blocks of epochs (Mitsuba scenes are never pickled).
-        inten, linear, imgs = _single_in_processes(
+        inten, linear, imgs, outside = _single_in_processes(
             target, sun, obs, e, inputs.wl, resolution_px, inputs.keep_local, n_workers,
             polarization,
         )  # fmt: skip
@@ -190,14 +191,14 @@ def _render_single(
         from speclight.render.single import render_single_polarized
 
         with stage("rendering (single)", len(v), enabled=progress) as advance:
-            inten, linear, imgs = render_single_polarized(
+            inten, linear, imgs, outside = render_single_polarized(
                 target, sun, obs, e, inputs.wl, caster, resolution_px, inputs.keep_local,
                 on_batch=advance,
                 on_hits=None if on_hits is None else _global_epochs(on_hits, v),
                 polarization=polarization,
             )  # fmt: skip
         used = caster.name
-    rendered = _Rendered(inten, 0.0, imgs, used)
+    rendered = _Rendered(inten, 0.0, imgs, used, outside=outside)
     if inputs.pole is not None:
         assert linear is not None
         _stokes_on_sky(rendered, linear, scattering_angle_on_sky(sun, obs, inputs.pole[v]))
@@ -255,13 +256,17 @@ def _result(inputs: EpochInputs, rendered: _Rendered, mode: RenderMode) -> Rende
         if rendered.stokes is not None:
             stokes[v] = rendered.stokes
             stokes_std[v] = rendered.stokes_std
+    outside = None
+    if rendered.outside is not None:
+        outside = np.full((n, n_wl), np.nan)
+        outside[v] = rendered.outside
     images = {}
     for j, img in rendered.images.items():
         g = int(v[j])
         img.epoch = g
         images[g] = img
     return RenderResult(
-        intensity, std, inputs.ok, rendered.variant, mode, images, stokes, stokes_std
+        intensity, std, inputs.ok, rendered.variant, mode, images, stokes, stokes_std, outside
     )
 
 
@@ -294,7 +299,7 @@ def _single_in_processes(
     keep: list[int],
     workers: int,
     polarization: bool = False,
-) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, dict]:
+) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, dict, NDArray[np.float64] | None]:
     import itertools
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
@@ -307,11 +312,12 @@ def _single_in_processes(
     with ProcessPoolExecutor(len(jobs), mp_context=mp.get_context("spawn")) as pool:
         parts = list(pool.map(_single_chunk, jobs))
     images = {}
-    for a, (_, _, imgs) in zip(bounds[:-1], parts, strict=True):
+    for a, (_, _, imgs, _) in zip(bounds[:-1], parts, strict=True):
         for k, img in imgs.items():
             images[int(a) + k] = img
     linear = np.concatenate([p[1] for p in parts]) if polarization else None
-    return np.concatenate([p[0] for p in parts]), linear, images
+    outside = None if parts[0][3] is None else np.concatenate([p[3] for p in parts])
+    return np.concatenate([p[0] for p in parts]), linear, images, outside
 
 
 def material_contributions(

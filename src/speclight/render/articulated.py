@@ -115,6 +115,10 @@ def _place(out: RenderResult, res: RenderResult, idx: NDArray[np.int64]) -> None
     if out.stokes_W_sr_nm is not None and out.stokes_std_W_sr_nm is not None:
         out.stokes_W_sr_nm[idx] = res.stokes_W_sr_nm
         out.stokes_std_W_sr_nm[idx] = res.stokes_std_W_sr_nm
+    if res.outside_support_W_sr_nm is not None:
+        if out.outside_support_W_sr_nm is None:
+            out.outside_support_W_sr_nm = np.zeros_like(out.intensity_W_sr_nm)
+        out.outside_support_W_sr_nm[idx] = res.outside_support_W_sr_nm
     out.variant, out.mode = res.variant, res.mode
     for j, img in res.images.items():
         img.epoch = int(idx[j])

@@ -1,4 +1,5 @@
-"""Roughness derivatives of the microfacet terms of :mod:`speclight.render.brdf`, analytic.
+"""Roughness derivatives of the microfacet terms of :mod:`speclight.target.microfacet_terms`,
+analytic.
 
 Same formulas, same clipping (Walter, Marschner, Li & Torrance 2007, EGSR,
 doi:10.2312/EGWR/EGSR07/195-206; t = tan^2 of the angle to the normal, ``a`` the roughness):
@@ -23,14 +24,14 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.render.brdf import microfacet_d, smith_g1
+from speclight.target.microfacet_terms import microfacet_d, smith_g1
 
 F64 = NDArray[np.float64]
 Kind = Literal["beckmann", "ggx"]
 
 
 def microfacet_d_dalpha(cos_h: F64, alpha: float, kind: Kind) -> F64:
-    """dD/dalpha [sr-1] of :func:`~speclight.render.brdf.microfacet_d` (module doc)."""
+    """dD/dalpha [sr-1] of :func:`~speclight.target.microfacet_terms.microfacet_d` (module doc)."""
     c2 = np.clip(cos_h, 1e-12, 1.0) ** 2
     tan2 = (1.0 - c2) / c2
     d = microfacet_d(cos_h, alpha, kind)
@@ -40,7 +41,7 @@ def microfacet_d_dalpha(cos_h: F64, alpha: float, kind: Kind) -> F64:
 
 
 def smith_g1_dalpha(cos_v: F64, alpha: float, kind: Kind) -> F64:
-    """dG1/dalpha [1] of :func:`~speclight.render.brdf.smith_g1` (module doc)."""
+    """dG1/dalpha [1] of :func:`~speclight.target.microfacet_terms.smith_g1` (module doc)."""
     c = np.clip(cos_v, 1e-12, 1.0)
     tan = np.sqrt(np.maximum(1.0 - c * c, 0.0)) / c
     if kind == "beckmann":
@@ -56,7 +57,7 @@ def smith_g1_dalpha(cos_v: F64, alpha: float, kind: Kind) -> F64:
 
 
 def microfacet_weight_dalpha(cos_i: F64, cos_o: F64, cos_h: F64, alpha: float, kind: Kind) -> F64:
-    """d/dalpha of :func:`~speclight.render.brdf.microfacet_weight` [sr-1]."""
+    """d/dalpha of :func:`~speclight.target.microfacet_terms.microfacet_weight` [sr-1]."""
     gi, go = smith_g1(cos_i, alpha, kind), smith_g1(cos_o, alpha, kind)
     dgi, dgo = smith_g1_dalpha(cos_i, alpha, kind), smith_g1_dalpha(cos_o, alpha, kind)
     d, dd = microfacet_d(cos_h, alpha, kind), microfacet_d_dalpha(cos_h, alpha, kind)

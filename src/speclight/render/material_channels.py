@@ -58,6 +58,11 @@ class ChannelLayout:
                 self.block[k] = c
                 c += extra
         self.n_channels = c
+        #: (C,) True for the channels of light from outside a measured table's support.
+        self.outside = np.zeros(c, dtype=bool)
+        for k, start in self.block.items():
+            mask = self.bsdfs[k].outside_support()
+            self.outside[start : start + mask.size] = mask
 
 
 def pixel_contributions(
@@ -78,7 +83,7 @@ def pixel_contributions(
         chans.append(np.full(sel.size, k))
         weights.append(w)
         if k in layout.block:
-            r, c, bw = bsdf.block_weights(cos_i[sel], cos_o[sel], cos_d[sel])
+            r, c, bw = bsdf.block_weights(cos_i[sel], cos_o[sel], cos_h[sel], cos_d[sel])
             rows.append(sel[r])
             chans.append(layout.block[k] + c)
             weights.append(bw)

@@ -156,8 +156,11 @@ def build_scene(
                 has_vertex_texcoords=False,
             )
             params = mi.traverse(mesh)
-            params["vertex_positions"] = mi.Float(p.vertices_m.astype(np.float32).ravel())
-            params["faces"] = mi.UInt32(p.faces.astype(np.uint32).ravel())
+            # the buffers' own types: mi.Float / mi.UInt32 in JIT variants, but dynamic arrays
+            # (drjit.scalar.ArrayXf / ArrayXu) in the scalar ones, where mi.Float is one number
+            positions, faces = type(params["vertex_positions"]), type(params["faces"])
+            params["vertex_positions"] = positions(p.vertices_m.astype(np.float32).ravel())
+            params["faces"] = faces(p.faces.astype(np.uint32).ravel())
             params.update()
             path = Path(tmp) / f"part{k}.ply"
             mesh.write_ply(str(path))

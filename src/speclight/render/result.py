@@ -58,6 +58,10 @@ class RenderResult:
         frame (:mod:`speclight.render.polarization`); None unless polarisation was asked.
     stokes_std_W_sr_nm
         (N, L, 3) their Monte Carlo standard errors (zero in single mode).
+    outside_support_W_sr_nm
+        (N, L) the part of ``intensity_W_sr_nm`` reflected by measured tables outside their
+        measured support (their fitted extension, :mod:`speclight.target.brdf_table`);
+        None when no material has a support (no lab table; path mode, which has none).
     """
 
     intensity_W_sr_nm: NDArray[np.float64]
@@ -68,3 +72,4 @@ class RenderResult:
     images: dict[int, RenderImage] = field(default_factory=dict)
     stokes_W_sr_nm: NDArray[np.float64] | None = None
     stokes_std_W_sr_nm: NDArray[np.float64] | None = None
+    outside_support_W_sr_nm: NDArray[np.float64] | None = None

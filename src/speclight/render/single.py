@@ -148,7 +148,7 @@ def render_single(
     on_hits: Callable[..., None] | None = None,
 ) -> tuple[F64, dict[int, RenderImage]]:
     """Intensity (N, L) [W sr-1 nm-1] of valid epochs and the kept images (see module doc)."""
-    intensity, _, images = render_single_polarized(
+    intensity, _, images, _ = render_single_polarized(
         target, sun_dir, obs_dir, irradiance, wavelength_nm, caster, resolution_px, keep,
         on_batch, on_hits, polarization=False,
     )  # fmt: skip
@@ -173,6 +173,20 @@ def channel_sum(
     return np.asarray(total, dtype=float), main, blocks, cos_half
 
 
+def outside_support_sum(w: F64, layout: ChannelLayout, blocks: dict[int, F64]) -> F64 | None:
+    """``sum_c w_c R_c(lambda)`` (N, L) [m² sr-1] over the channels of light from outside a
+    measured table's support (:attr:`ChannelLayout.outside`); None when the target has none."""
+    if not layout.outside.any():
+        return None
+    total = np.zeros((w.shape[0], next(iter(blocks.values())).shape[1]))
+    for k, start in layout.block.items():
+        size = blocks[k].shape[0]
+        mask = layout.outside[start : start + size]
+        if mask.any():
+            total += w[:, start : start + size][:, mask] @ blocks[k][mask]
+    return total
+
+
 def render_single_polarized(
     target: Target,
     sun_dir: F64,
@@ -185,8 +199,10 @@ def render_single_polarized(
     on_batch: Callable[[int], None] | None = None,
     on_hits: Callable[..., None] | None = None,
     polarization: bool = True,
-) -> tuple[F64, F64 | None, dict[int, RenderImage]]:
-    """Intensity (N, L), its linear polarisation Q_s (N, L) [W sr-1 nm-1] and kept images.
+) -> tuple[F64, F64 | None, dict[int, RenderImage], F64 | None]:
+    """Intensity (N, L), its linear polarisation Q_s (N, L) [W sr-1 nm-1], kept images, and
+    the part of the intensity from outside measured tables' support (N, L) [W sr-1 nm-1]
+    (None: no material has a support; :mod:`speclight.target.brdf_table`).
 
     ``Q_s`` is the Stokes Q referenced to the normal of the scattering plane (the plane of
     the Sun and observer directions): positive when the light is polarised perpendicular to
@@ -213,6 +229,9 @@ def render_single_polarized(
     total, main, blocks, cos_half = channel_sum(w, layout, sun_dir, obs_dir, wavelength_nm)
     n_mat = len(layout.mats)
     intensity = irradiance * total
+    outside = outside_support_sum(w, layout, blocks)
+    if outside is not None:
+        outside *= irradiance
     linear = None
     if polarization:  # the block channels (diffuse bases) are unpolarised
         q = [bsdf.linear_factor(cos_half, wavelength_nm) for bsdf in layout.bsdfs]
@@ -248,7 +267,7 @@ def render_single_polarized(
             up_body=kp.up,
             stokes_qu_W_m2_sr_nm=qu,
         )
-    return intensity, linear, images
+    return intensity, linear, images, outside
 
 
 def material_contributions(

@@ -115,11 +115,11 @@ def local_workers(
 ) -> tuple[int, str | None]:
     """Workers of a local cluster: ``requested`` (default: the cores), at most the cores and
     at most as many tasks of ``task_bytes`` (their estimated peak memory) as the memory limit
-    (:func:`speclight.simulate.memory.memory_limit_bytes`) holds; at least one.
+    (:func:`speclight.simulation.memory.memory_limit_bytes`) holds; at least one.
 
     Returns the count and, when it is below what was asked, a one-line note saying why.
     """
-    from speclight.simulate.memory import memory_limit_bytes
+    from speclight.simulation.memory import memory_limit_bytes
 
     cores = os.cpu_count() or 1
     asked = max(1, int(requested or cores))

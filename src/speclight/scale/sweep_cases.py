@@ -29,9 +29,9 @@ from speclight.scenario.builtin_examples import example_names, example_text
 from speclight.scenario.dotted_fields import Path_, set_field
 from speclight.scenario.engines import check_engines
 from speclight.scenario.load import data_path
-from speclight.simulate.geometry_stage import time_grid
-from speclight.simulate.memory import check_run_limits, grid_epochs
-from speclight.simulate.radiometry import wavelength_grid_nm
+from speclight.simulation.geometry_stage import time_grid
+from speclight.simulation.memory import check_run_limits, grid_epochs
+from speclight.simulation.radiometry import wavelength_grid_nm
 
 
 @dataclass(frozen=True)

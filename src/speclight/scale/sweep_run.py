@@ -24,15 +24,15 @@ from typing import Any
 import numpy as np
 
 from speclight.errors import InputError
+from speclight.io.store_io import check_free_space, store_lock, store_writes
 from speclight.orbit.orbit_sources import file_keys
 from speclight.scale import sweep_store as store
 from speclight.scale.executor import open_executor
-from speclight.scale.store_io import check_free_space, store_lock, store_writes
 from speclight.scale.sweep_cases import CaseTask, SweepPlan
 from speclight.scale.worker_cache import worker_cached
 from speclight.scenario import LoadedScenario, parse_scenario
 
-#: Scenario sections the geometry stage reads (``simulate.geometry_stage``).
+#: Scenario sections the geometry stage reads (``simulation.geometry_stage``).
 GEOMETRY_SECTIONS = {"time", "observer", "orbit", "attitude"}
 
 Task = Callable[[CaseTask], dict[str, np.ndarray]]
@@ -79,8 +79,8 @@ def _geometry_key(loaded: LoadedScenario) -> str:
 def run_case(task: CaseTask) -> dict[str, np.ndarray]:
     """One case through the pipeline: ``count_rate``, ``ab_magnitude`` (and
     ``count_rate_measured`` with noise; ``intensity``, ``spectral_flux`` with spectra)."""
-    from speclight.simulate import simulate
-    from speclight.simulate.geometry_stage import scenario_geometry
+    from speclight.simulation import simulate
+    from speclight.simulation.geometry_stage import scenario_geometry
 
     loaded = parse_scenario(task.yaml_text, source=task.source, base_dir=Path(task.base_dir))
     try:

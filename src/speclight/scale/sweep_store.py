@@ -38,7 +38,7 @@ import numpy as np
 from speclight import schema
 from speclight.errors import InputError
 from speclight.io import zarr_store_path
-from speclight.scale.store_io import readable
+from speclight.io.store_io import readable
 from speclight.scale.sweep_cases import SweepPlan
 
 FIELD = "--output"
@@ -332,7 +332,7 @@ def states(group: Any) -> np.ndarray:
 
 def damaged_cases(group: Any, cases: np.ndarray) -> list[int]:
     """Cases among ``cases`` (marked done) whose per-case arrays do not read back (a chunk
-    file cut short: :func:`speclight.scale.store_io.readable`); the caller runs them again."""
+    file cut short: :func:`speclight.io.store_io.readable`); the caller runs them again."""
     arrays = [group[name] for name in (*CURVES, *SPECTRA) if name in group]
     bad: list[int] = []
     for lo in range(0, cases.size, SMALL_CHUNK):  # a block at once, one by one where it fails

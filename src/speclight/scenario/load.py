@@ -150,7 +150,7 @@ def scenario_yaml(scenario: Scenario) -> str:
 def _check_map_file(loaded: LoadedScenario) -> None:
     """``render.mode: map``: the map opens, is complete, matches the grid and bands, and
     serves the lasers (:mod:`speclight.scenario.map_lasers`)."""
-    from speclight.render.map_lookup import check_map_matches, read_header
+    from speclight.maps.map_lookup import check_map_matches, read_header
     from speclight.scenario.map_lasers import check_map_lasers
     from speclight.wavelength_grid import grid_from_range_nm
 

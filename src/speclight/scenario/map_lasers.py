@@ -1,4 +1,4 @@
-"""Load-time checks of lasers in ``render: {mode: map}`` (``speclight.simulate.map_ranging``).
+"""Load-time checks of lasers in ``render: {mode: map}`` (``speclight.simulation.map_ranging``).
 
 A map-mode scenario with lasers needs a map that holds the coaxial returns: phase angle 0,
 ``range_offset`` and ``range_histogram`` (made by ``speclight reflectivity-map`` with
@@ -17,7 +17,7 @@ import numpy as np
 from speclight.errors import InputError
 
 if TYPE_CHECKING:
-    from speclight.render.map_lookup import MapHeader
+    from speclight.maps.map_lookup import MapHeader
     from speclight.scenario.scenario_model import Scenario
 
 #: A laser within this distance of the observer is coaxial for a map: its phase angle is

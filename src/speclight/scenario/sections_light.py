@@ -150,6 +150,16 @@ class Material(Strict):
         description="Measured BRDF: a shipped table name, a CSV file "
         "(columns phi_i theta_i phi_o theta_o brdf) or a spectral RGL .bsdf file",
     )
+    extension: str | None = Field(
+        default=None,
+        description="Measured lab table: the analytic model fitted to it that holds outside "
+        "its support (microfacet, phong, abg, binomial; default microfacet)",
+    )
+    coefficients: dict[str, Any] | None = Field(
+        default=None,
+        description="Analytic models (phong, abg, binomial, microfacet): their coefficients "
+        "(docs/brdf-models.md; speclight brdf-fit writes them)",
+    )
 
     @model_validator(mode="after")
     def _params(self) -> Material:
@@ -441,7 +451,7 @@ class Atmosphere(Strict):
     @property
     def params(self) -> Any:
         """The validated :class:`speclight.atmosphere.params.AtmosphereParams` (paths as
-        written; :func:`speclight.simulate.radiometry.atmosphere_params` resolves them)."""
+        written; :func:`speclight.simulation.radiometry.atmosphere_params` resolves them)."""
         return self._params
 
 

@@ -10,7 +10,7 @@ speclight needs (STYLE.md item 13, as colour's method registries and pvlib's
 * rendering (:mod:`speclight.render.bsdfs`, one module per model): which render modes
   support it, in which its polarisation is modelled, how the single mode splits it into
   channels (geometric weight times spectral factor), which engines it needs;
-* the output's provenance (:mod:`speclight.simulate.input_hashes`): which parameters name a
+* the output's provenance (:mod:`speclight.simulation.input_hashes`): which parameters name a
   file whose bytes are hashed (:func:`bsdf_file_parameters`);
 * messages and ``docs/scenario.md`` (its model table is checked against this one).
 
@@ -22,54 +22,46 @@ agreement where it supports both modes.
 
 A model whose support depends on its parameters (``measured``: a lab table or an RGL
 ``.bsdf`` file) has one entry per *form*; :func:`bsdf_model` picks the form that applies.
+
+The analytic models fitted to measured tables (``phong``, ``abg``, ``binomial``,
+``microfacet``; ``speclight brdf-fit``) take one parameter, ``coefficients``, a mapping
+checked by :mod:`speclight.target.brdf_fit.form_coefficients`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from collections.abc import Mapping
+from functools import cache
 from types import MappingProxyType
 from typing import Any, Literal
 
 from speclight.errors import InputError, did_you_mean
-from speclight.target.brdf_table import load_brdf_table
+from speclight.target.brdf_fit.directional_albedo import warn_if_creating_energy
+from speclight.target.brdf_fit.form_coefficients import (
+    FORMS,
+    FrozenCoefficients,
+    coefficient_problem,
+    evaluate,
+)
+from speclight.target.brdf_table import DEFAULT_EXTENSION, EXTENSIONS, load_brdf_table
+from speclight.target.bsdf_model_types import BsdfModel, BsdfParameter
 from speclight.target.rgl_file import check_rgl_material, is_rgl_path
 
 #: The ``bsdf`` names (written out for type checkers; a test checks it against the table).
-BsdfName = Literal["lambertian", "beckmann", "ggx", "plastic", "specular", "measured"]
+BsdfName = Literal[
+    "lambertian",
+    "beckmann",
+    "ggx",
+    "plastic",
+    "specular",
+    "measured",
+    "phong",
+    "abg",
+    "binomial",
+    "microfacet",
+]
 #: Largest accepted microfacet roughness alpha (RMS slope); beyond ~1 the models lose meaning.
 MAX_ROUGHNESS = 1.0
-
-
-@dataclass(frozen=True)
-class BsdfParameter:
-    """A material parameter that some models take (a key of the scenario's material).
-
-    Attributes
-    ----------
-    name
-        The key (and :class:`~speclight.target.Material` field).
-    meaning
-        What it is, with its unit and range, for messages and docs.
-    bounds
-        ``(low, high)``: the value must lie in (low, high] (numbers only); None: no range.
-    names_file
-        The value may name a file (its SHA-256 goes into the output's ``input_files``).
-    """
-
-    name: str
-    meaning: str
-    bounds: tuple[float, float] | None = None
-    names_file: bool = False
-
-    def range_problem(self, value: Any) -> str | None:
-        """Why ``value`` is out of :attr:`bounds` (None when it is inside)."""
-        if self.bounds is None:
-            return None
-        low, high = self.bounds
-        if not low < float(value) <= high:
-            return f"{self.name} = {value!r} must lie in ({low:g}, {high:g}] ({self.meaning})"
-        return None
 
 
 ROUGHNESS = BsdfParameter(
@@ -87,73 +79,20 @@ BRDF_TABLE = BsdfParameter(
     "spectral RGL .bsdf file",
     names_file=True,
 )
+EXTENSION = BsdfParameter(
+    "extension",
+    f"the analytic model fitted to a lab table that holds outside its measured support: "
+    f"{', '.join(EXTENSIONS)} (default {DEFAULT_EXTENSION})",
+)
+COEFFICIENTS = BsdfParameter(
+    "coefficients",
+    "the analytic model's coefficients, a mapping (docs/brdf-models.md; speclight brdf-fit "
+    "writes them)",
+)
 #: Every parameter some model takes, by name.
 PARAMETERS: Mapping[str, BsdfParameter] = MappingProxyType(
-    {p.name: p for p in (ROUGHNESS, DIFFUSE_REFLECTANCE, BRDF_TABLE)}
+    {p.name: p for p in (ROUGHNESS, DIFFUSE_REFLECTANCE, BRDF_TABLE, EXTENSION, COEFFICIENTS)}
 )
-
-
-@dataclass(frozen=True)
-class BsdfModel:
-    """One BSDF model (or one form of it, see the module docstring).
-
-    Attributes
-    ----------
-    name
-        The ``bsdf`` value.
-    summary
-        One line: what it models, with its reference.
-    reflectance
-        What the material's ``reflectance`` means for it.
-    required, optional
-        Parameters it needs / may take (any other given is an error).
-    reflectance_kinds
-        The :class:`~speclight.target.Reflectance` kinds it accepts (None: any).
-    reflectance_default
-        The ``reflectance`` a Python spec may leave out (None: it must be given).
-    modes
-        Render modes that support it (``single``, ``path``).
-    polarized_modes
-        Render modes in which its polarisation is modelled (``render.polarization``).
-    channels
-        How the single mode splits it: geometric weight(s) [sr-1] times spectral factor(s).
-    engines
-        Optional engines it needs in every mode: ``(engine, key)``, the engine's name in
-        :data:`speclight.engine_packages.ENGINES` and the material key that asks for it.
-    examples
-        Representative parameters (scenario material mappings) for docs and the contract test.
-    form
-        For a model with several forms, which one this is ("" otherwise).
-    select
-        For a model with several forms: the form for given parameter values.
-    check
-        A further check of a built material (reads files): ``check(material, field)``.
-    """
-
-    name: str
-    summary: str
-    reflectance: str
-    required: tuple[BsdfParameter, ...] = ()
-    optional: tuple[BsdfParameter, ...] = ()
-    reflectance_kinds: tuple[str, ...] | None = None
-    reflectance_default: float | None = None
-    modes: tuple[str, ...] = ("single", "path")
-    polarized_modes: tuple[str, ...] = ()
-    channels: str = ""
-    engines: tuple[tuple[str, str], ...] = ()
-    examples: tuple[Mapping[str, Any], ...] = ()
-    form: str = ""
-    select: Callable[[Mapping[str, Any]], BsdfModel] | None = field(default=None, repr=False)
-    check: Callable[[Any, str], None] | None = field(default=None, repr=False)
-
-    @property
-    def label(self) -> str:
-        """``name`` or ``name (form)``: for messages and test ids."""
-        return f"{self.name} ({self.form})" if self.form else self.name
-
-    def takes(self, parameter: str) -> bool:
-        """True when the model needs or may take ``parameter``."""
-        return any(p.name == parameter for p in (*self.required, *self.optional))
 
 
 def _check_rgl(material: Any, where: str) -> None:
@@ -161,9 +100,10 @@ def _check_rgl(material: Any, where: str) -> None:
 
 
 def _read_lab_table(material: Any, where: str) -> None:
-    """Read the lab table now (it is cached), not halfway through a render."""
+    """Read the lab table and fit its extension now (both cached), not halfway through a
+    render."""
     try:
-        load_brdf_table(str(material.brdf_table))
+        load_brdf_table(str(material.brdf_table), material.extension or DEFAULT_EXTENSION)
     except InputError as exc:
         raise InputError(exc.message, source=exc.source, field=f"{where}.brdf_table") from None
 
@@ -191,13 +131,20 @@ def _microfacet(distribution: str, label: str) -> BsdfModel:
 MEASURED_TABLE = BsdfModel(
     "measured",
     "a measured BRDF table f(theta_h, theta_d) (lab tables measured in the plane of incidence; "
-    "Romeiro et al. 2008, doi:10.1007/978-3-540-88693-8_63)",
+    "Romeiro et al. 2008, doi:10.1007/978-3-540-88693-8_63) inside its support, an analytic "
+    "model fitted to it outside",
     "a scale R(lambda) / R(table wavelength) (1: as measured)",
     required=(BRDF_TABLE,),
+    optional=(EXTENSION,),
+    reflectance_kinds=("constant", "table"),
     reflectance_default=1.0,
     modes=("single",),
-    channels="one: f(theta_h, theta_d) cos theta_i x R(lambda) / R(table wavelength)",
-    examples=({"bsdf": "measured", "brdf_table": "starlink_v1p5_chassis_532nm"},),
+    channels="1 + 1: the table f(theta_h, theta_d) cos theta_i inside its support, the "
+    "extension f cos theta_i outside it; both x R(lambda) / R(table wavelength)",
+    examples=(
+        {"bsdf": "measured", "brdf_table": "starlink_v1p5_chassis_532nm"},
+        {"bsdf": "measured", "brdf_table": "starlink_v1p5_solar_array_532nm", "extension": "abg"},
+    ),
     form="lab table",
     check=_read_lab_table,
 )
@@ -215,6 +162,83 @@ MEASURED_RGL = BsdfModel(
     form="RGL .bsdf file",
     check=_check_rgl,
 )
+
+
+@cache
+def _albedo_checked(name: str, coefficients: FrozenCoefficients, label: str) -> None:
+    """Warn (once per model, coefficients and material) when they create energy."""
+    warn_if_creating_energy(
+        label,
+        lambda *c: evaluate(name, coefficients, *c),
+        "check its coefficients (speclight brdf-fit holds a fit to at most 1)",
+    )
+
+
+def _check_energy(material: Any, where: str) -> None:
+    """A notice when a material's analytic BRDF reflects more than it receives."""
+    if isinstance(material.coefficients, FrozenCoefficients):
+        label = f"{where} (bsdf {material.bsdf})"
+        _albedo_checked(material.bsdf, material.coefficients, label)
+
+
+def _analytic(name: str, summary: str, *examples: Mapping[str, Any]) -> BsdfModel:
+    """An analytic model; an example with a ``reflectance`` key is taken as a whole."""
+    return BsdfModel(
+        name,
+        summary,
+        "a scale R(lambda) / R(coefficients.wavelength_nm) (1: as fitted)",
+        required=(COEFFICIENTS,),
+        reflectance_kinds=("constant", "table"),
+        reflectance_default=1.0,
+        channels="one: f cos theta_i x R(lambda) / R(coefficients.wavelength_nm)",
+        examples=tuple(
+            dict(e) if "reflectance" in e else {"bsdf": name, "coefficients": dict(e)}
+            for e in examples
+        ),
+        check=_check_energy,
+    )
+
+
+_ANALYTIC = (
+    _analytic(
+        "phong",
+        "energy-normalised Phong lobe about the mirror direction and a diffuse term "
+        "(Lafortune & Willems 1994; lumos-sat's PHONG)",
+        {"kd": 0.2, "ks": 0.5, "n": 30.0},
+        {  # coloured: scaled by R(lambda) / R(532 nm)
+            "bsdf": "phong",
+            "coefficients": {"kd": 0.2, "ks": 0.5, "n": 30.0, "wavelength_nm": 532.0},
+            "reflectance": {"wavelength_nm": [400.0, 1000.0], "value": [0.6, 0.4]},
+        },
+    ),
+    _analytic(
+        "abg",
+        "Harvey's ABg scatter A / (B + x^g), x the distance between the view and mirror "
+        "directions projected on the surface (Harvey 1976, doi:10.1117/12.954861; Zemax; "
+        "lumos-sat's ABG)",
+        {"a": 9.737e-5, "b": 8.448e-6, "g": 2.686},  # Kandula et al. 2025's boom
+    ),
+    _analytic(
+        "binomial",
+        "Greynolds' binomial model (Greynolds 2015, doi:10.1117/12.2196071; the form lumos-sat "
+        "fits to the Starlink tables)",
+        {"b": [[0.5, 0.0]], "c": [[0.0] * 9 + [-2.0]], "d": 3.0, "l1": -5},
+    ),
+    _analytic(
+        "microfacet",
+        "a diffuse term and a GGX or Beckmann lobe with Schlick's or the exact Fresnel term "
+        "(Walter et al. 2007, doi:10.2312/EGWR/EGSR07/195-206)",
+        {"diffuse": 0.2, "f0": 0.5, "roughness": 0.2, "distribution": "ggx"},
+        {
+            "diffuse": 0.1,
+            "f0": 0.04,
+            "roughness": 0.3,
+            "distribution": "beckmann",
+            "fresnel": "exact",
+        },
+    ),
+)
+assert tuple(m.name for m in _ANALYTIC) == tuple(FORMS)
 
 _MODELS = (
     BsdfModel(
@@ -271,6 +295,7 @@ _MODELS = (
             MEASURED_RGL if is_rgl_path(given.get("brdf_table")) else MEASURED_TABLE
         ),
     ),
+    *_ANALYTIC,
 )
 #: The models by ``bsdf`` name.
 BSDF_MODELS: Mapping[str, BsdfModel] = MappingProxyType({m.name: m for m in _MODELS})
@@ -337,6 +362,18 @@ def parameter_problems(
                 f"got a {reflectance_kind} reflectance",
             )
         )
+    coefficients = given.get("coefficients")
+    spectral = reflectance_kind not in (None, "constant")
+    if name in FORMS and spectral and isinstance(coefficients, Mapping):
+        if "wavelength_nm" not in coefficients:
+            problems.append(
+                (
+                    "reflectance",
+                    f"a spectral reflectance of bsdf '{name}' is normalised at "
+                    "coefficients.wavelength_nm, which is not given; give it, or a constant "
+                    "reflectance",
+                )
+            )
     return problems
 
 
@@ -347,6 +384,12 @@ def _parameter_problem(model: BsdfModel, p: BsdfParameter, value: Any) -> str | 
     if not model.takes(p.name):
         users = ", ".join(m.name for m in _MODELS if m.takes(p.name))
         return f"{p.name} is not used by bsdf '{model.name}'; remove it (used by: {users})"
+    if p is COEFFICIENTS:
+        return coefficient_problem(model.name, value)
+    if p is EXTENSION and value not in EXTENSIONS:
+        return f"extension = {value!r}{did_you_mean(str(value), EXTENSIONS)} must be one of " + (
+            ", ".join(EXTENSIONS)
+        )
     return p.range_problem(value)
 
 

@@ -2,7 +2,8 @@
 
 Accepted forms (docs/scenario.md): ``reflectance`` is a number, ``{file: path}``,
 ``{wavelength_nm: [...], value: [...]}``, ``{conductor: Al}`` or ``{dielectric: SiO2}``;
-a material is ``{bsdf, reflectance, roughness?, diffuse_reflectance?, brdf_table?}``; a shape is
+a material is ``{bsdf, reflectance, roughness?, diffuse_reflectance?, brdf_table?, extension?,
+coefficients?}``; a shape is
 ``{builtin: sphere|plate|cube|cylinder|box_wing|bus_array, ...sizes}`` or
 ``{mesh_file: path}`` (or a list of PLY files). Unknown keys are errors with a did-you-mean.
 """
@@ -106,6 +107,8 @@ def material_from_spec(
             diffuse, field=f"{field}.diffuse_reflectance", base_dir=base_dir
         ),
         brdf_table=None if table is None else str(table),
+        extension=spec.get("extension"),
+        coefficients=spec.get("coefficients"),
     )
 
 

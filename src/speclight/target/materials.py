@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 from speclight.errors import InputError
+from speclight.target.brdf_fit.form_coefficients import FrozenCoefficients
 from speclight.target.bsdf_models import (
     BSDF_NAMES,
     MAX_ROUGHNESS,
@@ -34,8 +37,10 @@ class Material:
         (rough surface, Cook-Torrance microfacet model with that normal distribution,
         Walter et al. 2007,
         doi:10.2312/EGWR/EGSR07/195-206), ``specular`` (smooth mirror), ``plastic`` (diffuse
-        base under a dielectric coat: smooth, or Beckmann-rough when ``roughness`` is given) or
-        ``measured`` (tabulated BRDF, see :mod:`speclight.target.brdf_table`).
+        base under a dielectric coat: smooth, or Beckmann-rough when ``roughness`` is given),
+        ``measured`` (tabulated BRDF, see :mod:`speclight.target.brdf_table`), or an analytic
+        model fitted to a table, ``phong``, ``abg``, ``binomial``, ``microfacet``
+        (:mod:`speclight.target.brdf_fit`, docs/brdf-models.md).
     reflectance
         Spectral reflectance: the albedo of a Lambertian surface, the Fresnel term of the
         microfacet and mirror models (angle dependent for n,k kinds).
@@ -49,6 +54,14 @@ class Material:
         A path ending in ``.bsdf`` is an RGL measured material (Mitsuba's ``measured``
         plugin, :mod:`speclight.target.rgl_file`): isotropic files only, checked on creation;
         its ``reflectance`` must be a constant scale factor in (0, 1] (1: as measured).
+    extension
+        ``measured`` lab tables: the analytic model fitted to the table that holds outside
+        its measured support (:data:`speclight.target.brdf_table.EXTENSIONS`; None: the
+        default, :data:`~speclight.target.brdf_table.DEFAULT_EXTENSION`).
+    coefficients
+        The analytic models' coefficients (a mapping, e.g. ``{"kd": 0.1, "ks": 0.4, "n":
+        30}``; :mod:`speclight.target.brdf_fit.form_coefficients`); their ``reflectance``
+        scales them by ``R(lambda) / R(coefficients["wavelength_nm"])`` (1 for a constant).
     """
 
     name: str
@@ -57,6 +70,8 @@ class Material:
     roughness: float | None = None
     diffuse_reflectance: Reflectance | None = None
     brdf_table: str | None = None
+    extension: str | None = None
+    coefficients: Mapping[str, Any] | None = None
 
     def __post_init__(self) -> None:
         field = f"target.materials.{self.name}"
@@ -70,6 +85,8 @@ class Material:
         if problems:
             key, message = problems[0]
             raise InputError(message, field=f"{field}.{key}")
+        if isinstance(self.coefficients, Mapping):  # checked: now an immutable copy
+            object.__setattr__(self, "coefficients", FrozenCoefficients(self.coefficients))
         check = self.model.check
         if check is not None:  # reads the material's file (an RGL .bsdf)
             check(self, field)

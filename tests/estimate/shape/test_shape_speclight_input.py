@@ -13,7 +13,7 @@ from speclight.estimate.shape import read_shape_input
 from speclight.estimate.shape.ecliptic import julian_date, pole_vector
 from speclight.io.netcdf import write_dataset
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
+from speclight.simulation import simulate
 
 
 def test_speclight_input_geometry(tmp_path):

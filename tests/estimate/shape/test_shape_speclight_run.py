@@ -20,8 +20,8 @@ from speclight.estimate.shape.ecliptic import (
 )
 from speclight.io.netcdf import write_dataset
 from speclight.scenario import example_text, parse_scenario
-from speclight.simulate import simulate
-from speclight.simulate.geometry_stage import attitude_quaternions
+from speclight.simulation import simulate
+from speclight.simulation.geometry_stage import attitude_quaternions
 
 PERIOD_S = 40.0
 MATERIALS = {"+x": "white_paint", "-x": "white_paint", "+y": "kapton_mli",

@@ -11,8 +11,8 @@ times its albedo in each band, the spectrum of each facet.
 
 Per-facet unmixing (:func:`facet_materials`): each facet's band spectrum split into the
 scenario's materials by non-negative least squares against their band signatures
-(:func:`speclight.estimate.endmember_spectra.endmembers_from_scenario`, the unmixing of
-``speclight unmix``, :func:`speclight.estimate.unmixing.unmix`): with the Lambert law the
+(:func:`speclight.estimate.spectra.endmember_spectra.endmembers_from_scenario`, the unmixing of
+``speclight unmix``, :func:`speclight.estimate.spectra.unmixing.unmix`): with the Lambert law the
 band spectrum is the facet's area times its band albedos, so the result is each
 material's area on the facet [m2].
 """
@@ -29,7 +29,7 @@ from speclight.estimate.shape.convex_fit import ConvexSolution
 from speclight.estimate.shape.convex_model import N_ROTATION, ConvexModel
 
 if TYPE_CHECKING:
-    from speclight.estimate.scenario_bands import BandResponses
+    from speclight.estimate.inputs.band_responses import BandResponses
     from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
@@ -71,14 +71,14 @@ def facet_materials(
     facet_band_area: F64, loaded: LoadedScenario, bands: BandResponses
 ) -> tuple[list[str], F64]:
     """Material names (M,) and each facet's area of each material (K, M) (module doc)."""
-    from speclight.estimate.endmember_spectra import endmembers_from_scenario
-    from speclight.estimate.unmixing import unmix
+    from speclight.estimate.spectra.endmember_spectra import endmembers_from_scenario
+    from speclight.estimate.spectra.unmixing import unmix
 
     ends = endmembers_from_scenario(loaded, bands)
     if len(ends.names) > facet_band_area.shape[1]:
         raise InputError(
             f"{len(ends.names)} distinct materials cannot be unmixed from "
             f"{facet_band_area.shape[1]} bands (give at least as many bands as materials)",
-            field="--bands",
+            field="bands",
         )
     return ends.names, unmix(facet_band_area, ends.signatures, "nnls").abundance

@@ -16,9 +16,10 @@ doi:10.1006/icar.2001.6674):
   Lambert weight ``c`` (0.1 by default, as convexinv).
 
 For satellites, ``material``: one of speclight's own BRDF models (``lambertian``,
-``beckmann``, ``ggx``, ``measured``) through the render stage's material evaluation
-(:func:`speclight.render.material_channels.main_weight` and ``main_factor``, the same
-functions the single-scattering render uses per pixel), at one wavelength; its derivatives
+``beckmann``, ``ggx``, ``measured``, and the analytic ``phong``, ``abg``, ``binomial``,
+``microfacet``) through the render stage's material evaluation
+(:meth:`speclight.render.bsdfs.MaterialBsdf.fcos`: every channel, as the single-scattering
+render sums them per pixel), at one wavelength; its derivatives
 by central differences of step :data:`MATERIAL_STEP` (the microfacet lobes have no
 closed-form derivative in the cosines here).
 """
@@ -36,7 +37,16 @@ from speclight.target.materials import Material
 
 F64 = NDArray[np.float64]
 LAW_NAMES = ("lambert", "lommel-seeliger", "ls-lambert")
-MATERIAL_BSDFS = ("lambertian", "beckmann", "ggx", "measured")
+MATERIAL_BSDFS = (
+    "lambertian",
+    "beckmann",
+    "ggx",
+    "measured",
+    "phong",
+    "abg",
+    "binomial",
+    "microfacet",
+)
 #: Step of the central differences of a material law in mu0 and mu [1].
 MATERIAL_STEP = 1e-5
 #: A floor of ``mu0 + mu`` in the Lommel-Seeliger term, whose numerator is then 0 [1].
@@ -111,10 +121,11 @@ class MaterialLaw:
         chp_safe = np.where(chp > 1e-9, chp, 1e-9)
         cos_h = np.clip((mu0 + mu) / (2.0 * chp_safe), -1.0, 1.0)
         flat = [np.ravel(x) for x in (mu0, mu, cos_h, chp)]
-        weight = bsdf.main_weight(flat[0], flat[1], flat[2], flat[3], np.zeros_like(flat[0]))
-        factor = bsdf.main_factor(flat[3], np.array([self.wavelength_nm]))[:, 0]
+        # every channel (a lab table's extension is a block channel beside its main one)
+        wl = np.array([self.wavelength_nm])
+        fcos = bsdf.fcos(flat[0], flat[1], flat[2], flat[3], np.zeros_like(flat[0]), wl)[:, 0]
         lit = (flat[0] > 0) & (flat[1] > 0)
-        return np.where(lit, flat[1] * weight * factor, 0.0).reshape(mu0.shape)
+        return np.where(lit, flat[1] * fcos, 0.0).reshape(mu0.shape)
 
     def __call__(self, mu0: F64, mu: F64, cos_half_phase: F64) -> tuple[F64, F64, F64]:
         h = MATERIAL_STEP

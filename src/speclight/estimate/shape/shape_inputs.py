@@ -2,12 +2,12 @@
 geometry of their scenario.
 
 speclight input (``fmt="speclight"``): MEASURED (a speclight NetCDF or a CSV of count rates,
-:func:`speclight.estimate.measured.read_measured`) becomes band reflectance factors [m2 sr-1]
-(:func:`speclight.estimate.unmix_inputs.read_reflectance_factors`: the rates over the
+:func:`speclight.estimate.inputs.measured.read_measured`) becomes band reflectance factors [m2 sr-1]
+(:func:`speclight.estimate.inputs.reflectance_factors.read_reflectance_factors`: the rates over the
 aperture, the range squared, the Sun and the atmosphere: eq. 5 of Nussbaum et al. 2022), calibrated
 photometry that no longer depends on the distance. The geometry at the measured epochs comes
 from the scenario (the one given, else the one a NetCDF carries) through the pipeline's own
-:func:`speclight.simulate.geometry_stage.scenario_geometry`: the Sun's and the observer's
+:func:`speclight.simulation.geometry_stage.scenario_geometry`: the Sun's and the observer's
 directions at the target (GCRS, rotated to ecliptic J2000), and the epochs moved back by
 the light time ``range / c`` (the light left the target then). Each pass (points closer than
 :data:`PASS_GAP_S`) is one light curve; the brightness fitted is the mean factor over the
@@ -35,7 +35,7 @@ from speclight.estimate.shape.inversion_data import (
 )
 
 if TYPE_CHECKING:
-    from speclight.estimate.scenario_bands import BandResponses
+    from speclight.estimate.inputs.band_responses import BandResponses
     from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
@@ -108,18 +108,21 @@ def _speclight_input(
     import xarray as xr
 
     from speclight.attitude.quaternion import quat_rotate
-    from speclight.estimate.measured import read_measured
-    from speclight.estimate.unmix_inputs import dataset_scenario, read_reflectance_factors
-    from speclight.simulate.geometry_stage import scenario_geometry
+    from speclight.estimate.inputs.measured import read_measured
+    from speclight.estimate.inputs.reflectance_factors import (
+        dataset_scenario,
+        read_reflectance_factors,
+    )
+    from speclight.simulation.geometry_stage import scenario_geometry
 
     src = str(path)
     is_nc = path.suffix.lower() in (".nc", ".nc4", ".netcdf", ".h5")
     if loaded is None:
         if not is_nc:
             raise InputError(
-                f"{src} is a CSV of count rates: give --scenario SCENARIO.yaml "
+                f"{src} is a CSV of count rates: give loaded=SCENARIO "
                 "(the geometry and the instrument)",
-                field="--scenario",
+                field="loaded",
             )
         with xr.open_dataset(path, engine="h5netcdf") as ds:
             loaded = dataset_scenario(ds, src)
@@ -131,7 +134,7 @@ def _speclight_input(
         if b not in names:
             raise InputError(
                 f"band '{b}'{did_you_mean(b, names)} is not measured (bands: {', '.join(names)})",
-                field="--bands",
+                field="bands",
             )
     idx = [names.index(b) for b in chosen]
     factor = factors.factor[:, idx]

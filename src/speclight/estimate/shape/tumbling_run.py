@@ -29,7 +29,7 @@ def _prior(inputs: ShapeInput, t0_jd: float) -> list[TumblingState]:
     from speclight.attitude.quaternion import quat_from_matrix, quat_multiply
     from speclight.estimate.shape.ecliptic import julian_date
     from speclight.scenario.sections_geometry import TorqueFreeAttitude
-    from speclight.simulate.geometry_stage import _orientation
+    from speclight.simulation.geometry_stage import _orientation
 
     assert inputs.loaded is not None
     sc = inputs.loaded.scenario
@@ -62,10 +62,10 @@ def tumbling_fit(
     """Fit the torque-free state of the scenario's target to ``inputs`` (module doc)."""
     if inputs.loaded is None or inputs.loaded.scenario.target is None:
         raise InputError(
-            "tumbling states need a scenario with a target (its mesh is the EGI): give --scenario",
-            field="--tumbling-starts",
+            "tumbling states need a scenario with a target (its mesh is the EGI): give `loaded`",
+            field="n_starts",
         )
-    from speclight.simulate.reflection import build_target
+    from speclight.simulation.reflection import build_target
 
     target = build_target(inputs.loaded)
     normals, areas = mesh_facets(

@@ -14,6 +14,7 @@ from types import MappingProxyType
 from typing import Any
 
 from speclight.errors import InputError
+from speclight.render.bsdfs.bsdf_analytic import AnalyticBsdf
 from speclight.render.bsdfs.bsdf_interface import MaterialBsdf
 from speclight.render.bsdfs.bsdf_lambertian import LambertianBsdf
 from speclight.render.bsdfs.bsdf_measured import MeasuredRglBsdf, MeasuredTableBsdf
@@ -33,6 +34,10 @@ RENDERERS: Mapping[str, type[MaterialBsdf]] = MappingProxyType(
         "specular": SpecularBsdf,
         MEASURED_TABLE.label: MeasuredTableBsdf,
         MEASURED_RGL.label: MeasuredRglBsdf,
+        "phong": AnalyticBsdf,
+        "abg": AnalyticBsdf,
+        "binomial": AnalyticBsdf,
+        "microfacet": AnalyticBsdf,
     }
 )
 

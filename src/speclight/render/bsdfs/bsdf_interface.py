@@ -75,7 +75,7 @@ class MaterialBsdf:
         cannot be read: the run reports that file itself)."""
         return 0
 
-    def block_weights(self, cos_i: F64, cos_o: F64, cos_d: F64) -> tuple[I64, I64, F64]:
+    def block_weights(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64) -> tuple[I64, I64, F64]:
         """(row into the inputs, channel within the block, weight [sr-1]) of the block."""
         empty = np.zeros(0, np.int64)
         return empty, empty, np.zeros(0)
@@ -83,6 +83,11 @@ class MaterialBsdf:
     def block_factor(self, wavelength_nm: F64) -> F64:
         """Spectral factors (block_size, L) [1] of the block channels."""
         return np.zeros((0, len(wavelength_nm)))
+
+    def outside_support(self) -> NDArray[np.bool_]:
+        """Which block channels carry the light of a measured table's extension, from
+        outside the table's support (:mod:`speclight.target.brdf_table`); none here."""
+        return np.zeros(self.block_size(), dtype=bool)
 
     def entries_per_pixel(self) -> int:
         """Block entries one pixel adds that the single mode's batch budget counts
@@ -104,7 +109,7 @@ class MaterialBsdf:
         out = self.main_weight(cos_i, cos_o, cos_h, cos_d, mirror_ok)[:, None] * self.main_factor(
             cos_d, wavelength_nm
         )
-        rows, chans, w = self.block_weights(cos_i, cos_o, cos_d)
+        rows, chans, w = self.block_weights(cos_i, cos_o, cos_h, cos_d)
         if rows.size:
             blk = self.block_factor(wavelength_nm) if block_factor is None else block_factor
             vals = w[:, None] * blk[chans]
@@ -160,6 +165,32 @@ def fresnel_linear_factor(
     eta = refl.eta(wavelength_nm)
     index = eta.real if real_index else eta
     return linear_factor(finite_cosines(cos_half_phase)[:, None], index[None, :])
+
+
+def normalised_reflectance(
+    refl: Reflectance, reference_nm: float, wavelength_nm: F64, field: str
+) -> F64:
+    """``R(lambda) / R(reference_nm)`` (L,) [1] of a measured or fitted BRDF's
+    ``reflectance`` (1 for a constant); ``field`` names the material in errors.
+
+    Raises
+    ------
+    InputError
+        A spectral reflectance with no reference wavelength (a table that states none), or
+        zero there.
+    """
+    if refl.kind == "constant":
+        return np.ones(len(wavelength_nm))
+    ref = refl.evaluate(np.array([reference_nm]))[0] if np.isfinite(reference_nm) else np.nan
+    if not (np.isfinite(ref) and ref > 0):
+        raise InputError(
+            f"a spectral reflectance is normalised at the wavelength the BRDF was measured "
+            f"(or fitted) at, here {reference_nm:g} nm, where it is {ref:g}: state the "
+            "wavelength ('# lambda = 532 nm' in the table, coefficients.wavelength_nm), or "
+            "give a constant reflectance",
+            field=f"{field}.reflectance",
+        )
+    return np.asarray(refl.evaluate(wavelength_nm) / ref, dtype=float)
 
 
 def spectrum_grid(lo_nm: float, hi_nm: float) -> F64:

@@ -3,9 +3,9 @@
 f = F(theta_d) D(h) G1(i) G1(o) / (4 cos_i cos_o) with the Beckmann or GGX normal
 distribution and the separable Smith masking (Walter et al. 2007, "Microfacet models for
 refraction through rough surfaces", doi:10.2312/EGWR/EGSR07/195-206; the terms in
-:mod:`speclight.render.brdf`), as Mitsuba 3's ``roughconductor``, which path mode uses. The
-Fresnel term F is that of the material's n, k at the half-phase angle, or F = 1 scaled by a
-reflectance given as numbers (Mitsuba's ``material='none'``).
+:mod:`speclight.target.microfacet_terms`), as Mitsuba 3's ``roughconductor``, which path mode
+uses. The Fresnel term F is that of the material's n, k at the half-phase angle, or F = 1
+scaled by a reflectance given as numbers (Mitsuba's ``material='none'``).
 """
 
 from __future__ import annotations
@@ -14,7 +14,6 @@ from typing import Any, Literal, cast
 
 import numpy as np
 
-from speclight.render.brdf import microfacet_weight
 from speclight.render.brdf_gradient import microfacet_weight_dalpha
 from speclight.render.bsdfs.bsdf_interface import (
     F64,
@@ -25,6 +24,7 @@ from speclight.render.bsdfs.bsdf_interface import (
     reflectance_spectrum,
     spectrum_grid,
 )
+from speclight.target.microfacet_terms import microfacet_weight
 from speclight.target.reflectance import Reflectance
 
 Distribution = Literal["beckmann", "ggx"]

@@ -22,7 +22,6 @@ from typing import Any
 
 import numpy as np
 
-from speclight.render.brdf import microfacet_weight
 from speclight.render.bsdfs.bsdf_interface import (
     F64,
     I64,
@@ -36,6 +35,7 @@ from speclight.render.bsdfs.coat_optics import coat_transmittance
 from speclight.render.bsdfs.path_coat import coat_tables, coated_diffuse
 from speclight.render.bsdfs.path_plastic import base_for_mitsuba
 from speclight.render.shading import SUN_SOLID_ANGLE_SR
+from speclight.target.microfacet_terms import microfacet_weight
 from speclight.target.optical_constants import fresnel_reflectance
 
 #: Cosine nodes per axis of the base's (cos theta_i, cos theta_o) binning grid.
@@ -95,7 +95,7 @@ class PlasticBsdf(MaterialBsdf):
     ) -> int:
         return PLASTIC_NODES**2
 
-    def block_weights(self, cos_i: F64, cos_o: F64, cos_d: F64) -> tuple[I64, I64, F64]:
+    def block_weights(self, cos_i: F64, cos_o: F64, cos_h: F64, cos_d: F64) -> tuple[I64, I64, F64]:
         idx, bw = bilinear_nodes(cos_i, cos_o)
         rows = np.repeat(np.arange(len(cos_i)), 4)
         return rows, idx.ravel(), (bw * (cos_i / np.pi)[:, None]).ravel()

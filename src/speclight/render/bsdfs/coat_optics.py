@@ -115,7 +115,7 @@ def rough_coat_albedo(mu: F64, eta: F64, alpha: float, *, transmit: bool) -> F64
     ``T(mu) = int D_wi(m) G1(wt, m) (1 - F(wi.m)) dm`` (refraction into the coat), with the
     distribution of visible normals ``D_wi(m) = G1(wi, m) <wi.m> D(m) / mu`` (Heitz 2014,
     "Understanding the masking-shadowing function", JCGT 3(2), eqs. 38-39) and the separable
-    Smith term of :func:`speclight.render.brdf.smith_g1`; ``eta`` < 1 seen from inside.
+    Smith term of :func:`speclight.target.microfacet_terms.smith_g1`; ``eta`` < 1 seen from inside.
     Integrated over Beckmann microfacet normals with Gauss-Legendre nodes in the normal's
     cumulative distribution (tan^2 theta_m = -alpha^2 ln(1 - u)) and azimuth.
     """

@@ -1,0 +1,99 @@
+"""``speclight shape`` from files to files: SHAPE.nc, the OBJ beside it, the figure.
+
+The outputs are claimed before the run and written atomically (:mod:`speclight.io.output`),
+as every command's: the NetCDF, ``SHAPE.obj`` (the output's name with ``.obj``; only when
+the data constrain a shape) and the figure.
+"""
+
+from __future__ import annotations
+
+from contextlib import ExitStack
+from pathlib import Path
+
+import xarray as xr
+
+from speclight.estimate.shape.minkowski import format_obj
+from speclight.estimate.shape.shape_dataset import shape_dataset
+from speclight.estimate.shape.shape_inputs import check_format, read_shape_input
+from speclight.estimate.shape.shape_run import ShapeOptions, ShapeRun, run_shape
+
+
+def obj_path(output: str | Path) -> Path:
+    """The OBJ file written beside ``output`` (its name with the suffix ``.obj``)."""
+    return Path(output).with_suffix(".obj")
+
+
+def shape_files(
+    *,
+    lc: Path,
+    fmt: str,
+    scenario: Path | None,
+    options: ShapeOptions,
+    output: str,
+    plot: str | None,
+    force: bool,
+    bands: list[str] | None = None,
+    tumbling_starts: int = 0,
+) -> tuple[xr.Dataset, ShapeRun]:
+    """Read ``lc``, invert it, write ``output``, its OBJ and the figure ``plot``.
+
+    Parameters
+    ----------
+    lc
+        The light curves (DAMIT ``.lc``, or speclight's NetCDF / CSV).
+    fmt
+        ``"speclight"`` or ``"damit"``.
+    scenario
+        Scenario YAML (speclight input; a NetCDF's own by default).
+    options
+        The run's options.
+    output, plot
+        SHAPE.nc and the figure (or None).
+    force
+        Overwrite existing outputs.
+    bands
+        Bands averaged into the brightness (default all).
+    tumbling_starts
+        Random starts of the tumbling fit (:mod:`speclight.estimate.shape.tumbling_run`; 0: none).
+    """
+    from speclight.io.netcdf import dataset_bytes
+    from speclight.io.output import OutputClaim
+    from speclight.plot.figure_output import claim_outputs
+
+    check_format(fmt)
+    inputs = {"light curves": lc, **({"scenario file": scenario} if scenario else {})}
+    obj = obj_path(output)
+    with claim_outputs(output, plot, force, inputs) as (claim, figure), ExitStack() as stack:
+        obj_claim = stack.enter_context(
+            OutputClaim(obj, force=force, inputs={**inputs, "output": output})
+        )
+        loaded = None
+        if scenario is not None:
+            from speclight.scenario import load_scenario
+
+            loaded = load_scenario(scenario)
+        data = read_shape_input(lc, fmt, loaded, bands)
+        run = run_shape(data, options)
+        ds = shape_dataset(run, str(obj) if run.polyhedron is not None else None)
+        if tumbling_starts > 0:
+            from speclight.estimate.shape.tumbling_run import add_tumbling, tumbling_fit
+
+            ds = add_tumbling(
+                ds,
+                tumbling_fit(
+                    data,
+                    run.law,
+                    min_period_h=options.min_period_h,
+                    max_period_h=options.max_period_h,
+                    n_starts=tumbling_starts,
+                    seed=options.seed,
+                ),
+            )
+        claim.write(dataset_bytes(ds))
+        if run.polyhedron is not None:
+            obj_claim.write(format_obj(run.polyhedron, f"speclight shape: EGI of {lc}").encode())
+        if figure is not None:
+            from speclight.plot.shape_figure import shape_figure
+
+            figure.write(shape_figure(ds, run.polyhedron))
+    return ds, run
