@@ -128,6 +128,7 @@ class ShapeRun:
     cov: Covariance
     mirror_cov: Covariance
     samples: F64
+    sample_areas: F64
     shape_p: float
     mirror_reported: bool
     pole_constrained: bool
@@ -143,8 +144,7 @@ class ShapeRun:
         """Other refined pole minima (not the mirror) whose chi-square is within the mirror's
         bound of the best (:func:`.uncertainty.mirror_ambiguous`): poles the data do not
         separate from the best either."""
-        s = self.cov.residual_scale
-        return [m for m in self.others if mirror_ambiguous(self.best, m, s)]
+        return [m for m in self.others if mirror_ambiguous(self.best, m, self.cov)]
 
     @property
     def shape_constrained(self) -> bool:
@@ -265,10 +265,10 @@ def _run_shape(inputs: ShapeInput, options: ShapeOptions) -> ShapeRun:
     mirror, mirror_is_minimum = _mirror(fine, coarse, best, refined[1:])
     others = [s for s in refined[1:] if s is not mirror]
     cov, mirror_cov = covariance(fine, best), covariance(fine, mirror)
-    samples = (
+    samples, sample_areas = (
         bootstrap(fine, best, options.bootstrap_draws, options.seed)
         if options.bootstrap_draws > 0
-        else np.zeros((0, 3))
+        else (np.zeros((0, 3)), np.zeros((0, len(fine.normals))))
     )
     s = cov.residual_scale
     p_shape = shape_p_value(fine, best)
@@ -292,8 +292,9 @@ def _run_shape(inputs: ShapeInput, options: ShapeOptions) -> ShapeRun:
         cov=cov,
         mirror_cov=mirror_cov,
         samples=samples,
+        sample_areas=sample_areas,
         shape_p=p_shape,
-        mirror_reported=mirror_is_minimum and mirror_ambiguous(best, mirror, s),
+        mirror_reported=mirror_is_minimum and mirror_ambiguous(best, mirror, cov),
         mirror_is_minimum=mirror_is_minimum,
         pole_constrained=constrained and spans(poles.chi2, s),
         period_constrained=constrained and spans(scan.chi2, s, "median"),
