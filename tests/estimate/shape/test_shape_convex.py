@@ -18,6 +18,7 @@ from conftest import render_mesh
 from speclight.estimate.shape import ShapeOptions, read_shape_input, run_shape
 from speclight.estimate.shape.ecliptic import angular_distance_deg, pole_vector
 from speclight.estimate.shape.egi import egi_difference, mesh_egi
+from speclight.estimate.shape.shape_dataset import verdict
 
 TRUE_LAMBDA, TRUE_BETA, TRUE_PERIOD_H = 40.0, 35.0, 6.3
 NOISE = 0.01  # relative photometric noise (0.01 mag)
@@ -100,6 +101,9 @@ def _check_solutions(run):
     for i in range(len(poles)):
         for j in range(i):
             assert angular_distance_deg(poles[i], poles[j]) >= 30.0
+    if run.mirror_reported:  # the verdict names the mirror pole
+        m = run.mirror
+        assert f"the mirror pole ({m.lambda_deg:.0f}, {m.beta_deg:.0f}) fits" in verdict(run)
     target = pole_vector(run.best.lambda_deg + 180.0, run.best.beta_deg)
     assert (
         angular_distance_deg(pole_vector(run.mirror.lambda_deg, run.mirror.beta_deg), target) < 30.0
