@@ -147,7 +147,8 @@ def test_bootstrap_spread_is_the_covariance():
     Tibshirani 1993, sec. 6.5, for least squares). 40 draws give a standard deviation to
     1 / sqrt(2 * 39) = 11 % (1 sigma); allowed: a factor 1.5 (the bootstrap refits a
     nonlinear model in 20 steps). Each draw also gives the facet areas of its refit:
-    positive, their fractions spread about the solution's."""
+    positive, their shares of the total spread as the covariance of the shares says (the
+    median facet), about the solution's."""
     rng = np.random.default_rng(5)
     t, sun, obs, curve = apparitions(rng, n_apparitions=4, step_h=0.5)
     vertices, faces = ellipsoid_mesh()
@@ -173,6 +174,9 @@ def test_bootstrap_spread_is_the_covariance():
     assert np.all((ratio > 1 / 1.5) & (ratio < 1.5)), ratio
     assert areas.shape == (40, 12) and np.all(areas > 0)
     fractions = areas / areas.sum(axis=1, keepdims=True)
+    # relative curves: the areas' shares (the scale is not measured), median over facets
+    share = np.median(np.log(fractions).std(axis=0, ddof=1) / cov.log_area)
+    assert 1 / 1.5 < share < 1.5, share
     mean, spread = fractions.mean(axis=0), fractions.std(axis=0, ddof=1)
     # the mean of 40 draws is within 4 standard errors of the solution's fractions
     assert np.all(np.abs(mean - sol.areas / sol.areas.sum()) <= 4 * spread / np.sqrt(40) + 1e-12)

@@ -58,7 +58,9 @@ class Covariance:
     pole_deg
         ``sqrt(sigma_beta^2 + cos^2 beta sigma_lambda^2)`` [deg].
     log_area
-        (K,) standard deviations of the log-areas [1] (relative area errors).
+        (K,) standard deviations of the log-areas [1] (relative area errors); with relative
+        photometry only (no calibrated curve), of the logs of the areas' shares of their sum
+        (the scale is not measured).
     residual_scale
         ``s = sqrt(chi2 / (N - p))``.
     residual_dof
@@ -92,12 +94,26 @@ def effective_dof(model: ConvexModel, sol: ConvexSolution) -> tuple[float, float
     return p_eff, max(model.data.n_points - p_eff, 1.0)
 
 
+def _shares(cov: F64, areas: F64) -> F64:
+    """The covariance with the log-areas ``g_k`` replaced by the logs of the areas' shares
+    ``log(a_k / sum a)``: ``d log(a_k / A) = dg_k - sum_j w_j dg_j`` with ``w = a / A`` (the
+    delta method), so ``M C M^T`` with ``M = I - 1 w^T`` on the area block. Relative
+    photometry does not measure the areas' common scale (only a weak penalty holds it), and
+    its variance would otherwise swamp every area's."""
+    k = areas.size
+    m = np.eye(cov.shape[0])
+    m[N_ROTATION:, N_ROTATION:] -= np.outer(np.ones(k), areas / areas.sum())
+    return np.asarray(m @ cov @ m.T, dtype=np.float64)
+
+
 def covariance(model: ConvexModel, sol: ConvexSolution) -> Covariance:
     """Laplace covariance at ``sol`` (module doc)."""
     cov, p_eff = _unscaled_covariance(model, sol)
     dof = max(model.data.n_points - p_eff, 1.0)
     s2 = sol.chi2 / dof
     cov = cov * s2
+    if not np.any(model.data.calibrated):
+        cov = _shares(cov, sol.areas)
     sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     lam, bet = np.rad2deg(sd[0]), np.rad2deg(sd[1])
     pole = float(np.hypot(bet, np.cos(sol.theta[1]) * lam))
