@@ -210,9 +210,10 @@ def _attrs(run: ShapeRun, obj_file: str | None) -> dict[str, Any]:
         a["bootstrap_period_std_h"] = float(np.std(run.samples[:, 2], ddof=1))
         a["bootstrap_lambda_std_deg"] = float(np.std(run.samples[:, 0], ddof=1))
         a["bootstrap_beta_std_deg"] = float(np.std(run.samples[:, 1], ddof=1))
-        a["bootstrap_area_std"] = float(
-            np.median(np.std(run.sample_areas, axis=0, ddof=1) / run.best.areas)
-        )
+        areas = run.sample_areas
+        if not np.any(run.inputs.data.calibrated):  # the shares, as facet_area_std
+            areas = areas / areas.sum(axis=1, keepdims=True)
+        a["bootstrap_area_std"] = float(np.median(np.std(np.log(areas), axis=0, ddof=1)))
     if obj_file is not None:
         a["obj_file"] = obj_file
     return a
