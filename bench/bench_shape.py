@@ -1,6 +1,9 @@
 """Shape inversion (issue 27): calibration of the uncertainties and the cost of the search.
 
-Run: ``.venv/bin/python bench/bench_shape.py [--draws 20] [--part calibration|timing|all]``
+Run: ``.venv/bin/python bench/bench_shape.py [--draws 20] [--part calibration|timing|all]``,
+or on a real DAMIT file kept outside the repository (the blind check of issue 27):
+``.venv/bin/python bench/bench_shape.py --part damit --lc FILE --period-range-h LO HI
+[--reference LAMBDA BETA PERIOD] [--workers N]``
 
 1. **Calibration** (blind draws): each draw a Lambertian ellipsoid with random axes
    (b/a, c/b uniform in [0.6, 0.95]), a random pole (uniform on the sphere), a random period
@@ -16,6 +19,11 @@ Run: ``.venv/bin/python bench/bench_shape.py [--draws 20] [--part calibration|ti
    one pole-map fit, and their scaling with the number of points (120 .. 960) and facets
    (HEALPix nside 1, 2, 4: 12, 48, 192).
 
+3. **DAMIT** (``--part damit``): ``run_shape`` on a ``.lc`` file as ``speclight shape --format
+   damit`` runs it; printed: the period, the pole and its mirror, the distance of the pole
+   found (or its mirror) from a published one (``--reference``), the wall-clock and CPU
+   seconds (the scan's worker processes included) and the load average before and after.
+
 Other jobs share the machine: the seconds are indicative.
 """
 
@@ -23,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import sys
 import time
 from pathlib import Path
@@ -143,12 +152,69 @@ def timing(blas_threads: int | None) -> None:
         print(f"{d.n_points:6d} {len(model.normals):6d}  {trial:16.3f}  {pole:16.3f}")
 
 
+def _cpu_seconds() -> float:
+    """User + system CPU seconds of this process and its finished children (the scan's
+    workers)."""
+    return sum(
+        r.ru_utime + r.ru_stime
+        for r in (
+            resource.getrusage(who) for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)
+        )
+    )
+
+
+def damit(
+    lc: str, lo: float, hi: float, reference: list[float] | None, workers: int | None
+) -> None:
+    """The inversion of a DAMIT file, timed, against a published pole and period."""
+    from speclight.estimate.shape import read_shape_input
+
+    inputs = read_shape_input(lc, "damit")
+    d = inputs.data
+    print(f"{d.n_points} points in {d.n_curves} curves over {d.baseline_d:.0f} d")
+    print(f"load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    t, cpu = time.perf_counter(), _cpu_seconds()
+    run = run_shape(inputs, ShapeOptions(lo, hi, workers=workers))
+    wall, cpu = time.perf_counter() - t, _cpu_seconds() - cpu
+    print(f"load average after: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    b, m = run.best, run.mirror
+    print(
+        f"{run.scan.trial_period_h.size} trial periods; wall {wall:.0f} s, CPU {cpu:.0f} s "
+        f"(workers {workers or 'all cores'})"
+    )
+    print(f"period {b.period_h:.7f} +- {run.cov.period_h:.1g} h")
+    print(f"pole ({b.lambda_deg:.1f}, {b.beta_deg:.1f}) chi2 {b.chi2:.1f}")
+    print(
+        f"mirror ({m.lambda_deg:.1f}, {m.beta_deg:.1f}) chi2 {m.chi2:.1f}: minimum "
+        f"{run.mirror_is_minimum}, fits as well {run.mirror_reported}"
+    )
+    if reference:
+        lam, bet, per = reference
+        found = pole_vector(b.lambda_deg, b.beta_deg)
+        dist = [
+            float(angular_distance_deg(found, pole_vector(la, bet))) for la in (lam, lam + 180.0)
+        ]
+        print(
+            f"reference ({lam}, {bet}), P {per} h: period off by {b.period_h - per:+.2g} h, "
+            f"pole {dist[0]:.1f} deg from it, {dist[1]:.1f} deg from its mirror"
+        )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--draws", type=int, default=20)
-    ap.add_argument("--part", choices=("calibration", "timing", "all"), default="all")
+    ap.add_argument("--part", choices=("calibration", "timing", "damit", "all"), default="all")
+    ap.add_argument("--lc", help="a DAMIT .lc file (--part damit)")
+    ap.add_argument("--period-range-h", nargs=2, type=float, default=(5.0, 7.0))
+    ap.add_argument("--reference", nargs=3, type=float, metavar=("LAMBDA", "BETA", "PERIOD"))
+    ap.add_argument("--workers", type=int, default=None)
     args = ap.parse_args()
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
+    if args.part == "damit":
+        if not args.lc:
+            ap.error("--part damit needs --lc FILE")
+        damit(args.lc, *args.period_range_h, args.reference, args.workers)
+        return
     if args.part in ("timing", "all"):
         timing(None)
         timing(1)

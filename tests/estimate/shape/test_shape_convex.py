@@ -18,6 +18,7 @@ from conftest import render_mesh
 from speclight.estimate.shape import ShapeOptions, read_shape_input, run_shape
 from speclight.estimate.shape.ecliptic import angular_distance_deg, pole_vector
 from speclight.estimate.shape.egi import egi_difference, mesh_egi
+from speclight.estimate.shape.shape_dataset import verdict
 
 TRUE_LAMBDA, TRUE_BETA, TRUE_PERIOD_H = 40.0, 35.0, 6.3
 NOISE = 0.01  # relative photometric noise (0.01 mag)
@@ -81,7 +82,29 @@ def test_convex_body_recovered(tmp_path, bodies, body):
         angular_distance_deg(found, mirror) < POLE_TOLERANCE_DEG and run.mirror_reported
     )
     assert run.shape_constrained and run.pole_constrained
+    _check_solutions(run)
     if near_truth:  # the mirror solution's shape is the mirror image
         normals = run.model.normals
         true_egi = mesh_egi(vertices, faces, normals)
         assert egi_difference(run.best.areas, true_egi, normals, EGI_FWHM_DEG) < EGI_TOLERANCE
+
+
+def _check_solutions(run):
+    """What the run reports is consistent: the best has the lowest chi-square of all its
+    solutions, no two solutions share a minimum (30 deg), and the mirror solution is at
+    the best's mirror pole when it is a minimum (the mirror start could before end back in
+    the best's own minimum and be reported as its mirror)."""
+    sols = [run.best, run.mirror, *run.others]
+    assert all(run.best.chi2 <= s.chi2 for s in sols)
+    distinct = [run.best, *([run.mirror] if run.mirror_is_minimum else []), *run.others]
+    poles = [pole_vector(s.lambda_deg, s.beta_deg) for s in distinct]
+    for i in range(len(poles)):
+        for j in range(i):
+            assert angular_distance_deg(poles[i], poles[j]) >= 30.0
+    if run.mirror_reported:  # the verdict names the mirror pole
+        m = run.mirror
+        assert f"the mirror pole ({m.lambda_deg:.0f}, {m.beta_deg:.0f}) fits" in verdict(run)
+    target = pole_vector(run.best.lambda_deg + 180.0, run.best.beta_deg)
+    assert (
+        angular_distance_deg(pole_vector(run.mirror.lambda_deg, run.mirror.beta_deg), target) < 30.0
+    )

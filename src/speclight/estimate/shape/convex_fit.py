@@ -93,9 +93,7 @@ def fit_convex(
     free = np.ones(theta0.size, bool)
     free[:2] = free_pole
     free[2] = free_period
-    lm = levenberg_marquardt(
-        model.residuals, theta0, free, max_iterations=max_iterations, rtol=RTOL
-    )
+    lm = levenberg_marquardt(model.evaluate, theta0, free, max_iterations=max_iterations, rtol=RTOL)
     return ConvexSolution(lm.x, model.chi2(lm.x), lm)
 
 

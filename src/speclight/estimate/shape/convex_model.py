@@ -22,6 +22,7 @@ of the areas is then free), ``w_scale sqrt(N) mean(g)``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -59,6 +60,14 @@ def ecliptic_to_body(
     return np.asarray(_rz(-phi) @ pole)
 
 
+def _spin(u: F64, cos_phi: F64, sin_phi: F64) -> F64:
+    """``R_z(-phi) u`` for (N, 3) vectors ``u`` and per-row ``cos, sin`` of ``phi``."""
+    return np.stack(
+        [cos_phi * u[:, 0] + sin_phi * u[:, 1], cos_phi * u[:, 1] - sin_phi * u[:, 0], u[:, 2]],
+        axis=1,
+    )
+
+
 def _body_and_derivatives(
     v: F64, lambda_rad: float, beta_rad: float, period_h: float, t_d: F64
 ) -> tuple[F64, F64]:
@@ -66,15 +75,43 @@ def _body_and_derivatives(
     rz_lam = _rz(np.array(-lambda_rad))
     ry = _ry(beta_rad - np.pi / 2.0)
     w = v @ rz_lam.T  # R_z(-lambda) v
-    u = w @ ry.T  # the pole frame
     omega = 2.0 * np.pi * HOURS_PER_DAY / period_h  # [rad/d]
-    rphi = _rz(-omega * t_d)
-    body = np.einsum("nij,nj->ni", rphi, u)
-    d_lam = -np.einsum("nij,nj->ni", rphi, (w @ _KZ.T) @ ry.T)
-    d_bet = np.einsum("nij,nj->ni", rphi, u @ _KY.T)
+    phi = omega * t_d
+    c, s = np.cos(phi), np.sin(phi)
+    body = _spin(w @ ry.T, c, s)
+    d_lam = -_spin((w @ _KZ.T) @ ry.T, c, s)
+    d_bet = _spin(w @ (_KY @ ry).T, c, s)  # d R_y(b) / db = K_y R_y(b)
     # d phi / d P = -omega t / P, and d R_z(-phi) / d phi = -K_z R_z(-phi)
-    d_per = -(body @ _KZ.T) * (-omega * t_d / period_h)[:, None]
+    d_per = (body @ _KZ.T) * (omega * t_d / period_h)[:, None]
     return body, np.stack([d_lam, d_bet, d_per])
+
+
+@dataclass(frozen=True)
+class _Forward:
+    """The brightness ``lum`` (N,) at a parameter vector with what its Jacobian needs: the
+    areas ``a``, the facets' law values ``s``, ``s0 = dS/dmu0``, ``s1 = dS/dmu`` (N, K) and the
+    body-frame Sun and observer vectors' derivatives ``ds``, ``do`` (3, N, 3)."""
+
+    lum: F64
+    a: F64
+    normals: F64
+    s: F64
+    s0: F64
+    s1: F64
+    ds: F64
+    do: F64
+
+    def jacobian_into(self, jac: F64) -> None:
+        """``dL/dtheta`` into ``jac`` (N, 3 + K). The rotation columns use ``sum_k a_k S'_k
+        (n_k . dv) = dv . sum_k a_k S'_k n_k``: an (N, K) x (K, 3) product instead of an
+        (N, K) array per parameter."""
+        weighted = self.a[:, None] * self.normals
+        g0, g1 = self.s0 @ weighted, self.s1 @ weighted
+        for p in range(N_ROTATION):
+            jac[:, p] = np.einsum("ij,ij->i", self.ds[p], g0) + np.einsum(
+                "ij,ij->i", self.do[p], g1
+            )
+        np.multiply(self.s, self.a, out=jac[:, N_ROTATION:])
 
 
 @dataclass(frozen=True)
@@ -105,52 +142,71 @@ class ConvexModel:
 
     def brightness(self, theta: F64, jacobian: bool = False) -> tuple[F64, F64 | None]:
         """``L`` (N,) and, with ``jacobian``, ``dL/dtheta`` (N, 3 + K)."""
+        state = self._forward(theta)
+        if not jacobian:
+            return state.lum, None
+        jac = np.empty((self.data.n_points, self.n_parameters))
+        state.jacobian_into(jac)
+        return state.lum, jac
+
+    def _forward(self, theta: F64) -> _Forward:
+        """The brightness at ``theta`` and what its Jacobian needs.
+
+        The (N, K) arrays are the cost here, so few are made: the cosines of facets not
+        both lit and seen are set to 0, where every law has ``S = dS/dmu0 = dS/dmu = 0``."""
         lam, bet, per = (float(x) for x in theta[:N_ROTATION])
         a = np.exp(theta[N_ROTATION:])
         t = self.data.time_jd - self.t0_jd
         s_b, ds = _body_and_derivatives(self.data.sun_ecliptic, lam, bet, per, t)
         o_b, do = _body_and_derivatives(self.data.observer_ecliptic, lam, bet, per, t)
         mu0, mu = s_b @ self.normals.T, o_b @ self.normals.T
-        seen = (mu0 > 0) & (mu > 0)
-        mu0c, muc = np.where(seen, mu0, 0.0), np.where(seen, mu, 0.0)
-        s, s0, s1 = self.law(mu0c, muc, self.data.cos_half_phase[:, None])
-        s = np.where(seen, s, 0.0)
-        lum = s @ a
-        if not jacobian:
-            return lum, None
-        s0, s1 = np.where(seen, s0, 0.0), np.where(seen, s1, 0.0)
-        jac = np.empty((lum.size, self.n_parameters))
-        for p in range(N_ROTATION):
-            jac[:, p] = (s0 * (ds[p] @ self.normals.T) + s1 * (do[p] @ self.normals.T)) @ a
-        jac[:, N_ROTATION:] = s * a[None, :]
-        return lum, jac
+        seen = mu0 > 0
+        seen &= mu > 0
+        mu0 *= seen
+        mu *= seen
+        s, s0, s1 = self.law(mu0, mu, self.data.cos_half_phase[:, None])
+        return _Forward(np.asarray(s @ a), a, self.normals, s, s0, s1, ds, do)
 
-    def residuals(self, theta: F64) -> tuple[F64, F64]:
-        """Residuals (N + penalties,) and their Jacobian (module doc)."""
+    def evaluate(self, theta: F64) -> tuple[F64, Callable[[], F64]]:
+        """Residuals (N + penalties,) now and a function returning their Jacobian (module
+        doc); the Jacobian costs about as much again, so a trial step that is not taken
+        skips it (:func:`.lm_solver.levenberg_marquardt`)."""
         d = self.data
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            return self._residuals(theta, d)
-
-    def _residuals(self, theta: F64, d: InversionData) -> tuple[F64, F64]:
-        lum, dlum = self.brightness(theta, jacobian=True)
-        assert dlum is not None
-        r, jac = _compare(d, lum, dlum)
+        n = d.n_points
+        relative_only = not np.any(d.calibrated)
+        rows = n + 3 + (1 if relative_only else 0)
         g = theta[N_ROTATION:]
         a = np.exp(g)
         total = np.sum(a)
         closure = a @ self.normals / total
-        w = CLOSURE_WEIGHT * np.sqrt(d.n_points)
-        rows_r = [w * closure]
-        rows_j = np.zeros((3, self.n_parameters))
-        rows_j[:, N_ROTATION:] = w * (self.normals.T * a - np.outer(closure, a)) / total
-        rows = [rows_j]
-        if not np.any(d.calibrated):
-            ws = SCALE_WEIGHT * np.sqrt(d.n_points)
-            rows_r.append(np.array([ws * np.mean(g)]))
-            scale_row = np.zeros((1, self.n_parameters))
-            scale_row[0, N_ROTATION:] = ws / g.size
-            rows.append(scale_row)
-        return np.concatenate([r, *rows_r]), np.vstack([jac, *rows])
+        w = CLOSURE_WEIGHT * np.sqrt(n)
+        ws = SCALE_WEIGHT * np.sqrt(n)
+        r = np.empty(rows)
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            state = self._forward(theta)
+            rel, ybar, safe = _relative_terms(d, state.lum)
+            r[:n] = (d.brightness - np.where(rel, ybar * state.lum / safe, state.lum)) / d.sigma
+        r[n : n + 3] = w * closure
+        if relative_only:
+            r[n + 3] = ws * np.mean(g)
+
+        def jacobian() -> F64:
+            jac = np.empty((rows, self.n_parameters))
+            with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+                state.jacobian_into(jac[:n])
+                _relative_jacobian(d, state.lum, rel, ybar, safe, jac[:n])
+            jac[n:, :N_ROTATION] = 0.0
+            jac[n : n + 3, N_ROTATION:] = w * (self.normals.T * a - np.outer(closure, a)) / total
+            if relative_only:
+                jac[n + 3, N_ROTATION:] = ws / g.size
+            return jac
+
+        return r, jacobian
+
+    def residuals(self, theta: F64) -> tuple[F64, F64]:
+        """Residuals (N + penalties,) and their Jacobian (module doc)."""
+        r, jacobian = self.evaluate(theta)
+        return r, jacobian()
 
     def fitted(self, theta: F64) -> F64:
         """The model on the data's scale: ``L`` for calibrated curves, ``ybar L / Lbar``
@@ -208,13 +264,21 @@ def _relative_scale(d: InversionData, lum: F64) -> F64:
     return np.where(rel, ratio, 1.0)
 
 
-def _compare(d: InversionData, lum: F64, dlum: F64) -> tuple[F64, F64]:
-    rel = ~d.calibrated[d.curve]
-    ybar, lbar = _curve_means(d, d.brightness), _curve_means(d, lum)
-    safe = np.where(lbar > 0, lbar, 1.0)
-    model = np.where(rel, ybar * lum / safe, lum)
-    r = (d.brightness - model) / d.sigma
-    dmean = _curve_means(d, dlum)
-    drel = (ybar / safe)[:, None] * (dlum - (lum / safe)[:, None] * dmean)
-    jac = -np.where(rel[:, None], drel, dlum) / d.sigma[:, None]
-    return r, jac
+def _relative_terms(d: InversionData, lum: F64) -> tuple[NDArray[np.bool_], F64, F64]:
+    """Per point: relative curve or not, the curve's mean data ``ybar`` and mean model
+    ``Lbar`` (1 where it is not > 0)."""
+    lbar = _curve_means(d, lum)
+    return ~d.calibrated[d.curve], _curve_means(d, d.brightness), np.where(lbar > 0, lbar, 1.0)
+
+
+def _relative_jacobian(
+    d: InversionData, lum: F64, rel: NDArray[np.bool_], ybar: F64, lbar: F64, jac: F64
+) -> None:
+    """The data residuals' Jacobian from ``jac`` = dL/dtheta (N, P), in place: relative rows
+    ``(y - ybar L / Lbar) / sigma`` have ``-(ybar / Lbar) (dL - (L / Lbar) mean(dL)) / sigma``
+    (means over the point's curve), calibrated rows ``(y - L) / sigma`` have ``-dL / sigma``."""
+    if np.any(rel):
+        shift = _curve_means(d, jac)
+        shift *= np.where(rel, lum / lbar, 0.0)[:, None]
+        jac -= shift
+    jac *= (-np.where(rel, ybar / lbar, 1.0) / d.sigma)[:, None]

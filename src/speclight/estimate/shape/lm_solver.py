@@ -1,10 +1,14 @@
 """Levenberg-Marquardt on residuals with an analytic Jacobian.
 
 Minimises ``sum r(x)^2`` over the free entries of ``x``; each step solves
-``(J^T J + lam diag(J^T J)) dx = -J^T r`` (Marquardt 1963, J. SIAM 11, 431,
+``(J^T J + lam D) dx = -J^T r`` with ``D = diag(J^T J)`` (Marquardt 1963, J. SIAM 11, 431,
 doi:10.1137/0111030: the damping scaled by the diagonal, so the step does not depend on the
-parameters' units), the damping divided by :data:`DOWN` after a step that lowered the sum
-and multiplied by :data:`UP` (the step retried) after one that did not.
+parameters' units). The damping follows the gain ratio ``rho`` of the actual to the
+predicted decrease (Nielsen 1999, IMM-REP-1999-05; Madsen, Nielsen & Tingleff 2004,
+"Methods for non-linear least squares problems", eq. 3.16): after a step that lowered the
+sum ``lam *= max(1/3, 1 - (2 rho - 1)^3)``, after one that did not ``lam *= nu`` and
+``nu *= 2``. A step that fails costs only the residuals: the Jacobian is computed for the
+steps taken (``fun`` returns it as a function).
 """
 
 from __future__ import annotations
@@ -16,10 +20,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 F64 = NDArray[np.float64]
-Residuals = Callable[[F64], tuple[F64, F64]]
-UP, DOWN = 10.0, 10.0
+#: ``x -> (r, J)``: residuals now, their Jacobian (all parameters' columns) on demand.
+Residuals = Callable[[F64], tuple[F64, Callable[[], F64]]]
 START_DAMPING = 1e-3
 MAX_DAMPING = 1e12
+MIN_DAMPING = 1e-12
+#: Successive small steps that end a run.
+SMALL_STEPS = 2
 
 
 @dataclass(frozen=True)
@@ -35,9 +42,11 @@ class LmResult:
     residuals, jacobian
         ``r`` and ``J`` (all parameters' columns) there.
     iterations
-        Steps tried.
+        Steps taken (failed trial steps not counted).
     converged
         True when the relative decrease of the cost fell below the tolerance.
+    evaluations
+        Residual evaluations, failed trial steps included.
     """
 
     x: F64
@@ -46,6 +55,7 @@ class LmResult:
     jacobian: F64
     iterations: int
     converged: bool
+    evaluations: int = 0
 
 
 def levenberg_marquardt(
@@ -61,47 +71,60 @@ def levenberg_marquardt(
     Parameters
     ----------
     fun
-        ``x -> (r, J)``: residuals (M,) and their Jacobian (M, P) with respect to all P
-        parameters.
+        ``x -> (r, jacobian)``: residuals (M,) and a function returning their Jacobian
+        (M, P) with respect to all P parameters.
     x0
         (P,) start.
     free
         (P,) True for the parameters that move.
     max_iterations
-        Most steps tried.
+        Most steps taken.
     rtol
-        Converged when a successful step lowers the cost by less than ``rtol`` times it.
+        Converged when :data:`SMALL_STEPS` successive steps each lower the cost by less
+        than ``rtol`` times it (one such step can follow a damping raised by a failed
+        trial, well before the minimum).
     """
     x = np.asarray(x0, dtype=float).copy()
-    r, jac = fun(x)
+    r, jac_of = fun(x)
+    jac = jac_of()
     cost = float(r @ r)
-    lam = START_DAMPING
+    lam, nu = START_DAMPING, 2.0
     converged = False
-    it = 0
+    it = evaluations = small = 0
     idx = np.flatnonzero(free)
+    every = idx.size == x.size
     for it in range(1, max_iterations + 1):
-        j = jac[:, idx]
-        jtj = j.T @ j
-        grad = j.T @ r
+        jtj_all, grad_all = jac.T @ jac, jac.T @ r
+        jtj = jtj_all if every else jtj_all[np.ix_(idx, idx)]
+        grad = grad_all if every else grad_all[idx]
         diag = np.maximum(np.diag(jtj), 1e-12 * max(float(np.max(np.diag(jtj))), 1e-300))
         while True:
             try:
                 step = np.linalg.solve(jtj + lam * np.diag(diag), -grad)
             except np.linalg.LinAlgError:
                 step = np.full(idx.size, np.nan)
-            trial = x.copy()
-            trial[idx] += step
-            r_new, jac_new = fun(trial) if np.all(np.isfinite(step)) else (r, jac)
-            new_cost = float(r_new @ r_new)
+            new_cost, trial = np.inf, x
+            if np.all(np.isfinite(step)):
+                trial = x.copy()
+                trial[idx] += step
+                r_new, jac_new_of = fun(trial)
+                evaluations += 1
+                new_cost = float(r_new @ r_new)
             if np.isfinite(new_cost) and new_cost < cost:
                 break
-            lam *= UP
+            lam *= nu
+            nu *= 2.0
             if lam > MAX_DAMPING:
-                return LmResult(x, cost, r, jac, it, True)
+                return LmResult(x, cost, r, jac, it - 1, True, evaluations)
+        predicted = float(step @ (lam * diag * step - grad))
+        rho = (cost - new_cost) / predicted if predicted > 0 else 1.0
         gain = (cost - new_cost) / cost if cost > 0 else 0.0
-        x, r, jac, cost = trial, r_new, jac_new, new_cost
-        lam = max(lam / DOWN, 1e-12)
-        if gain < rtol:
+        x, r, cost = trial, r_new, new_cost
+        jac = jac_new_of()
+        lam = max(lam * max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), MIN_DAMPING)
+        nu = 2.0
+        small = small + 1 if gain < rtol else 0
+        if small >= SMALL_STEPS:
             converged = True
             break
-    return LmResult(x, cost, r, jac, it, converged)
+    return LmResult(x, cost, r, jac, it, converged, evaluations)

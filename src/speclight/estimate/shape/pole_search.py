@@ -111,3 +111,31 @@ def _distinct_minima(lam: F64, bet: F64, chi2: F64, n: int) -> list[tuple[float,
         if len(taken) == n or not np.isfinite(chi2[i, j]):
             break
     return taken
+
+
+def pole_distance_deg(sol: ConvexSolution, lambda_deg: float, beta_deg: float) -> float:
+    """Angle between a solution's pole and ``(lambda_deg, beta_deg)`` [deg]."""
+    return float(
+        angular_distance_deg(
+            pole_vector(sol.lambda_deg, sol.beta_deg), pole_vector(lambda_deg, beta_deg)
+        )
+    )
+
+
+def distinct_solutions(solutions: list[ConvexSolution]) -> list[ConvexSolution]:
+    """Lowest chi-square first, each at least :data:`DISTINCT_DEG` from the poles kept before
+    it (fits from different starts that ended in one minimum count once)."""
+    kept: list[ConvexSolution] = []
+    for s in sorted(solutions, key=lambda s: s.chi2):
+        if all(pole_distance_deg(s, k.lambda_deg, k.beta_deg) >= DISTINCT_DEG for k in kept):
+            kept.append(s)
+    return kept
+
+
+def nearest_solution(
+    solutions: list[ConvexSolution], lambda_deg: float, beta_deg: float
+) -> ConvexSolution | None:
+    """The lowest-chi-square solution within :data:`DISTINCT_DEG` of ``(lambda_deg,
+    beta_deg)``, or None."""
+    near = [s for s in solutions if pole_distance_deg(s, lambda_deg, beta_deg) < DISTINCT_DEG]
+    return min(near, key=lambda s: s.chi2) if near else None

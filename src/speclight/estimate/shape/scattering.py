@@ -49,6 +49,8 @@ MATERIAL_BSDFS = (
 )
 #: Step of the central differences of a material law in mu0 and mu [1].
 MATERIAL_STEP = 1e-5
+#: A floor of ``mu0 + mu`` in the Lommel-Seeliger term, whose numerator is then 0 [1].
+_TINY_SUM = 1e-300
 #: convexinv's Lambert weight of the ``ls-lambert`` law.
 DEFAULT_LAMBERT_WEIGHT = 0.1
 
@@ -82,13 +84,23 @@ class LommelSeeligerLambert:
     name: str = "ls-lambert"
 
     def __call__(self, mu0: F64, mu: F64, cos_half_phase: F64) -> tuple[F64, F64, F64]:
-        c = self.lambert_weight
-        total = mu0 + mu
-        inv = np.divide(1.0, total, out=np.zeros_like(total), where=total > 0)
-        k = 1.0 / (4.0 * np.pi)
-        s = k * mu0 * mu * (inv + c)
-        d0 = k * (mu * mu * inv * inv + c * mu)
-        d1 = k * (mu0 * mu0 * inv * inv + c * mu0)
+        # written in place: these arrays are (points x facets), the inversion's main cost
+        c, k = self.lambert_weight, 1.0 / (4.0 * np.pi)
+        work = np.add(mu0, mu)
+        # 1 / (mu0 + mu), finite where both are 0 (a facet not lit and seen: S = S' = 0)
+        inv = np.divide(1.0, np.maximum(work, _TINY_SUM, out=work))
+        q = np.multiply(mu, inv)  # mu / (mu0 + mu)
+        np.multiply(mu0, inv, out=inv)  # mu0 / (mu0 + mu)
+        s = np.multiply(mu, c)
+        s += q
+        s *= mu0
+        s *= k  # k mu0 mu (1 / (mu0 + mu) + c)
+        d0 = np.multiply(q, q, out=q)
+        d0 += np.multiply(mu, c, out=work)
+        d0 *= k  # k (mu^2 / (mu0 + mu)^2 + c mu)
+        d1 = np.multiply(inv, inv, out=inv)
+        d1 += np.multiply(mu0, c, out=work)
+        d1 *= k
         return s, d0, d1
 
 

@@ -17,7 +17,7 @@ import xarray as xr
 
 from speclight.estimate.shape.convex_fit import ConvexSolution
 from speclight.estimate.shape.shape_run import NULL_P_VALUE, ShapeRun
-from speclight.estimate.shape.uncertainty import covariance
+from speclight.estimate.shape.uncertainty import ambiguity_bound, covariance
 
 
 def _var(dims: tuple[str, ...], values: Any, units: str, long_name: str) -> xr.Variable:
@@ -43,9 +43,12 @@ def verdict(run: ShapeRun) -> str:
         else "the period is not constrained (the period scan is flat)"
     )
     if run.mirror_reported:
-        parts.append("the mirror pole fits as well")
-    for m in run.equivalent_minima:
-        parts.append(f"the pole ({m.lambda_deg:.0f}, {m.beta_deg:.0f}) fits as well")
+        m = run.mirror
+        parts.append(f"the mirror pole ({m.lambda_deg:.0f}, {m.beta_deg:.0f}) fits as well")
+    elif not run.mirror_is_minimum:
+        parts.append("the mirror pole is not a minimum")
+    for other in run.equivalent_minima:
+        parts.append(f"the pole ({other.lambda_deg:.0f}, {other.beta_deg:.0f}) fits as well")
     return "; ".join(parts)
 
 
@@ -128,6 +131,9 @@ def shape_dataset(run: ShapeRun, obj_file: str | None = None) -> xr.Dataset:
         "sample_period": _var(("sample",), run.samples[:, 2], "h", "bootstrap period"),
         "sample_lambda": _var(("sample",), run.samples[:, 0], "degree", "bootstrap pole longitude"),
         "sample_beta": _var(("sample",), run.samples[:, 1], "degree", "bootstrap pole latitude"),
+        "sample_facet_area": _var(
+            ("sample", "facet"), run.sample_areas, area_unit, "bootstrap facet areas (the EGI)"
+        ),
     }
     coords = {
         "period": ("period", run.scan.trial_period_h, {"units": "h", "long_name": "trial period"}),
@@ -180,6 +186,8 @@ def _attrs(run: ShapeRun, obj_file: str | None) -> dict[str, Any]:
         "chi2": b.chi2,
         "residual_scale": c.residual_scale,
         "mirror_chi2": run.mirror.chi2,
+        "mirror_is_minimum": int(run.mirror_is_minimum),
+        "ambiguity_chi2": ambiguity_bound(c),
         "shape_p_value": run.shape_p,
         "shape_constrained": int(run.shape_constrained),
         "pole_constrained": int(run.pole_constrained),
@@ -202,6 +210,10 @@ def _attrs(run: ShapeRun, obj_file: str | None) -> dict[str, Any]:
         a["bootstrap_period_std_h"] = float(np.std(run.samples[:, 2], ddof=1))
         a["bootstrap_lambda_std_deg"] = float(np.std(run.samples[:, 0], ddof=1))
         a["bootstrap_beta_std_deg"] = float(np.std(run.samples[:, 1], ddof=1))
+        areas = run.sample_areas
+        if not np.any(run.inputs.data.calibrated):  # the shares, as facet_area_std
+            areas = areas / areas.sum(axis=1, keepdims=True)
+        a["bootstrap_area_std"] = float(np.median(np.std(np.log(areas), axis=0, ddof=1)))
     if obj_file is not None:
         a["obj_file"] = obj_file
     return a

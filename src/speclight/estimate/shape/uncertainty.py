@@ -7,10 +7,21 @@
   parameters, :func:`effective_dof`). The pole's ``sigma_pole``
   is ``sqrt(sigma_beta^2 + cos^2 beta sigma_lambda^2)`` [deg].
 * Bootstrap: each draw resamples the points of every light curve with replacement
-  (Efron & Tibshirani 1993, ch. 6) and refits from the solution; the spread of the draws.
-* Mirror: the mirror pole is reported when its chi-square is within
-  :data:`MIRROR_DELTA` ``s^2`` of the best (the 99 % point of chi-square with 2 degrees of
-  freedom: the data cannot tell the two poles apart).
+  (Efron & Tibshirani 1993, ch. 6) and refits pole, period and facet areas from the
+  solution; the spread of the draws. It stands in for posterior samples (MCMC, e.g. emcee):
+  the residuals of real light curves are mostly model error, so a likelihood from their
+  scale would have to assume noise they are not, while resampling carries whatever they
+  are; and a sampler over the 3 + K parameters (K = 192 facets) needs of the order of 10^5
+  to 10^6 model evaluations where a draw here needs 20 fit steps.
+* Mirror (and any other pole minimum): reported beside the best when its chi-square is
+  within ``max(MIRROR_DELTA, sqrt(nu / 2)) s^2`` of the best (``nu = N - p``): the 99 %
+  point of chi-square with 2 degrees of freedom (:data:`MIRROR_DELTA`) where the residuals
+  are the noise, and half the chi-square's own standard deviation ``sqrt(2 nu)`` (in units of
+  ``s^2``) where many points make that bound tighter than the model can be trusted: on real
+  light curves the residuals are mostly model error (a convex, ideal-scattering body), not
+  noise. In relative terms the bound is ``0.5 sqrt(2 / nu) chi2_min``, the threshold the
+  DAMIT authors use to accept pole and period solutions (e.g. Durech et al. 2016, A&A 587,
+  A48; Hanus et al. 2016, A&A 586, A108).
 * Null tests: the data constrain a shape when the fit beats a sphere (no light-curve
   shape, only the phase-angle trend) by an F-test at :data:`NULL_P_VALUE`; they constrain the
   pole when the pole map's chi-square spans more than :data:`POLE_DELTA` ``s^2`` (the 99.9 %
@@ -47,9 +58,13 @@ class Covariance:
     pole_deg
         ``sqrt(sigma_beta^2 + cos^2 beta sigma_lambda^2)`` [deg].
     log_area
-        (K,) standard deviations of the log-areas [1] (relative area errors).
+        (K,) standard deviations of the log-areas [1] (relative area errors); with relative
+        photometry only (no calibrated curve), of the logs of the areas' shares of their sum
+        (the scale is not measured).
     residual_scale
         ``s = sqrt(chi2 / (N - p))``.
+    residual_dof
+        ``N - p`` (``p`` the effective number of parameters, :func:`effective_dof`).
     """
 
     lambda_deg: float
@@ -58,6 +73,7 @@ class Covariance:
     pole_deg: float
     log_area: F64
     residual_scale: float
+    residual_dof: float
 
 
 def _unscaled_covariance(model: ConvexModel, sol: ConvexSolution) -> tuple[F64, float]:
@@ -78,24 +94,48 @@ def effective_dof(model: ConvexModel, sol: ConvexSolution) -> tuple[float, float
     return p_eff, max(model.data.n_points - p_eff, 1.0)
 
 
+def _shares(cov: F64, areas: F64) -> F64:
+    """The covariance with the log-areas ``g_k`` replaced by the logs of the areas' shares
+    ``log(a_k / sum a)``: ``d log(a_k / A) = dg_k - sum_j w_j dg_j`` with ``w = a / A`` (the
+    delta method), so ``M C M^T`` with ``M = I - 1 w^T`` on the area block. Relative
+    photometry does not measure the areas' common scale (only a weak penalty holds it), and
+    its variance would otherwise swamp every area's."""
+    k = areas.size
+    m = np.eye(cov.shape[0])
+    m[N_ROTATION:, N_ROTATION:] -= np.outer(np.ones(k), areas / areas.sum())
+    return np.asarray(m @ cov @ m.T, dtype=np.float64)
+
+
 def covariance(model: ConvexModel, sol: ConvexSolution) -> Covariance:
     """Laplace covariance at ``sol`` (module doc)."""
     cov, p_eff = _unscaled_covariance(model, sol)
-    s2 = sol.chi2 / max(model.data.n_points - p_eff, 1.0)
+    dof = max(model.data.n_points - p_eff, 1.0)
+    s2 = sol.chi2 / dof
     cov = cov * s2
+    if not np.any(model.data.calibrated):
+        cov = _shares(cov, sol.areas)
     sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     lam, bet = np.rad2deg(sd[0]), np.rad2deg(sd[1])
     pole = float(np.hypot(bet, np.cos(sol.theta[1]) * lam))
     return Covariance(
-        float(lam), float(bet), float(sd[2]), pole, sd[N_ROTATION:], float(np.sqrt(s2))
+        float(lam),
+        float(bet),
+        float(sd[2]),
+        pole,
+        sd[N_ROTATION:],
+        float(np.sqrt(s2)),
+        float(dof),
     )
 
 
-def bootstrap(model: ConvexModel, sol: ConvexSolution, draws: int, seed: int) -> F64:
-    """(draws, 3) bootstrap ``(lambda [deg], beta [deg], P [h])`` (module doc)."""
+def bootstrap(model: ConvexModel, sol: ConvexSolution, draws: int, seed: int) -> tuple[F64, F64]:
+    """Bootstrap refits (module doc): (draws, 3) ``(lambda [deg], beta [deg], P [h])`` and
+    (draws, K) the facet areas of each refit (the shape's spread, in the units of
+    ``sol.areas``)."""
     rng = np.random.default_rng(seed)
     d = model.data
     out = np.empty((draws, 3))
+    areas = np.empty((draws, len(model.normals)))
     runs = [np.flatnonzero(d.curve == c) for c in range(d.n_curves)]
     for k in range(draws):
         idx = np.sort(np.concatenate([rng.choice(r, r.size) for r in runs]))
@@ -115,7 +155,8 @@ def bootstrap(model: ConvexModel, sol: ConvexSolution, draws: int, seed: int) ->
             fit.beta_deg,
             fit.period_h,
         )
-    return out
+        areas[k] = fit.areas
+    return out, areas
 
 
 def sphere_chi2(model: ConvexModel) -> float:
@@ -141,9 +182,16 @@ def shape_p_value(model: ConvexModel, sol: ConvexSolution) -> float:
     return float(stats.f.sf(f, p, dof)) if np.isfinite(f) else 1.0
 
 
-def mirror_ambiguous(best: ConvexSolution, mirror: ConvexSolution, scale: float) -> bool:
-    """True when the mirror's chi-square is within :data:`MIRROR_DELTA` ``s^2`` of the best."""
-    return bool(mirror.chi2 - best.chi2 <= MIRROR_DELTA * scale**2)
+def ambiguity_bound(cov: Covariance) -> float:
+    """The chi-square rise within which another pole fits as well as the best:
+    ``max(MIRROR_DELTA, sqrt(nu / 2)) s^2`` (module doc)."""
+    return max(MIRROR_DELTA, float(np.sqrt(cov.residual_dof / 2.0))) * cov.residual_scale**2
+
+
+def mirror_ambiguous(best: ConvexSolution, mirror: ConvexSolution, cov: Covariance) -> bool:
+    """True when ``mirror`` (or another pole minimum) fits as well as ``best``: its
+    chi-square within :func:`ambiguity_bound` of the best's (``cov`` the best's)."""
+    return bool(mirror.chi2 - best.chi2 <= ambiguity_bound(cov))
 
 
 def spans(chi2: F64, scale: float, reference: str = "max") -> bool:
