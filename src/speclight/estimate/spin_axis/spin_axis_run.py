@@ -173,6 +173,7 @@ def spin_axis_measured(
     ranging_weight: float | None = None,
     refine_method: str = "nelder-mead",
     period_bound: float | None = None,
+    period_kind: str | None = None,
 ) -> SpinAxisRun:
     """Search the spin axis of a measured pass against a reflectivity map (module doc).
 
@@ -207,6 +208,10 @@ def spin_axis_measured(
     refine_method, period_bound
         The refinement's method and, for a free period, the fraction by which it may differ
         (:func:`.spin_axis_core.spin_axis_search`).
+    period_kind
+        What the period is (:mod:`.spin_axis_period`): ``sidereal``, ``synodic`` (a light
+        curve's, e.g. from ``speclight period``) or ``auto``; default ``auto`` for a given
+        ``period_s``, ``sidereal`` for the scenario's.
 
     Returns
     -------
@@ -217,6 +222,7 @@ def spin_axis_measured(
     from speclight.estimate.inputs.measured import read_measured
     from speclight.estimate.inputs.reflectance_factors import read_reflectance_factors
     from speclight.estimate.spin_axis.spin_axis_limits import check_search_cost
+    from speclight.estimate.spin_axis.spin_axis_period import check_period_kind
     from speclight.estimate.spin_axis.spin_axis_refine import check_refine_options
     from speclight.maps.map_lookup import check_map_matches
     from speclight.simulation.geometry_stage import scenario_geometry
@@ -224,6 +230,9 @@ def spin_axis_measured(
 
     check_search_options(grid_deg, n_phases)
     check_refine_options(refine_method, period_bound)
+    if period_kind is None:
+        period_kind = "sidereal" if period_s is None else "auto"
+    check_period_kind(period_kind)
     period, body_axis, spin = _spin_model(loaded, period_s)
     map_path = Path(map_path)
     bmap = load_band_map(map_path)
@@ -313,10 +322,11 @@ def spin_axis_measured(
         ranging,
         refine_method,
         period_bound,
+        period_kind,
     )
     seconds = time.perf_counter() - t0
     refined_epochs = epochs
-    if period_bound is not None and np.isfinite(result.refined_period_s):
+    if np.isfinite(result.refined_period_s):
         refined_epochs = dataclasses.replace(epochs, period_s=result.refined_period_s)
     tracks = {
         "best": phase_vector_track(epochs, body_axis, **_candidate(result.best)),
@@ -394,10 +404,14 @@ def axis_dataset(run: SpinAxisRun, map_path: str, scenario_source: str) -> xr.Da
         refine_misfit_evaluations=r.refine_n_misfit,
         refine_gradient_evaluations=r.refine_n_gradient,
         period_free=int(run.period_bound is not None),
+        refined_period_s=r.refined_period_s,
+        period_kind=r.period_kind,
     )
+    for kind, err in r.period_kind_errors.items():
+        attrs[f"{kind}_best_error"] = err
     if run.period_bound is not None:
         attrs["period_bound"] = run.period_bound
-        attrs["refined_period_s"] = r.refined_period_s
+    ds = _with_confidence(ds, r)
     attrs.update(
         period_s=run.period_s,
         spin_body_axis=np.asarray(run.spin_body_axis, dtype=float),
@@ -416,4 +430,33 @@ def axis_dataset(run: SpinAxisRun, map_path: str, scenario_source: str) -> xr.Da
         seconds=run.seconds,
     )
     ds.attrs.update(attrs)
+    return ds
+
+
+#: AXIS.nc attributes of :class:`.spin_axis_confidence.AxisConfidence` (docs/spin-axis.md).
+CONFIDENCE_ATTRS = (
+    "sigma_axis_deg", "sigma_east_deg", "sigma_north_deg", "correlation_east_north",
+    "sigma_phase_deg", "sigma_period_s", "misfit_per_chi2", "region68_fraction",
+    "region95_fraction", "region95_max_sep_deg", "contrast", "noise_floor", "noise_ratio",
+    "hac_lag",
+)  # fmt: skip
+
+
+def _with_confidence(ds: xr.Dataset, r: SpinAxisResult) -> xr.Dataset:
+    """``delta_chi2(ra, dec)`` and the confidence attributes (NaN without a refinement)."""
+    c = r.confidence
+    for name in CONFIDENCE_ATTRS:
+        ds.attrs[name] = float("nan") if c is None else getattr(c, name)
+    ds.attrs["axis_constrained"] = int(c is not None and c.constrained)
+    ds.attrs["axis_note"] = "not refined: no sigmas" if c is None else c.note
+    scale = float("nan") if c is None else c.misfit_per_chi2
+    finite = np.isfinite(r.error)
+    e_min = float(np.min(r.error[finite])) if finite.any() else float("nan")
+    ds["delta_chi2"] = (("ra", "dec"), (r.error - e_min) / scale)
+    ds["delta_chi2"].attrs.update(
+        units="1",
+        long_name="rise of the misfit over the best cell in units of chi-square (the "
+        "sandwich covariance's misfit per unit chi-square); <= 2.30: 68 % region, <= 5.99: "
+        "95 % region",
+    )
     return ds
