@@ -276,7 +276,7 @@ def _verdict(out: AxisConfidence) -> tuple[bool, str]:
     if out.noise_ratio > MAX_NOISE_RATIO:
         notes.append(
             f"the misfit is {out.noise_ratio:.3g} times the noise floor ({out.noise_floor:.3g}): "
-            "the model does not fit the data (a wrong period, map or spin model?)"
+            "the model does not fit the data (a wrong period or spin model, or a map error above the noise)"
         )
     constrained = not flat and not out.region95_max_sep_deg > SECOND_REGION_DEG
     if not notes:
