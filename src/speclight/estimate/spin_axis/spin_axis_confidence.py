@@ -58,6 +58,8 @@ MAX_REGION_FRACTION = 0.05
 MAX_SIGMA_DEG = 30.0
 #: 95 % cells farther than this from the refined axis [deg]: a second region.
 SECOND_REGION_DEG = 20.0
+#: Blocks of consecutive epochs of the jackknife.
+JACKKNIFE_BLOCKS = 10
 #: Refined misfit over this times the noise floor: flagged.
 MAX_NOISE_RATIO = 10.0
 
@@ -126,8 +128,44 @@ def sandwich_covariance(r: F64, jac: F64, n_t: int) -> tuple[F64, F64, int]:
         w = 1.0 - ell / (lag + 1.0)
         gamma = g[ell:].T @ g[:-ell]
         s += w * (gamma + gamma.T)
-    a_inv = np.linalg.pinv(jac.T @ jac, rcond=1e-12)
-    return a_inv @ s @ a_inv, a_inv, lag
+    a_inv = np.asarray(np.linalg.pinv(jac.T @ jac, rcond=1e-12), dtype=np.float64)
+    return np.asarray(a_inv @ s @ a_inv, dtype=np.float64), a_inv, lag
+
+
+def jackknife_covariance(model: SpinMisfit, x0: F64, ranged: bool) -> F64:
+    """Delete-a-block jackknife covariance (K, K) of the parameters ``x`` (Efron & Stein
+    1981; Kuensch 1989, Ann. Stat. 17, 1217, doi:10.1214/aos/1176347265): the pass is cut
+    into :data:`JACKKNIFE_BLOCKS` runs of consecutive epochs, the fit is repeated without
+    each (L-BFGS-B with the analytic gradient, from ``x0``), and ``C = (G - 1) / G sum_g
+    (x_g - mean x)(x_g - mean x)^T``. It sees what the residuals do to the answer: noise
+    and a map error that varies along the pass alike."""
+    from scipy.optimize import minimize
+
+    n_t = model.y.shape[0]
+    edges = np.linspace(0, n_t, JACKKNIFE_BLOCKS + 1).astype(int)
+    xs = []
+    for g in range(JACKKNIFE_BLOCKS):
+        keep = np.ones(n_t, dtype=bool)
+        keep[edges[g] : edges[g + 1]] = False
+        geo = model.geo
+        sub = dataclasses.replace(
+            model,
+            geo=EpochGeometry(
+                geo.sun_gcrs[keep], geo.observer_gcrs[keep], geo.t_s[keep], geo.period_s
+            ),
+            y=model.y[keep],
+            ranging=model.ranging.select(keep)
+            if ranged and model.ranging is not None
+            else model.ranging,
+        )
+        res = minimize(
+            sub.misfit_and_gradient, x0, jac=True, method="L-BFGS-B",
+            options={"maxiter": 100, "ftol": 1e-12, "gtol": 1e-9},
+        )  # fmt: skip
+        xs.append(np.asarray(res.x, dtype=float))
+    x = np.array(xs)
+    d = x - x.mean(axis=0)
+    return np.asarray((JACKKNIFE_BLOCKS - 1) / JACKKNIFE_BLOCKS * (d.T @ d))
 
 
 def axis_confidence(
@@ -141,6 +179,7 @@ def axis_confidence(
     ra_deg: F64,
     free_period: bool = False,
     ranging: object | None = None,
+    method: str = "jackknife",
 ) -> AxisConfidence:
     """Sigmas, regions and flags of the refined solution (module doc).
 
@@ -164,6 +203,8 @@ def axis_confidence(
         Whether the period was fitted (its sigma is then given).
     ranging
         The range-offset term (:class:`.spin_axis_ranging.RangingTerm`), or None.
+    method
+        The covariance: ``jackknife`` (:func:`jackknife_covariance`) or ``sandwich``.
     """
     out = AxisConfidence()
     finite = np.isfinite(error)
@@ -173,7 +214,7 @@ def axis_confidence(
     if np.isfinite(refined[3]) and out.noise_floor > 0:
         out.noise_ratio = float(refined[3] / out.noise_floor)
     if np.all(np.isfinite(refined[:3])):
-        _sigmas(out, bmap, geo, y, spin_body_axis, refined, free_period, ranging)
+        _sigmas(out, bmap, geo, y, spin_body_axis, refined, free_period, ranging, method)
     _regions(out, error, dec_deg, ra_deg, refined)
     out.constrained, out.note = _verdict(out)
     return out
@@ -188,6 +229,7 @@ def _sigmas(
     refined: tuple[float, float, float, float],
     free_period: bool,
     ranging: object | None,
+    method: str,
 ) -> None:
     model = SpinMisfit.around(
         bmap,
@@ -204,6 +246,8 @@ def _sigmas(
     if jac is None or not np.all(np.isfinite(r)) or not np.any(jac):
         return
     cov, a_inv, out.hac_lag = sandwich_covariance(r, jac, y.shape[0])
+    if method == "jackknife":
+        cov = jackknife_covariance(model, x0, ranging is not None)
     # x = (a, b): a tilts the axis towards -b_frame... (:mod:`.spin_axis_gradient`): the
     # tangent rotation (a, b) moves the axis by (b, -a) in the frame's (x, y); x is the
     # ascending node (east), y north of it
@@ -276,7 +320,8 @@ def _verdict(out: AxisConfidence) -> tuple[bool, str]:
     if out.noise_ratio > MAX_NOISE_RATIO:
         notes.append(
             f"the misfit is {out.noise_ratio:.3g} times the noise floor ({out.noise_floor:.3g}): "
-            "the model does not fit the data (a wrong period or spin model, or a map error above the noise)"
+            "the model does not fit the data (a wrong period or spin model, or a map error "
+            "above the noise)"
         )
     constrained = not flat and not out.region95_max_sep_deg > SECOND_REGION_DEG
     if not notes:

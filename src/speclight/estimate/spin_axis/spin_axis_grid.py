@@ -333,7 +333,7 @@ def grid_pass(
                 turn = 2 * np.pi * np.mod(geo.t_s[None] / per, 1.0)
         frames = axis_frames(ra_all[start:stop], dec_all[start:stop])
         e_i[start:stop], er = _chunk_terms(ps, frames, turn)
-        if turn is not None:
+        if period_s_axes is not None:
             gone = ~np.isfinite(period_s_axes[start:stop])
             e_i[start:stop][gone] = np.inf
         if e_r is not None and er is not None:
