@@ -154,6 +154,8 @@ def _draw(rng: np.random.Generator, geo_all: EpochGeometry, truth_map, search, a
 
 
 def _report(label: str, rows: list[dict]) -> None:
+    if not rows:
+        return
     for key in ("c", "sand"):
         print(f"\n### sigmas: {'jackknife (default)' if key == 'c' else 'sandwich (HAC)'}")
         _report_one(label, [dict(r, c=r[key]) for r in rows])

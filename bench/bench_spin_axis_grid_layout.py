@@ -1,4 +1,4 @@
-"""The spin-axis grid pass: corners gathered all at once vs one at a time (issue 26 item 4).
+"""The spin-axis grid pass: the corners weighed by ``einsum`` or by ``matmul`` (issue 26 item 4).
 
 Run: ``.venv/bin/python bench/bench_spin_axis_grid_layout.py [--grid-deg 2] [--phases 72]
 [--epochs 300] [--reps 3]``
@@ -8,9 +8,9 @@ HEALPix nside 8 (768 directions) x phase angles 40, 70, 100, 130 deg x 8 rolls x
 resampled onto the spin frame with ``--phases`` phases (4 corners per lookup); a pass of
 ``--epochs`` epochs with phase angles 54-117 deg (the box-wing example's); every axis of a
 ``--grid-deg`` grid. The grid pass (:func:`speclight.estimate.spin_axis.spin_axis_grid.grid_pass`)
-runs with the module's :func:`gather` (corners one at a time, ``out += w_c table[rows_c]``)
-and with the former one (``einsum`` over ``table[rows]``, all corners gathered at once into an
-array 4 times the block's), interleaved ``--reps`` times in one process, wall and CPU time;
+runs with the module's :func:`gather` (the gathered corners (n, 4, K B) weighed and summed
+as ``n`` products ``(1 x 4) @ (4 x K B)`` by ``matmul``) and with the former one (the same by
+``einsum("nc,ncj->nj")``), interleaved ``--reps`` times in one process, wall and CPU time;
 then the pass with each axis's own period (a synodic period, :mod:`.spin_axis_period`). The
 misfits of both are compared (largest difference). Other jobs share the machine: the load
 average is printed with each run.
@@ -58,7 +58,7 @@ def _geometry(n_t: int) -> EpochGeometry:
 
 
 def _gather_all_corners(table, corners, sl, fill=np.nan):
-    """The former :func:`grid.gather`: all corners gathered, then weighed by ``einsum``."""
+    """The former :func:`grid.gather`: the gathered corners weighed by ``einsum``."""
     if corners.weights is None:
         out = table[corners.rows[sl, 0]]
     else:
@@ -85,12 +85,12 @@ def main() -> None:
     ra_all, dec_all = rr.ravel(), dd.ravel()
     print(f"{ra_all.size} axes x {args.phases} phases x {args.epochs} epochs x 10 bands")
     new = grid.gather
-    times: dict[str, list[float]] = {"one corner at a time": [], "all corners at once": []}
+    times: dict[str, list[float]] = {"matmul (now)": [], "einsum (before)": []}
     results = {}
     for _ in range(args.reps):
         for label, fn in (
-            ("all corners at once", _gather_all_corners),
-            ("one corner at a time", new),
+            ("einsum (before)", _gather_all_corners),
+            ("matmul (now)", new),
         ):
             grid.gather = fn
             t0, c0 = time.perf_counter(), time.process_time()
@@ -105,7 +105,7 @@ def main() -> None:
     grid.gather = new
     for label, ts in times.items():
         print(f"{label}: best {min(ts):.2f} s, median {np.median(ts):.2f} s")
-    diff = np.max(np.abs(results["one corner at a time"] - results["all corners at once"]))
+    diff = np.max(np.abs(results["matmul (now)"] - results["einsum (before)"]))
     print(f"largest misfit difference: {diff:.2e}")
     periods = sidereal_periods(120.0, bisector_rates(geo, ra_all, dec_all))
     t0 = time.perf_counter()

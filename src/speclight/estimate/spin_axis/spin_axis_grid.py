@@ -196,8 +196,9 @@ def gather(table: F32, corners: Corners, sl: slice, fill: float = np.nan) -> F32
     bad)."""
     if corners.weights is None:
         out = table[corners.rows[sl, 0]]
-    else:  # (n, corners, K C) weighted and summed over the corners
-        out = np.einsum("nc,ncj->nj", corners.weights[sl], table[corners.rows[sl]])
+    else:  # (n, corners, K C) weighted and summed over the corners: (1 x c) @ (c x K C)
+        w = corners.weights[sl]
+        out = np.matmul(w[:, None, :], table[corners.rows[sl]])[:, 0]
     bad = corners.bad[sl]
     if bad.any():
         out[bad] = fill
