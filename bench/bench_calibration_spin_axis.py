@@ -171,7 +171,8 @@ def _z_scores(rows: list[dict]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         zn.append(r["north"] / sn)
         cov = np.array([[se**2, rho * se * sn], [rho * se * sn, sn**2]])
         v = np.array([r["east"], r["north"]])
-        d2.append(float(v @ np.linalg.solve(cov, v)) if np.all(np.isfinite(cov)) else np.inf)
+        ok = np.all(np.isfinite(cov)) and np.linalg.det(cov) > 0
+        d2.append(float(v @ np.linalg.solve(cov, v)) if ok else np.inf)
     return np.array(ze), np.array(zn), np.array(d2)
 
 

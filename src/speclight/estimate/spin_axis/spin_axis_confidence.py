@@ -1,6 +1,13 @@
 """How well the data pin the spin axis: sigmas, a confidence region, and what cannot be trusted.
 
-**Sigmas** (sandwich estimator; White 1980, Econometrica 48, 817, doi:10.2307/1912934;
+**Sigmas**: the delete-a-block jackknife (:func:`jackknife_covariance`) plus the sandwich
+below. The jackknife sees what the residuals along the pass do to the answer, noise and map
+error alike, but on a flat or one-sided surface its refits may not move (a singular
+covariance); the sandwich adds the local curvature's floor. The sum counts the noise twice,
+a conservative choice the calibration bench supports (BENCHMARKS.md "Spin-axis calibration":
+the sigmas are still small by 1.4-2 times where the map's error dominates).
+
+**Sandwich** (White 1980, Econometrica 48, 817, doi:10.2307/1912934;
 Newey & West 1987, Econometrica 55, 703, doi:10.2307/1913610): at the refined solution the
 misfit ``sum r^2`` has the Gauss-Newton Hessian ``2 A``, ``A = J^T J`` (the analytic
 Jacobian of :class:`.spin_axis_gradient.SpinMisfit`, parameters: the axis's tangent
@@ -204,7 +211,8 @@ def axis_confidence(
     ranging
         The range-offset term (:class:`.spin_axis_ranging.RangingTerm`), or None.
     method
-        The covariance: ``jackknife`` (:func:`jackknife_covariance`) or ``sandwich``.
+        The covariance: ``jackknife`` (:func:`jackknife_covariance` plus the sandwich) or
+        ``sandwich`` (:func:`sandwich_covariance`).
     """
     out = AxisConfidence()
     finite = np.isfinite(error)
@@ -246,8 +254,8 @@ def _sigmas(
     if jac is None or not np.all(np.isfinite(r)) or not np.any(jac):
         return
     cov, a_inv, out.hac_lag = sandwich_covariance(r, jac, y.shape[0])
-    if method == "jackknife":
-        cov = jackknife_covariance(model, x0, ranging is not None)
+    if method == "jackknife":  # plus the sandwich: never below the local noise's curvature
+        cov = cov + jackknife_covariance(model, x0, ranging is not None)
     # x = (a, b): a tilts the axis towards -b_frame... (:mod:`.spin_axis_gradient`): the
     # tangent rotation (a, b) moves the axis by (b, -a) in the frame's (x, y); x is the
     # ascending node (east), y north of it
