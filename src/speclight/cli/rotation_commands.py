@@ -135,9 +135,10 @@ def spin_axis(
     def run() -> None:
         from speclight.estimate.inputs.source_spectrum import check_light
         from speclight.estimate.spin_axis.spin_axis_core import check_search_options
+        from speclight.estimate.spin_axis.spin_axis_dataset import axis_dataset
         from speclight.estimate.spin_axis.spin_axis_period import check_period_kind
         from speclight.estimate.spin_axis.spin_axis_refine import check_refine_options
-        from speclight.estimate.spin_axis.spin_axis_run import axis_dataset, spin_axis_measured
+        from speclight.estimate.spin_axis.spin_axis_run import spin_axis_measured
         from speclight.scenario import load_scenario
 
         free = free_period if free_period is not None else period_s is not None

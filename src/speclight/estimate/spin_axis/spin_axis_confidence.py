@@ -51,7 +51,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
-from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry
+from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, angular_distance_deg
 from speclight.maps.map_lookup import ReflectivityMap
 
 F64 = NDArray[np.float64]
@@ -286,8 +286,6 @@ def _regions(
     ra_deg: F64,
     refined: tuple[float, float, float, float],
 ) -> None:
-    from speclight.estimate.spin_axis.spin_axis_core import angular_distance_deg
-
     c = out.misfit_per_chi2
     finite = np.isfinite(error)
     if not finite.any():

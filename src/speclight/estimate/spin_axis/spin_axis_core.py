@@ -40,6 +40,9 @@ from speclight.estimate.spin_axis.spin_axis_lookup import (
     EpochGeometry,
     SpinFrameMap,
 )
+from speclight.estimate.spin_axis.spin_axis_lookup import (
+    angular_distance_deg as angular_distance_deg,
+)
 from speclight.estimate.spin_axis.spin_axis_misfit import exact_misfit as exact_misfit
 from speclight.maps.map_lookup import ReflectivityMap
 
@@ -236,13 +239,6 @@ def local_minima(error: F64) -> NDArray[np.int64]:
     return idx[np.argsort(e.ravel()[idx], kind="stable")]
 
 
-def angular_distance_deg(ra1: ArrayLike, dec1: ArrayLike, ra2: ArrayLike, dec2: ArrayLike) -> F64:
-    """Great-circle distance [deg] between RA/Dec pairs [deg]."""
-    r1, d1, r2, d2 = (np.radians(np.asarray(v, dtype=float)) for v in (ra1, dec1, ra2, dec2))
-    c = np.sin(d1) * np.sin(d2) + np.cos(d1) * np.cos(d2) * np.cos(r1 - r2)
-    return np.degrees(np.arccos(np.clip(c, -1.0, 1.0)))
-
-
 def spin_axis_search(
     bmap: ReflectivityMap,
     sfm: SpinFrameMap,
@@ -305,11 +301,12 @@ def spin_axis_search(
     check_measured_curves(y, band_names)
     ranging = ranging.select(ok) if ranging is not None else None
     ra, dec = radec_grid(grid_deg)
-    from speclight.estimate.spin_axis.spin_axis_period_scan import grid_for_period
+    from speclight.estimate.spin_axis.spin_axis_period_scan import grid_for_period, scan_grid_deg
 
     scan = grid_for_period(
-        sfm, geo, y, ra, dec, chunk, progress, ranging, period_kind, period_bound, grid_deg
-    )
+        sfm, geo, y, ra, dec, chunk, progress, ranging, period_kind, period_bound,
+        radec_grid(scan_grid_deg(grid_deg)), grid_terms,
+    )  # fmt: skip
     flat, ranging, kind = scan.misfit, scan.ranging, scan.kind
     if not np.any(np.isfinite(flat)):
         raise InputError(

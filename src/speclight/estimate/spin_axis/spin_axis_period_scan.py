@@ -74,7 +74,8 @@ def grid_for_period(
     ranging: RangingTerm | None,
     period_kind: str,
     period_bound: float | None,
-    grid_deg: float,
+    coarse: tuple[F64, F64],
+    terms: Callable[..., tuple[F64, F64 | None]],
 ) -> PeriodGrid:
     """The grid's misfit under the period as given (module doc).
 
@@ -87,27 +88,29 @@ def grid_for_period(
     period_bound
         None: the period ``geo.period_s`` is fixed; else the fraction within which it is
         scanned.
-    grid_deg
-        The axis grid step [deg] (the scan's is :func:`scan_grid_deg`).
+    coarse
+        The scan's RA and Dec cell centres [deg] (a grid of :func:`scan_grid_deg`).
+    terms
+        :func:`.spin_axis_core.grid_terms` (passed in: the core calls this module).
     """
     import dataclasses
 
-    from speclight.estimate.spin_axis.spin_axis_core import radec_grid
-
     if period_bound is None:
         kinds = ["sidereal", "synodic"] if period_kind == "auto" else [period_kind]
-        found = {k: _one_pass(sfm, geo, y, ra, dec, chunk, progress, ranging, k) for k in kinds}
+        found = {
+            k: _one_pass(terms, sfm, geo, y, ra, dec, chunk, progress, ranging, k) for k in kinds
+        }
         errors = {k: _best(v[0]) for k, v in found.items()}
         kind = min(kinds, key=lambda k: errors[k])
         return PeriodGrid(found[kind][0], found[kind][1], kind, errors, geo.period_s)
-    ra_c, dec_c = radec_grid(scan_grid_deg(grid_deg))
+    ra_c, dec_c = coarse
     span = float(np.ptp(geo.t_s)) if geo.t_s.size else 0.0
     periods = scan_periods(geo.period_s, period_bound, sfm.n_phases, span)
     scanned = np.array(
         [
             _best(
                 _one_pass(
-                    sfm, dataclasses.replace(geo, period_s=float(p)), y, ra_c, dec_c, chunk,
+                    terms, sfm, dataclasses.replace(geo, period_s=float(p)), y, ra_c, dec_c, chunk,
                     None, ranging, "sidereal",
                 )[0]
             )
@@ -118,7 +121,7 @@ def grid_for_period(
         float(periods[int(np.argmin(scanned))]) if np.any(np.isfinite(scanned)) else geo.period_s
     )
     flat, rg = _one_pass(
-        sfm, dataclasses.replace(geo, period_s=p_best), y, ra, dec, chunk, progress, ranging,
+        terms, sfm, dataclasses.replace(geo, period_s=p_best), y, ra, dec, chunk, progress, ranging,
         "sidereal",
     )  # fmt: skip
     return PeriodGrid(flat, rg, "sidereal", {"sidereal": _best(flat)}, p_best, periods, scanned)
@@ -129,6 +132,7 @@ def _best(flat: F64) -> float:
 
 
 def _one_pass(
+    terms: Callable[..., tuple[F64, F64 | None]],
     sfm: SpinFrameMap,
     geo: EpochGeometry,
     y: F64,
@@ -141,14 +145,13 @@ def _one_pass(
 ) -> tuple[F64, RangingTerm | None]:
     """One grid pass (A, K) with ``geo.period_s`` read as ``kind``, and the ranging term
     with its weight resolved."""
-    from speclight.estimate.spin_axis.spin_axis_core import grid_terms
     from speclight.estimate.spin_axis.spin_axis_period import bisector_rates, sidereal_periods
 
     periods = None
     if kind == "synodic":
         dd, rr = np.meshgrid(dec, ra, indexing="ij")
         periods = sidereal_periods(geo.period_s, bisector_rates(geo, rr.ravel(), dd.ravel()))
-    flat, e_r = grid_terms(sfm, geo, y, ra, dec, chunk, progress, ranging, periods)
+    flat, e_r = terms(sfm, geo, y, ra, dec, chunk, progress, ranging, periods)
     if ranging is not None and e_r is not None:
         from speclight.estimate.spin_axis.spin_axis_ranging import resolve_weight
 
