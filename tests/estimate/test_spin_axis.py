@@ -135,3 +135,52 @@ def test_synthetic_map_gives_the_axis_it_was_made_with(ra, dec, phase0) -> None:
     # the error surface is saved on the grid, its minimum where the best cell is
     i, j = np.unravel_index(np.argmin(res.error), res.error.shape)
     assert (res.ra_deg[i], res.dec_deg[j]) == (best_ra, best_dec)
+
+
+def _sweeping_pass(n: int = 200) -> tuple[np.ndarray, np.ndarray]:
+    t = np.linspace(0.0, 150.0, n)
+    ang = np.radians(np.linspace(-30, 30, n))
+    los = np.stack([np.cos(ang) * 0.8, np.sin(ang) * 0.8, np.full(n, 0.6)], -1)
+    return t, los
+
+
+def test_a_synodic_period_gives_each_axis_its_sidereal_period() -> None:
+    # the pass made with a sidereal period; the search given the synodic one of the true
+    # axis by the linear relation 1/P_syn = 1/P_sid - Omega/(2 pi) (Harris et al. 1984),
+    # Omega computed here from the line of sight's azimuth about the true axis
+    from speclight.estimate.spin_axis.spin_axis_period import bisector_rates
+
+    ra, dec, phase0, p_sid = 40.0, 25.0, 50.0, 37.0
+    t, los = _sweeping_pass()
+    y = _rates(_body_directions(los, ra, dec, phase0, t, p_sid))
+    geo = EpochGeometry(los, los, t, p_sid)
+    omega = float(bisector_rates(geo, np.array([ra]), np.array([dec]))[0])
+    p_syn = 1.0 / (1.0 / p_sid - omega / (2 * np.pi))
+    assert abs(p_syn - p_sid) / p_sid > 0.005  # a shift the grid would not tolerate
+    bmap = _closed_form_map(16)
+    sfm = spin_frame_map(bmap, None, 36)
+    geo_syn = EpochGeometry(los, los, t, p_syn)
+    res = spin_axis_search(bmap, sfm, geo_syn, y, ["b0", "b1"], 10.0, period_kind="auto")
+    assert res.period_kind == "synodic"
+    assert res.period_kind_errors["synodic"] < res.period_kind_errors["sidereal"]
+    # the refined axis within the map's pixel (3.7 deg at nside 16), its period the truth's
+    # to the accuracy the axis gives it (dP/P = P Omega'/(2 pi), well below 0.5 %)
+    assert angular_distance_deg(res.refined[0], res.refined[1], ra, dec) < 3.7
+    assert res.refined_period_s == pytest.approx(p_sid, rel=5e-3)
+    assert res.confidence is not None and res.confidence.constrained
+
+
+def test_a_map_without_attitude_signal_is_said_not_to_constrain_the_axis() -> None:
+    # a Lambertian sphere's light depends on the phase angle alone; coaxial light: a constant
+    bmap = _closed_form_map(8)
+    flat = np.ones_like(bmap.intensity_W_sr_nm)
+    bmap = ReflectivityMap(bmap.header, bmap.direction_body, flat)
+    t, los = _sweeping_pass()
+    rng = np.random.default_rng(2)
+    y = 1.0 + 0.01 * rng.normal(size=(t.size, 2))
+    res = spin_axis_search(
+        bmap, spin_frame_map(bmap, None, 12), EpochGeometry(los, los, t, 37.0), y,
+        ["b0", "b1"], 30.0,
+    )  # fmt: skip
+    assert res.confidence is not None and not res.confidence.constrained
+    assert res.confidence.note.startswith("the data do not constrain the axis")

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from speclight.errors import InputError
-from speclight.estimate.spin_axis import spin_axis_core as sa
+from speclight.estimate.spin_axis.spin_axis_answer import refined_or_best
 from speclight.estimate.spin_axis.spin_axis_core import check_measured_curves, spin_axis_search
 from speclight.estimate.spin_axis.spin_axis_limits import check_search_cost, search_cost
 from speclight.estimate.spin_axis.spin_axis_lookup import (
@@ -82,11 +82,11 @@ def test_fallback_rule_by_hand() -> None:
     good = Refined(11.0, 21.0, 31.0, 0.1, 37.0, 5, 0)
     worse = Refined(50.0, 60.0, 70.0, 0.9, 37.0, 5, 0)
     nan = Refined(np.nan, 1.0, 1.0, np.nan, 37.0, 5, 0)
-    assert sa._refined_or_best([nan, good], best, 0.4, geo) == (good.answer, 37.0, "")
-    answer, period, note = sa._refined_or_best([worse], best, 0.4, geo)
+    assert refined_or_best([nan, good], best, 0.4, geo.period_s) == (good.answer, 37.0, "")
+    answer, period, note = refined_or_best([worse], best, 0.4, geo.period_s)
     assert answer == (10.0, 20.0, 30.0, 0.4) and "above the grid's best" in note
     assert period == geo.period_s
-    answer, _, note = sa._refined_or_best([nan], best, np.inf, geo)
+    answer, _, note = refined_or_best([nan], best, np.inf, geo.period_s)
     assert answer == best and "no finite misfit" in note  # the grid's own misfit then
 
 

@@ -33,6 +33,7 @@ SPIN_AXIS_FLAGS = {
     "bands": "--bands", "refine_method": "--refine", "period_bound": "--period-bound",
     "y": "MEASURED", "bmap": "--map", "map_path": "--map", "ranging_weight": "--ranging-weight",
     "light": "--source", "phase_angles_deg": "--phase-angles-deg",
+    "period_kind": "--period-kind",
 }  # fmt: skip
 #: Python parameter -> flag of the cores ``period`` calls.
 PERIOD_FLAGS = {
@@ -57,6 +58,15 @@ def spin_axis(
         float | None,
         typer.Option("--period-s", help="Rotation period \\[s] (default: the scenario's)."),
     ] = None,
+    period_kind: Annotated[
+        str | None,
+        typer.Option(
+            "--period-kind",
+            help="What the period is: sidereal (the body's), synodic (the light curve's, "
+            "as speclight period measures it: each axis gets its own sidereal period) or auto "
+            "(both tried, the better fit kept); default: auto with --period-s, else sidereal.",
+        ),
+    ] = None,
     grid_deg: Annotated[
         float, typer.Option("--grid-deg", help="RA/Dec grid step in deg, 0.01..90.")
     ] = 2.0,
@@ -80,13 +90,19 @@ def spin_axis(
         ),
     ] = "nelder-mead",
     free_period: Annotated[
-        bool,
-        typer.Option("--free-period", help="Refine the period too, within --period-bound."),
-    ] = False,
+        bool | None,
+        typer.Option(
+            "--free-period/--fixed-period",
+            help="Scan and refine the period too, within --period-bound (default: free with "
+            "--period-s, a light curve's period, fixed with the scenario's).",
+        ),
+    ] = None,
     period_bound: Annotated[
         float,
         typer.Option(
-            "--period-bound", help="With --free-period: largest relative change of the period."
+            "--period-bound",
+            help="With a free period: largest relative change of the period (scanned, then "
+            "refined).",
         ),
     ] = 0.05,
     source: Annotated[
@@ -119,15 +135,20 @@ def spin_axis(
     def run() -> None:
         from speclight.estimate.inputs.source_spectrum import check_light
         from speclight.estimate.spin_axis.spin_axis_core import check_search_options
+        from speclight.estimate.spin_axis.spin_axis_dataset import axis_dataset
+        from speclight.estimate.spin_axis.spin_axis_period import check_period_kind
         from speclight.estimate.spin_axis.spin_axis_refine import check_refine_options
-        from speclight.estimate.spin_axis.spin_axis_run import axis_dataset, spin_axis_measured
+        from speclight.estimate.spin_axis.spin_axis_run import spin_axis_measured
         from speclight.scenario import load_scenario
 
-        bound = period_bound if free_period else None
+        free = free_period if free_period is not None else period_s is not None
+        bound = period_bound if free else None
         with flag_names(**SPIN_AXIS_FLAGS):
             check_search_options(grid_deg, phases)
             check_refine_options(refine_method, bound)
             check_light(source)
+            if period_kind is not None:
+                check_period_kind(period_kind)
         names = [b.strip() for b in bands.split(",") if b.strip()] if bands else None
 
         def search() -> tuple[Any, Any]:
@@ -135,7 +156,7 @@ def spin_axis(
                 load_scenario(scenario), measured, map_file, period_s=period_s,
                 grid_deg=grid_deg, n_phases=phases, bands=names, refine=not no_refine,
                 light=source, ranging_weight=ranging_weight, refine_method=refine_method,
-                period_bound=bound,
+                period_bound=bound, period_kind=period_kind,
             )  # fmt: skip
             return result, axis_dataset(result, str(map_file), str(scenario))
 
@@ -145,7 +166,7 @@ def spin_axis(
             compute=search, data=lambda found: dataset_file(found[1]),
             figure=lambda found: _axis_figure(found[1]), flags=SPIN_AXIS_FLAGS,
         )  # fmt: skip
-        typer.echo(_axis_summary(ds.attrs, result, free_period))
+        typer.echo(_axis_summary(ds.attrs, result, free))
         say_wrote(output, plot_file)
 
     guarded(run)
@@ -170,7 +191,11 @@ def _axis_summary(a: Any, result: Any, free_period: bool) -> str:
         how = (
             f"refined RA {a['refined_ra_deg']:.2f} Dec {a['refined_dec_deg']:.2f} phase "
             f"{a['refined_phase_deg']:.1f} "
-            + (f"period {a['refined_period_s']:.6g} s " if free_period else "")
+            + (
+                f"sidereal period {a['refined_period_s']:.6g} s "
+                if free_period or a["period_kind"] == "synodic"
+                else ""
+            )
             + f"by {a['refine_method']} with {a['refine_misfit_evaluations']} misfit and "
             f"{a['refine_gradient_evaluations']} gradient evaluations "
         )
@@ -181,9 +206,15 @@ def _axis_summary(a: Any, result: Any, free_period: bool) -> str:
         )
     else:
         how = "not refined (--no-refine) "
+    kinds = ", ".join(
+        f"{k} {a[k + '_best_error']:.4g}" for k in ("sidereal", "synodic") if k + "_best_error" in a
+    )
     return (
         head + how + f"({result.result.n_epochs} epochs, {result.light}, ranging weight "
-        f"{result.ranging_weight:g}, {result.seconds:.1f} s)"
+        f"{result.ranging_weight:g}, period read as {a['period_kind']} (best misfit {kinds}), "
+        f"{result.seconds:.1f} s)\n"
+        + ("" if a["axis_constrained"] else "WARNING: ")
+        + a["axis_note"]
     )
 
 

@@ -28,7 +28,7 @@ free within a bound.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -40,10 +40,14 @@ from speclight.estimate.spin_axis.spin_axis_lookup import (
     EpochGeometry,
     SpinFrameMap,
 )
+from speclight.estimate.spin_axis.spin_axis_lookup import (
+    angular_distance_deg as angular_distance_deg,
+)
 from speclight.estimate.spin_axis.spin_axis_misfit import exact_misfit as exact_misfit
 from speclight.maps.map_lookup import ReflectivityMap
 
 if TYPE_CHECKING:
+    from speclight.estimate.spin_axis.spin_axis_confidence import AxisConfidence
     from speclight.estimate.spin_axis.spin_axis_ranging import RangingTerm
 
 F64 = NDArray[np.float64]
@@ -79,6 +83,15 @@ class SpinAxisResult:
     refine_n_gradient: int = 0  # analytic gradient (Jacobian) evaluations
     #: what became of the refinement, in words ("" where it ended below the grid's best)
     refine_note: str = ""
+    #: how the given period was read (``sidereal`` or ``synodic``; :mod:`.spin_axis_period`)
+    period_kind: str = "sidereal"
+    #: the grid's best misfit under each period kind tried
+    period_kind_errors: dict[str, float] = field(default_factory=dict)
+    #: sigmas, regions and flags of the refined solution (None without a refinement)
+    confidence: AxisConfidence | None = None
+    #: with a free period: the periods scanned [s] and the best misfit of each
+    scan_periods_s: F64 | None = None
+    scan_errors: F64 | None = None
 
 
 def check_search_options(grid_deg: float, n_phases: int) -> None:
@@ -136,6 +149,7 @@ def grid_errors(
     chunk: int = DEFAULT_AXIS_CHUNK,
     progress: Callable[[int, int], None] | None = None,
     ranging: RangingTerm | None = None,
+    period_s_axes: F64 | None = None,
 ) -> tuple[F64, NDArray[np.int64]]:
     """Misfit (A, n_phases) of every axis of the RA x Dec grid (A = n_ra n_dec, RA fastest)
     and the best phase's index per axis.
@@ -156,8 +170,10 @@ def grid_errors(
         Called with (done, total) axes, or None.
     ranging
         The range-offset term, or None.
+    period_s_axes
+        Each axis's own period [s] (n_dec n_ra,), or None for ``geo.period_s``.
     """
-    e_i, e_r = grid_terms(sfm, geo, y, ra_deg, dec_deg, chunk, progress, ranging)
+    e_i, e_r = grid_terms(sfm, geo, y, ra_deg, dec_deg, chunk, progress, ranging, period_s_axes)
     out = e_i if e_r is None or ranging is None else e_i + float(ranging.weight or 0.0) * e_r
     return out, np.argmin(out, axis=1)
 
@@ -171,6 +187,7 @@ def grid_terms(
     chunk: int = DEFAULT_AXIS_CHUNK,
     progress: Callable[[int, int], None] | None = None,
     ranging: RangingTerm | None = None,
+    period_s_axes: F64 | None = None,
 ) -> tuple[F64, F64 | None]:
     """Intensity term (A, n_phases) and ranging term (or None) of every grid candidate
     (:func:`.spin_axis_grid.grid_pass`).
@@ -191,11 +208,16 @@ def grid_terms(
         Called with (done, total) axes, or None.
     ranging
         The range-offset term, or None.
+    period_s_axes
+        Each axis's own period [s] (n_dec n_ra,), or None for ``geo.period_s``.
     """
     from speclight.estimate.spin_axis.spin_axis_grid import grid_pass
 
     dd, rr = np.meshgrid(dec_deg, ra_deg, indexing="ij")
-    return grid_pass(sfm, geo, y, rr.ravel(), dd.ravel(), chunk, progress, ranging)
+    return grid_pass(
+        sfm, geo, y, rr.ravel(), dd.ravel(), chunk, progress, ranging,
+        period_s_axes=period_s_axes,
+    )  # fmt: skip
 
 
 def local_minima(error: F64) -> NDArray[np.int64]:
@@ -217,13 +239,6 @@ def local_minima(error: F64) -> NDArray[np.int64]:
     return idx[np.argsort(e.ravel()[idx], kind="stable")]
 
 
-def angular_distance_deg(ra1: ArrayLike, dec1: ArrayLike, ra2: ArrayLike, dec2: ArrayLike) -> F64:
-    """Great-circle distance [deg] between RA/Dec pairs [deg]."""
-    r1, d1, r2, d2 = (np.radians(np.asarray(v, dtype=float)) for v in (ra1, dec1, ra2, dec2))
-    c = np.sin(d1) * np.sin(d2) + np.cos(d1) * np.cos(d2) * np.cos(r1 - r2)
-    return np.degrees(np.arccos(np.clip(c, -1.0, 1.0)))
-
-
 def spin_axis_search(
     bmap: ReflectivityMap,
     sfm: SpinFrameMap,
@@ -238,6 +253,7 @@ def spin_axis_search(
     ranging: RangingTerm | None = None,
     refine_method: str = "nelder-mead",
     period_bound: float | None = None,
+    period_kind: str = "sidereal",
 ) -> SpinAxisResult:
     """Grid search, mirror and refinement (module docstring).
 
@@ -261,11 +277,17 @@ def spin_axis_search(
     period_bound
         None: the period ``geo.period_s`` is fixed; else the refinement fits it too, within
         this fraction of it.
+    period_kind
+        What ``geo.period_s`` is (:mod:`.spin_axis_period`): ``sidereal`` (the body's),
+        ``synodic`` (the light curve's: each axis gets its own sidereal period) or ``auto``
+        (both tried, the better fit kept).
     """
-    from speclight.estimate.spin_axis.spin_axis_refine import check_refine_options, refine_candidate
+    from speclight.estimate.spin_axis.spin_axis_period import check_period_kind
+    from speclight.estimate.spin_axis.spin_axis_refine import check_refine_options
 
     check_search_options(grid_deg, sfm.n_phases)
     check_refine_options(refine_method, period_bound)
+    check_period_kind(period_kind)
     ok = np.all(np.isfinite(y), axis=1)
     ok &= np.all(np.isfinite(geo.sun_gcrs), axis=1) & np.all(np.isfinite(geo.observer_gcrs), axis=1)
     if ok.sum() < 3:
@@ -279,12 +301,13 @@ def spin_axis_search(
     check_measured_curves(y, band_names)
     ranging = ranging.select(ok) if ranging is not None else None
     ra, dec = radec_grid(grid_deg)
-    flat, e_r = grid_terms(sfm, geo, y, ra, dec, chunk, progress, ranging)
-    if ranging is not None and e_r is not None:
-        from speclight.estimate.spin_axis.spin_axis_ranging import resolve_weight
+    from speclight.estimate.spin_axis.spin_axis_period_scan import grid_for_period, scan_grid_deg
 
-        ranging = resolve_weight(ranging, flat, e_r)
-        flat = flat + float(ranging.weight or 0.0) * e_r
+    scan = grid_for_period(
+        sfm, geo, y, ra, dec, chunk, progress, ranging, period_kind, period_bound,
+        radec_grid(scan_grid_deg(grid_deg)), grid_terms,
+    )  # fmt: skip
+    flat, ranging, kind = scan.misfit, scan.ranging, scan.kind
     if not np.any(np.isfinite(flat)):
         raise InputError(
             f"no candidate of the grid has a finite misfit: at the {int(ok.sum())} measured "
@@ -293,6 +316,8 @@ def spin_axis_search(
             "bands, and covers the pass's phase angles",
             field="bmap",
         )
+    synodic_s = geo.period_s if kind == "synodic" else None
+    start_period_s = scan.period_s if period_bound is not None else None
     best_k = np.argmin(flat, axis=1)
     phase = np.arange(sfm.n_phases) * 360.0 / sfm.n_phases
     error = flat.min(axis=1).reshape(dec.size, ra.size)
@@ -309,21 +334,24 @@ def spin_axis_search(
         i = int(far[0])
         mirror = (float(r_f[i]), float(d_f[i]), float(p_f[i]), float(e_f[i]))
     refined = nan4
-    tries = []
+    n_m = n_g = 0
     note = "not refined (the refinement was turned off): refined_* is NaN"
     period_s = float("nan")
+    confidence = None
     if do_refine:
+        from speclight.estimate.spin_axis.spin_axis_answer import refine_answer
+        from speclight.estimate.spin_axis.spin_axis_confidence import axis_confidence, with_period
+
         step = max(grid_deg, 360.0 / sfm.n_phases) / 2
         starts = [best] + ([mirror] if far.size else [])
-        tries = [
-            refine_candidate(
-                bmap, geo, y, spin_body_axis, s[:3], step, refine_method, period_bound, ranging
-            )
-            for s in starts
-        ]
-        refined, period_s, note = _refined_or_best(
-            tries, best, exact_misfit(bmap, geo, y, spin_body_axis, *best[:3], ranging), geo
-        )
+        refined, period_s, note, n_m, n_g = refine_answer(
+            bmap, geo, y, spin_body_axis, starts, step, refine_method, period_bound, ranging,
+            synodic_s, start_period_s,
+        )  # fmt: skip
+        confidence = axis_confidence(
+            bmap, with_period(geo, period_s), y, spin_body_axis, refined, error, dec, ra,
+            period_bound is not None, ranging,
+        )  # fmt: skip
     return SpinAxisResult(
         ra,
         dec,
@@ -338,39 +366,12 @@ def spin_axis_search(
         0.0 if ranging is None else float(ranging.weight or 0.0),
         refine_method,
         period_s,
-        sum(t.n_misfit for t in tries),
-        sum(t.n_gradient for t in tries),
+        n_m,
+        n_g,
         note,
+        kind,
+        scan.errors,
+        confidence,
+        scan.periods_s,
+        scan.period_errors,
     )
-
-
-def _refined_or_best(
-    tries: list, best: tuple[float, float, float, float], best_exact: float, geo: EpochGeometry
-) -> tuple[tuple[float, float, float, float], float, str]:
-    """The best finite refinement (answer, period [s], "") of ``tries``
-    (:class:`.spin_axis_refine.Refined`); the grid's best cell with its misfit under the
-    map's own interpolation, the period given and the reason, where no refinement ended
-    finite or none below that misfit."""
-    finite = [t for t in tries if np.all(np.isfinite(t.answer)) and np.isfinite(t.period_s)]
-    exact = float(best_exact) if np.isfinite(best_exact) else best[3]
-    fallback = (best[0], best[1], best[2], exact)
-    if not finite:
-        return (
-            fallback,
-            geo.period_s,
-            (
-                "the refinement ended at no finite misfit from any start; refined_* is the "
-                "grid's best cell"
-            ),
-        )
-    chosen = min(finite, key=lambda t: t.error)
-    if np.isfinite(best_exact) and chosen.error > best_exact:
-        return (
-            fallback,
-            geo.period_s,
-            (
-                f"the refinement ended at a misfit {chosen.error:.4g} above the grid's best "
-                f"cell's {best_exact:.4g}; refined_* is that cell"
-            ),
-        )
-    return chosen.answer, chosen.period_s, ""

@@ -150,14 +150,18 @@ def _roll(p: F64, u: F64) -> F64:
     return np.asarray(np.mod(np.arctan2(lat_c, lon_c), 2 * np.pi))
 
 
-def lookup_corners(sfm: SpinFrameMap, ef: EpochFrames, frames: F64) -> Corners:
+def lookup_corners(
+    sfm: SpinFrameMap, ef: EpochFrames, frames: F64, spin_turn_rad: F64 | None = None
+) -> Corners:
     """Corners of the lookups of ``frames`` (A, 3, 3) x the epochs of ``ef`` (phase ``k``:
-    ``360 k / K`` deg at ``t_s = 0``; the grid layout of :class:`.SpinFrameMap`)."""
+    ``360 k / K`` deg at ``t_s = 0``; the grid layout of :class:`.SpinFrameMap`);
+    ``spin_turn_rad`` (A, T): each axis's own spin turn (its own period), else ``ef``'s."""
     n_ax = frames.shape[0]
     p = np.matmul(ef.p[None], frames)  # (A, T, 3): frame^T p, the spin-frame phase vectors
     n_k, m = sfm.n_phases, sfm.m
     n_az = n_k * m
-    az = np.arctan2(p[..., 1], p[..., 0]) - ef.spin_turn_rad
+    turn = ef.spin_turn_rad if spin_turn_rad is None else spin_turn_rad
+    az = np.arctan2(p[..., 1], p[..., 0]) - turn
     c = np.rint(np.mod(az.ravel(), 2 * np.pi) / (2 * np.pi) * n_az).astype(np.int64) % n_az
     pz = p[..., 2].ravel()
     bad = ~np.isfinite(pz)
@@ -192,8 +196,9 @@ def gather(table: F32, corners: Corners, sl: slice, fill: float = np.nan) -> F32
     bad)."""
     if corners.weights is None:
         out = table[corners.rows[sl, 0]]
-    else:  # (n, corners, K C) weighted and summed over the corners
-        out = np.einsum("nc,ncj->nj", corners.weights[sl], table[corners.rows[sl]])
+    else:  # (n, corners, K C) weighted and summed over the corners: (1 x c) @ (c x K C)
+        w = corners.weights[sl]
+        out = np.matmul(w[:, None, :], table[corners.rows[sl]])[:, 0]
     bad = corners.bad[sl]
     if bad.any():
         out[bad] = fill
@@ -250,6 +255,7 @@ def grid_pass(
     ranging: RangingTerm | None = None,
     block_bytes: int = BLOCK_BYTES,
     workers: int = 1,
+    period_s_axes: F64 | None = None,
 ) -> tuple[F64, F64 | None]:
     """Intensity term (A, K) and ranging term (A, K) or None of the axes ``ra_all, dec_all``.
 
@@ -279,6 +285,10 @@ def grid_pass(
         Gathered floats per block [bytes].
     workers
         Threads over the chunks.
+    period_s_axes
+        Each axis's own rotation period [s] (A,) (a synodic period turned sidereal,
+        :mod:`.spin_axis_period`; NaN: no candidate, infinite misfit), or None for
+        ``geo.period_s``.
     """
     n_t, n_b = y.shape
     n_k = sfm.n_phases
@@ -317,7 +327,16 @@ def grid_pass(
 
     def one(start: int) -> int:
         stop = min(start + chunk, n_axes)
-        e_i[start:stop], er = _chunk_terms(ps, axis_frames(ra_all[start:stop], dec_all[start:stop]))
+        turn = None
+        if period_s_axes is not None:
+            per = period_s_axes[start:stop, None]
+            with np.errstate(invalid="ignore"):
+                turn = 2 * np.pi * np.mod(geo.t_s[None] / per, 1.0)
+        frames = axis_frames(ra_all[start:stop], dec_all[start:stop])
+        e_i[start:stop], er = _chunk_terms(ps, frames, turn)
+        if period_s_axes is not None:
+            gone = ~np.isfinite(period_s_axes[start:stop])
+            e_i[start:stop][gone] = np.inf
         if e_r is not None and er is not None:
             e_r[start:stop] = er
         return stop
@@ -330,12 +349,15 @@ def grid_pass(
     return e_i, e_r
 
 
-def _chunk_terms(ps: _Pass, frames: F64) -> tuple[F64, F64 | None]:
-    """Both terms (A, K) of a chunk of axes, in blocks of ``ps.block_axes``."""
+def _chunk_terms(ps: _Pass, frames: F64, turn: F64 | None) -> tuple[F64, F64 | None]:
+    """Both terms (A, K) of a chunk of axes, in blocks of ``ps.block_axes`` (``turn``: the
+    axes' own spin turns (A, T) [rad], or None)."""
     n_ax, n_t, n_b, n_k = frames.shape[0], ps.yn_tiled.shape[0], ps.n_b, ps.sfm.n_phases
     rg = ps.ranging
-    c_r = None if rg is None else lookup_corners(rg.sfm, rg.ef, frames)
-    c_i = c_r if rg is not None and rg.shares_rates else lookup_corners(ps.sfm, ps.ef, frames)
+    if turn is not None:
+        turn = np.nan_to_num(turn)  # axes without a period: any lookup, marked afterwards
+    c_r = None if rg is None else lookup_corners(rg.sfm, rg.ef, frames, turn)
+    c_i = c_r if rg is not None and rg.shares_rates else lookup_corners(ps.sfm, ps.ef, frames, turn)
     assert c_i is not None
     sums = np.empty((3, n_ax, n_k * n_b), dtype=np.float32)  # sum p, p^2, p y over epochs
     e_r = None if rg is None else np.empty((n_ax, n_k))

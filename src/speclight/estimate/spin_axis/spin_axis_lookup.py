@@ -149,3 +149,10 @@ class EpochGeometry:
     observer_gcrs: F64  # (T, 3)
     t_s: F64  # (T,) seconds since the scenario start
     period_s: float
+
+
+def angular_distance_deg(ra1: ArrayLike, dec1: ArrayLike, ra2: ArrayLike, dec2: ArrayLike) -> F64:
+    """Great-circle distance [deg] between RA/Dec pairs [deg]."""
+    r1, d1, r2, d2 = (np.radians(np.asarray(v, dtype=float)) for v in (ra1, dec1, ra2, dec2))
+    c = np.sin(d1) * np.sin(d2) + np.cos(d1) * np.cos(d2) * np.cos(r1 - r2)
+    return np.degrees(np.arccos(np.clip(c, -1.0, 1.0)))

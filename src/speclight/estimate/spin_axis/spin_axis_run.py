@@ -23,14 +23,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import xarray as xr
 from numpy.typing import NDArray
 
 from speclight.attitude.quaternion import quat_rotate
 from speclight.errors import InputError
 from speclight.estimate.spin_axis.spin_axis_core import (
     DEFAULT_AXIS_CHUNK,
-    MIRROR_SEP_DEG,
     SpinAxisResult,
     check_search_options,
     spin_axis_search,
@@ -173,6 +171,7 @@ def spin_axis_measured(
     ranging_weight: float | None = None,
     refine_method: str = "nelder-mead",
     period_bound: float | None = None,
+    period_kind: str | None = None,
 ) -> SpinAxisRun:
     """Search the spin axis of a measured pass against a reflectivity map (module doc).
 
@@ -207,6 +206,10 @@ def spin_axis_measured(
     refine_method, period_bound
         The refinement's method and, for a free period, the fraction by which it may differ
         (:func:`.spin_axis_core.spin_axis_search`).
+    period_kind
+        What the period is (:mod:`.spin_axis_period`): ``sidereal``, ``synodic`` (a light
+        curve's, e.g. from ``speclight period``) or ``auto``; default ``auto`` for a given
+        ``period_s``, ``sidereal`` for the scenario's.
 
     Returns
     -------
@@ -217,6 +220,7 @@ def spin_axis_measured(
     from speclight.estimate.inputs.measured import read_measured
     from speclight.estimate.inputs.reflectance_factors import read_reflectance_factors
     from speclight.estimate.spin_axis.spin_axis_limits import check_search_cost
+    from speclight.estimate.spin_axis.spin_axis_period import check_period_kind
     from speclight.estimate.spin_axis.spin_axis_refine import check_refine_options
     from speclight.maps.map_lookup import check_map_matches
     from speclight.simulation.geometry_stage import scenario_geometry
@@ -224,6 +228,9 @@ def spin_axis_measured(
 
     check_search_options(grid_deg, n_phases)
     check_refine_options(refine_method, period_bound)
+    if period_kind is None:
+        period_kind = "sidereal" if period_s is None else "auto"
+    check_period_kind(period_kind)
     period, body_axis, spin = _spin_model(loaded, period_s)
     map_path = Path(map_path)
     bmap = load_band_map(map_path)
@@ -313,10 +320,11 @@ def spin_axis_measured(
         ranging,
         refine_method,
         period_bound,
+        period_kind,
     )
     seconds = time.perf_counter() - t0
     refined_epochs = epochs
-    if period_bound is not None and np.isfinite(result.refined_period_s):
+    if np.isfinite(result.refined_period_s):
         refined_epochs = dataclasses.replace(epochs, period_s=result.refined_period_s)
     tracks = {
         "best": phase_vector_track(epochs, body_axis, **_candidate(result.best)),
@@ -345,75 +353,3 @@ def spin_axis_measured(
         tracks,
         period_bound,
     )
-
-
-def axis_dataset(run: SpinAxisRun, map_path: str, scenario_source: str) -> xr.Dataset:
-    """AXIS.nc (docs/spin-axis.md): ``error(ra, dec)``, ``best_phase(ra, dec)`` and the answers."""
-    r = run.result
-    ds = xr.Dataset(
-        {
-            "error": (("ra", "dec"), r.error),
-            "best_phase": (("ra", "dec"), r.best_phase_deg),
-        },
-        coords={"ra": r.ra_deg, "dec": r.dec_deg, "band": r.band_names},
-    )
-    if run.time_utc is not None and run.tracks:
-        names = list(run.tracks)
-        ds = ds.assign_coords(time=run.time_utc, solution=names)
-        lon = np.stack([run.tracks[n][0] for n in names], axis=1)
-        lat = np.stack([run.tracks[n][1] for n in names], axis=1)
-        ds["track_lon"] = (("time", "solution"), lon, {"units": "deg"})
-        ds["track_lat"] = (("time", "solution"), lat, {"units": "deg"})
-        ds["track_lon"].attrs["long_name"] = "body-frame longitude of the phase vector"
-        ds["track_lat"].attrs["long_name"] = "body-frame latitude of the phase vector"
-    ds["ra"].attrs["units"] = "deg"
-    ds["dec"].attrs["units"] = "deg"
-    ds["best_phase"].attrs.update(
-        units="deg", long_name="rotation phase at the scenario start minimising the misfit"
-    )
-    ds["error"].attrs.update(
-        units="1",
-        long_name="misfit minimised over the phase: mean over epochs and bands of the squared "
-        "difference of the light curves each divided by its mean",
-    )
-    attrs: dict[str, Any] = {}
-    for key, val in (("best", r.best), ("mirror", r.mirror), ("refined", r.refined)):
-        attrs[f"{key}_ra_deg"], attrs[f"{key}_dec_deg"] = val[0], val[1]
-        attrs[f"{key}_phase_deg"], attrs[f"{key}_error"] = val[2], val[3]
-    if run.scenario_axis is not None:
-        attrs["scenario_ra_deg"], attrs["scenario_dec_deg"] = run.scenario_axis
-    refined = bool(np.isfinite(r.refined[0]))
-    attrs.update(
-        refine_method=r.refine_method if refined else "none",
-        refine_note=r.refine_note or "refined from the grid's best cell (and the mirror's)",
-        mirror_note="the lowest local minimum farther than mirror_min_separation_deg from the "
-        "best cell"
-        if np.isfinite(r.mirror[0])
-        else "no local minimum of the misfit farther than mirror_min_separation_deg from the "
-        "best cell: mirror_* is NaN",
-        refine_misfit_evaluations=r.refine_n_misfit,
-        refine_gradient_evaluations=r.refine_n_gradient,
-        period_free=int(run.period_bound is not None),
-    )
-    if run.period_bound is not None:
-        attrs["period_bound"] = run.period_bound
-        attrs["refined_period_s"] = r.refined_period_s
-    attrs.update(
-        period_s=run.period_s,
-        spin_body_axis=np.asarray(run.spin_body_axis, dtype=float),
-        n_phases=run.n_phases,
-        grid_deg=float(360.0 / r.ra_deg.size),
-        n_epochs=r.n_epochs,
-        mirror_min_separation_deg=MIRROR_SEP_DEG,
-        normalisation="each band's light curve divided by its mean over the epochs",
-        phase_convention="phase of the rotation about spin_body_axis at the scenario start, "
-        "from the ascending node of the spin plane (attitude model spin)",
-        measured_source=run.source,
-        light=run.light,
-        ranging_weight=run.ranging_weight,
-        map_file=map_path,
-        scenario_source=scenario_source,
-        seconds=run.seconds,
-    )
-    ds.attrs.update(attrs)
-    return ds

@@ -1,0 +1,125 @@
+"""Spin-axis uncertainties and the synodic period: closed forms and textbook estimators.
+
+References: the synodic-sidereal relation ``1 / P_sid = 1 / P_syn + Omega / (2 pi)`` (Harris
+et al. 1984, Icarus 57, 251; Pravec et al. 2005) with a phase vector turning uniformly about
+an axis by construction; the least-squares covariance ``sigma^2 (X^T X)^-1`` of a straight
+line fit with white noise (any regression textbook; the sandwich estimator reduces to it,
+White 1980); the variance of second differences of white noise, ``6 sigma^2``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from speclight.errors import InputError
+from speclight.estimate.spin_axis.spin_axis_confidence import (
+    AxisConfidence,
+    _verdict,
+    noise_floor,
+    sandwich_covariance,
+)
+from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry
+from speclight.estimate.spin_axis.spin_axis_period import (
+    bisector_rates,
+    check_period_kind,
+    sidereal_periods,
+)
+from speclight.estimate.spin_axis.spin_axis_period_scan import scan_periods
+
+
+def _turning_pass(rate_rad_s: float, n: int = 200) -> EpochGeometry:
+    """Sun and observer symmetric about a phase vector in the equator turning at ``rate``
+    about +z (GCRS): the phase vector is ``(cos(w t), sin(w t), 0)`` exactly."""
+    t = np.linspace(0.0, 600.0, n)
+    p = np.stack([np.cos(rate_rad_s * t), np.sin(rate_rad_s * t), np.zeros(n)], -1)
+    z = np.array([0.0, 0.0, 1.0])
+    half = np.radians(30.0)  # half the phase angle, in the plane of p and z
+    sun = np.cos(half) * p + np.sin(half) * z
+    obs = np.cos(half) * p - np.sin(half) * z
+    return EpochGeometry(sun, obs, t, 100.0)
+
+
+def test_bisector_rate_and_sidereal_period_closed_form() -> None:
+    w = 2e-3  # rad/s: 69 deg over the 600 s pass
+    geo = _turning_pass(w)
+    rates = bisector_rates(geo, np.array([0.0, 0.0]), np.array([90.0, -90.0]))
+    # about +z the azimuth grows at w; about -z (the reverse axis) it falls at w
+    np.testing.assert_allclose(rates, [w, -w], rtol=1e-9)
+    p_syn = 120.0
+    expected = 1.0 / (1.0 / p_syn + w / (2 * np.pi))
+    np.testing.assert_allclose(sidereal_periods(p_syn, rates)[0], expected, rtol=1e-12)
+    # a bisector turning faster than the light curve's frequency: no sidereal period
+    assert np.isnan(sidereal_periods(p_syn, np.array([-1.0]))[0])
+    with pytest.raises(InputError, match="period_kind"):
+        check_period_kind("apparent")
+
+
+def test_sandwich_is_the_textbook_covariance_for_white_residuals() -> None:
+    # straight line y = a + b t with white noise: C = sigma^2 (X^T X)^-1
+    rng = np.random.default_rng(3)
+    t = np.linspace(-1.0, 1.0, 4000)
+    x = np.stack([np.ones_like(t), t], -1)
+    sigma = 0.3
+    r = sigma * rng.normal(size=t.size)
+    cov, a_inv, _ = sandwich_covariance(r, x, t.size)
+    textbook = sigma**2 * np.linalg.inv(x.T @ x)
+    # the sandwich's own sampling error: relative ~ sqrt(2 / n) per variance (5 sigma)
+    np.testing.assert_allclose(np.diag(cov), np.diag(textbook), rtol=5 * np.sqrt(2 / t.size))
+    np.testing.assert_allclose(a_inv, np.linalg.inv(x.T @ x), rtol=1e-9, atol=1e-15)
+
+
+def test_sandwich_widens_for_correlated_residuals() -> None:
+    # AR(1) residuals rho = 0.9: the mean's variance is (1 + rho) / (1 - rho) = 19 times
+    # the white-noise formula's (long-run variance of an AR(1) process)
+    rng = np.random.default_rng(5)
+    n, rho = 20000, 0.9
+    e = rng.normal(size=n)
+    r = np.empty(n)
+    r[0] = e[0]
+    for i in range(1, n):
+        r[i] = rho * r[i - 1] + np.sqrt(1 - rho**2) * e[i]
+    x = np.ones((n, 1))
+    cov, _, lag = sandwich_covariance(r, x, n)
+    white = np.var(r) / n
+    assert lag > 5
+    # Bartlett weights at a finite lag are biased low: accept half to all of the factor 19
+    assert 0.5 * 19 < cov[0, 0] / white < 1.2 * 19
+
+
+def test_noise_floor_of_white_noise() -> None:
+    rng = np.random.default_rng(7)
+    t = np.linspace(0, 600, 3000)
+    sigma = 0.02
+    curve = 1.0 + 0.3 * np.sin(2 * np.pi * t / 120.0)  # smooth: second differences ~ 0
+    y = np.stack([curve * (1 + sigma * rng.normal(size=t.size)) for _ in range(2)], -1)
+    # the normalised curve's noise is sigma * curve / mean(curve) = sigma * curve: mean
+    # square sigma^2 (1 + 0.3^2 / 2)
+    expected = sigma**2 * (1 + 0.045)
+    # MAD of 2 x 3000 values: relative standard error of a variance ~ 2 x 1.65 / sqrt(n)
+    assert noise_floor(y) == pytest.approx(expected, rel=5 * 3.3 / np.sqrt(6000))
+
+
+def test_verdicts() -> None:
+    flat = AxisConfidence(contrast=1.01, region95_fraction=1.0, sigma_axis_deg=500.0)
+    ok, note = _verdict(flat)
+    assert not ok and note.startswith("the data do not constrain the axis")
+    two = AxisConfidence(
+        contrast=8.0, region95_fraction=0.001, sigma_axis_deg=2.0, region95_max_sep_deg=170.0
+    )
+    ok, note = _verdict(two)
+    assert not ok and "second minimum" in note
+    good = AxisConfidence(
+        contrast=8.0, region95_fraction=0.001, sigma_axis_deg=2.0, region95_max_sep_deg=4.0,
+        noise_ratio=50.0, noise_floor=1e-3,
+    )  # fmt: skip
+    ok, note = _verdict(good)
+    assert ok and "times the noise floor" in note
+
+
+def test_scan_steps_drift_two_phase_steps() -> None:
+    # 72 phases, 600 s pass, P 120 s: a relative step of 2 P / (K span) = 1/180 drifts
+    # 360 x 5 turns / 180 = 10 deg = two 5-deg phase steps
+    p = scan_periods(120.0, 0.05, 72, 600.0)
+    assert p[0] == pytest.approx(114.0) and p[-1] == pytest.approx(126.0)
+    assert np.max(np.diff(p)) / 120.0 <= 1 / 180 + 1e-12
