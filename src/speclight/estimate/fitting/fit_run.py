@@ -31,13 +31,14 @@ from numpy.typing import NDArray
 
 from speclight import schema
 from speclight.errors import InputError
-from speclight.estimate.fitting.fit import F64, fit_scales, shot_noise_sigma
+from speclight.estimate.fitting.fit import F64, fit_scales
 from speclight.estimate.fitting.fit_bins import EpochBins
 from speclight.estimate.fitting.fit_run_roughness import (
     fit_rough_gradient,
     fit_rough_slsqp,
     roughness_problems,
 )
+from speclight.estimate.fitting.noise_model import PoissonNoise
 from speclight.estimate.inputs.measured import MeasuredLightCurve
 from speclight.estimate.spectra.upsampling import band_albedo
 from speclight.scenario import LoadedScenario
@@ -171,8 +172,8 @@ def fit_scenario(
         ``gradient`` (analytic derivatives of the single-scattering render,
         :mod:`speclight.estimate.fitting.gradient_fit`). The albedos are in closed form either way.
     scan
-        ``slsqp`` with one roughness: scan the bounds before SLSQP (``False`` starts SLSQP
-        at the scenario's roughness).
+        Scan the bounds before the local method (:mod:`.roughness_scan`; ``False`` starts
+        it at the scenario's roughness).
     """
     from speclight.simulation import simulate
 
@@ -209,22 +210,20 @@ def fit_scenario(
     show = progress and sys.stderr.isatty()
     first = simulate(base, progress=show, time_utc=lc.time_utc)
     ds = first.dataset
-    sigma = lc.sigma_per_s
-    shot = shot_noise_sigma(lc.rate_per_s, sc.instrument.exposure_s, lc.n_samples)
-    sigma = shot if sigma is None else np.where(np.isfinite(sigma), sigma, shot)
+    sigma = noise_of(loaded, lc, ds)
     usable = (ds["flags"].values.astype(np.int64) & _SKIP) == 0
     m = np.where(usable[:, None], lc.rate_per_s, np.nan)
     _check_some_usable(lc, m, ds, loaded)
     bins = None
     if bin_s is not None:
-        bins = EpochBins.of(lc.time_utc, bin_s, np.isfinite(m) & np.isfinite(sigma) & (sigma > 0))
+        bins = EpochBins.of(lc.time_utc, bin_s, np.isfinite(m))
     rho = _band_reflectance(loaded, ds)
     notes: list[str] = []
     if rough:
         if method == "gradient":
             fit = fit_rough_gradient(
                 base, first, m=m, sigma=sigma, rough=rough, fit_scale="albedo" in free,
-                show=show, bins=bins,
+                show=show, scan=scan, bins=bins,
             )  # fmt: skip
             method_text = (
                 "gradient: least squares (trust region) over log roughness with the analytic "
@@ -252,7 +251,7 @@ def fit_scenario(
             raise InputError("`free` must include albedo or roughness", field="free")
         if bins is not None:
             model = bins.mean(model)
-        m_fit, s_fit = (m, sigma) if bins is None else (bins.mean(m), bins.sigma(sigma))
+        m_fit, s_fit = (m, sigma) if bins is None else (bins.mean(m), sigma.binned(bins))
         scales = fit_scales(model, m_fit, s_fit)
         roughness, extra = {}, {}
         method_text = "weighted least squares (closed form; linear in albedo)"
@@ -263,6 +262,40 @@ def fit_scenario(
     notes += _scale_problems(names, scales.scale, scales.scale_std, scales.n_used)
     fitted = model * scales.scale[None, :]
     return _result(lc, names, rho, scales, roughness, m, fitted, method_text, notes, extra)
+
+
+def noise_of(loaded: LoadedScenario, lc: MeasuredLightCurve, ds: Any) -> PoissonNoise:
+    """The noise of the measured rates (:mod:`.noise_model`): the model's own shot noise
+    over ``instrument.exposure_s`` times the exposures averaged, with the background (sky
+    and dark current) and read noise of the scenario's ``instrument.noise`` where it has
+    one, Gaussian with the data's own sigmas where they give them. ``ds`` is a simulation
+    of the scenario (its band responses give the sky's rate)."""
+    from speclight import instrument
+
+    sc = loaded.scenario
+    background: F64 | float = 0.0
+    read_e = 0.0
+    noise = sc.instrument.noise
+    if noise is not None and noise.enabled:
+        wl = ds["wavelength"].values.astype(float)
+        area = instrument.aperture_area_m2(
+            sc.telescope.aperture_diameter_m, sc.telescope.obstruction_diameter_m
+        )
+        kernel = (
+            ds["band_response"].transpose("band", "wavelength").values
+            * ds["detector_qe"].transpose("band", "wavelength").values
+        )
+        sky = instrument.sky_count_rate_per_s(
+            noise.sky_background_mag_arcsec2, area, wl, ds["optics_transmission"].values,
+            np.ones(wl.size), kernel,
+            background_aperture_radius_arcsec=noise.aperture_radius_arcsec,
+        )  # fmt: skip
+        background = np.asarray(sky, dtype=float) + noise.dark_current_e_per_s
+        read_e = float(noise.read_noise_e)
+    return PoissonNoise.of(
+        lc.rate_per_s.shape, sc.instrument.exposure_s, lc.n_samples, background, read_e,
+        given_sigma=lc.sigma_per_s,
+    )  # fmt: skip
 
 
 def _check_some_usable(lc: MeasuredLightCurve, m: F64, ds: Any, loaded: LoadedScenario) -> None:
