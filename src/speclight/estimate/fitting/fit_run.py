@@ -31,16 +31,23 @@ from numpy.typing import NDArray
 
 from speclight import schema
 from speclight.errors import InputError
-from speclight.estimate.fitting.fit import F64, fit_scales
+from speclight.estimate.fitting.fit import F64
 from speclight.estimate.fitting.fit_bins import EpochBins
+from speclight.estimate.fitting.fit_inputs import band_reflectance, noise_of
+from speclight.estimate.fitting.fit_quality import (
+    CLIP_SIGMA,
+    clipped_scales,
+    misfit_text,
+    outlier_text,
+    reduced_chi2,
+)
 from speclight.estimate.fitting.fit_run_roughness import (
     fit_rough_gradient,
     fit_rough_slsqp,
     roughness_problems,
 )
-from speclight.estimate.fitting.noise_model import PoissonNoise
+from speclight.estimate.fitting.noise_model import Likelihood
 from speclight.estimate.inputs.measured import MeasuredLightCurve
-from speclight.estimate.spectra.upsampling import band_albedo
 from speclight.scenario import LoadedScenario
 from speclight.scenario.overrides import replace_fields
 
@@ -149,6 +156,7 @@ def fit_scenario(
     progress: bool = False,
     method: str = "slsqp",
     scan: bool = True,
+    clip_sigma: float | None = CLIP_SIGMA,
 ) -> FitResult:
     """Fit the scenario's band albedos (and roughness) to measured count rates.
 
@@ -174,11 +182,25 @@ def fit_scenario(
     scan
         Scan the bounds before the local method (:mod:`.roughness_scan`; ``False`` starts
         it at the scenario's roughness).
+    clip_sigma
+        Leave out measurements more than this many robust sigmas from the fit, and say so
+        (:mod:`.fit_quality`); 0 or None keeps every one.
     """
     from speclight.simulation import simulate
 
     check_free(free)
     check_method(method)
+    if (
+        clip_sigma is not None
+        and clip_sigma != 0
+        and not (math.isfinite(clip_sigma) and clip_sigma >= 3)
+    ):
+        raise InputError(
+            f"clip_sigma = {clip_sigma!r}: give a number of sigmas >= 3, or 0 to keep every "
+            "measurement",
+            field="clip_sigma",
+        )
+    clip_sigma = clip_sigma or None
     sc = loaded.scenario
     if sc.target is None:
         raise InputError("the scenario has no target to fit", field="target")
@@ -217,13 +239,13 @@ def fit_scenario(
     bins = None
     if bin_s is not None:
         bins = EpochBins.of(lc.time_utc, bin_s, np.isfinite(m))
-    rho = _band_reflectance(loaded, ds)
+    rho = band_reflectance(loaded, ds)
     notes: list[str] = []
     if rough:
         if method == "gradient":
             fit = fit_rough_gradient(
                 base, first, m=m, sigma=sigma, rough=rough, fit_scale="albedo" in free,
-                show=show, scan=scan, bins=bins,
+                show=show, scan=scan, bins=bins, clip_sigma=clip_sigma,
             )  # fmt: skip
             method_text = (
                 "gradient: least squares (trust region) over log roughness with the analytic "
@@ -232,7 +254,7 @@ def fit_scenario(
         else:
             fit = fit_rough_slsqp(
                 base, first, m=m, sigma=sigma, rough=rough, fit_scale="albedo" in free,
-                show=show, scan=scan, bins=bins,
+                show=show, scan=scan, bins=bins, clip_sigma=clip_sigma,
             )  # fmt: skip
             method_text = (
                 "SLSQP over roughness (variable projection), weighted least squares for scales"
@@ -244,6 +266,7 @@ def fit_scenario(
         }
         notes += roughness_problems(rough, fit)
         extra = {"n_simulations": fit.n_simulations, "n_iterations": fit.n_iterations}
+        drop, n_par = fit.outliers, len(rough)
     else:
         model = ds["count_rate"].transpose("time", "band").values.astype(float)
         model = np.where(usable[:, None], model, np.nan)
@@ -252,8 +275,8 @@ def fit_scenario(
         if bins is not None:
             model = bins.mean(model)
         m_fit, s_fit = (m, sigma) if bins is None else (bins.mean(m), sigma.binned(bins))
-        scales = fit_scales(model, m_fit, s_fit)
-        roughness, extra = {}, {}
+        scales, drop = clipped_scales(Likelihood(m_fit, s_fit), model, clip_sigma)
+        roughness, extra, n_par = {}, {}, 0
         method_text = "weighted least squares (closed form; linear in albedo)"
     if bins is not None:
         m = bins.mean(m)
@@ -261,41 +284,24 @@ def fit_scenario(
         method_text += f"; measurements and model averaged over the same {bin_s:g} s bins"
     notes += _scale_problems(names, scales.scale, scales.scale_std, scales.n_used)
     fitted = model * scales.scale[None, :]
-    return _result(lc, names, rho, scales, roughness, m, fitted, method_text, notes, extra)
-
-
-def noise_of(loaded: LoadedScenario, lc: MeasuredLightCurve, ds: Any) -> PoissonNoise:
-    """The noise of the measured rates (:mod:`.noise_model`): the model's own shot noise
-    over ``instrument.exposure_s`` times the exposures averaged, with the background (sky
-    and dark current) and read noise of the scenario's ``instrument.noise`` where it has
-    one, Gaussian with the data's own sigmas where they give them. ``ds`` is a simulation
-    of the scenario (its band responses give the sky's rate)."""
-    from speclight import instrument
-
-    sc = loaded.scenario
-    background: F64 | float = 0.0
-    read_e = 0.0
-    noise = sc.instrument.noise
-    if noise is not None and noise.enabled:
-        wl = ds["wavelength"].values.astype(float)
-        area = instrument.aperture_area_m2(
-            sc.telescope.aperture_diameter_m, sc.telescope.obstruction_diameter_m
+    n_par += len(names) if "albedo" in free else 0
+    notices = [
+        text
+        for text in (
+            outlier_text(drop, lc.time_utc, names, clip_sigma or 0.0),
+            misfit_text(float(np.sum(scales.chi2)), int(np.sum(scales.n_used)), n_par),
         )
-        kernel = (
-            ds["band_response"].transpose("band", "wavelength").values
-            * ds["detector_qe"].transpose("band", "wavelength").values
-        )
-        sky = instrument.sky_count_rate_per_s(
-            noise.sky_background_mag_arcsec2, area, wl, ds["optics_transmission"].values,
-            np.ones(wl.size), kernel,
-            background_aperture_radius_arcsec=noise.aperture_radius_arcsec,
-        )  # fmt: skip
-        background = np.asarray(sky, dtype=float) + noise.dark_current_e_per_s
-        read_e = float(noise.read_noise_e)
-    return PoissonNoise.of(
-        lc.rate_per_s.shape, sc.instrument.exposure_s, lc.n_samples, background, read_e,
-        given_sigma=lc.sigma_per_s,
-    )  # fmt: skip
+        if text
+    ]
+    extra["n_outliers"] = int(np.count_nonzero(drop))
+    extra["chi2_per_dof"] = _num(
+        reduced_chi2(float(np.sum(scales.chi2)), int(np.sum(scales.n_used)), n_par)
+    )
+    m = np.where(drop, np.nan, m)
+    result = _result(lc, names, rho, scales, roughness, m, fitted, method_text, notes, extra)
+    if notices:
+        result.message = "; ".join(([] if result.converged else [result.message]) + notices)
+    return result
 
 
 def _check_some_usable(lc: MeasuredLightCurve, m: F64, ds: Any, loaded: LoadedScenario) -> None:
@@ -333,27 +339,6 @@ def _scale_problems(names: list[str], scale: F64, std: F64, n_used: NDArray) -> 
         elif scale[j] < 0:
             out.append(f"albedo of band '{name}' came out negative ({scale[j]:.3g} x start)")
     return out
-
-
-def _band_reflectance(loaded: LoadedScenario, ds: Any) -> F64:
-    """The scenario's target reflectance per band (module doc: Albedo) [1] (B,)."""
-    from speclight.simulation.reflection import build_target
-
-    target = build_target(loaded)
-    wl = ds["wavelength"].values.astype(float)
-    spectrum, total = np.zeros(wl.size), 0.0
-    for part in target.parts:
-        mat = part.material
-        refl = mat.diffuse_reflectance if mat.bsdf == "plastic" else mat.reflectance
-        assert refl is not None
-        spectrum += part.area_m2 * refl.evaluate(wl)
-        total += part.area_m2
-    response = (
-        ds["band_response"].transpose("band", "wavelength").values
-        * ds["optics_transmission"].values[None, :]
-        * ds["detector_qe"].transpose("band", "wavelength").values
-    )
-    return band_albedo(spectrum / total, response, wl)
 
 
 def _result(

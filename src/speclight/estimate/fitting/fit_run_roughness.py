@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from speclight.estimate.fitting.fit import F64
 from speclight.estimate.fitting.fit_bins import EpochBins
+from speclight.estimate.fitting.fit_quality import CLIP_SIGMA
 from speclight.estimate.fitting.noise_model import PoissonNoise
 from speclight.estimate.fitting.roughness_fit import fit_roughness
 from speclight.estimate.fitting.roughness_uncertainty import unconstrained_text
@@ -42,6 +43,7 @@ def fit_rough_slsqp(
     show: bool,
     scan: bool = True,
     bins: EpochBins | None = None,
+    clip_sigma: float | None = CLIP_SIGMA,
 ) -> Any:
     """SLSQP over the roughness (:mod:`.roughness_fit`), the scenario simulated at the
     measured epochs for every roughness value tried.
@@ -67,6 +69,8 @@ def fit_rough_slsqp(
         Scan the bounds before the local method (:mod:`.roughness_scan`).
     bins
         Rates, model and measurements averaged over these bins (:mod:`.fit_bins`), or None.
+    clip_sigma
+        Leave out measurements this many robust sigmas from the fit (:mod:`.fit_quality`).
     """
     from speclight.simulation import simulate
 
@@ -98,6 +102,7 @@ def fit_rough_slsqp(
         on_iteration=on_iteration,
         start_model=c0 if bins is None else bins.mean(c0),
         scan=scan,
+        clip_sigma=clip_sigma,
     )
 
 
@@ -112,6 +117,7 @@ def fit_rough_gradient(
     show: bool,
     scan: bool = True,
     bins: EpochBins | None = None,
+    clip_sigma: float | None = CLIP_SIGMA,
 ) -> Any:
     """The trust-region fit with analytic derivatives (:mod:`.gradient_fit`).
 
@@ -136,6 +142,8 @@ def fit_rough_gradient(
         Scan the bounds before the local method (:mod:`.roughness_scan`).
     bins
         Rates, derivatives and measurements averaged over these bins, or None.
+    clip_sigma
+        Leave out measurements this many robust sigmas from the fit (:mod:`.fit_quality`).
     """
     from speclight.estimate.fitting.gradient_fit import fit_roughness_gradient
     from speclight.estimate.fitting.roughness_gradient import RoughnessRates
@@ -152,7 +160,7 @@ def fit_rough_gradient(
     return fit_roughness_gradient(
         rates if bins is None else binned, m_fit, s_fit, start, ROUGHNESS_BOUNDS,
         fit_scale=fit_scale, on_iteration=_printer(rough, "evaluation") if show else None,
-        scan=scan,
+        scan=scan, clip_sigma=clip_sigma,
     )  # fmt: skip
 
 

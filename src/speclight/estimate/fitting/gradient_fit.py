@@ -36,6 +36,7 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from speclight.estimate.fitting.fit import F64
+from speclight.estimate.fitting.fit_quality import CLIP_SIGMA
 from speclight.estimate.fitting.noise_model import Likelihood, PoissonNoise
 from speclight.estimate.fitting.roughness_fit import solve
 from speclight.estimate.fitting.roughness_problem import RoughnessProblem
@@ -97,6 +98,7 @@ def fit_roughness_gradient(
     on_iteration: Callable[[int, F64, float], None] | None = None,
     max_evaluations: int = MAX_EVALUATIONS,
     scan: bool = True,
+    clip_sigma: float | None = CLIP_SIGMA,
 ) -> RoughnessFit:
     """Fit roughness values (and the band scales) with the model's analytic Jacobian: the
     scan, this trust-region method, the uncertainties (:mod:`.roughness_fit`).
@@ -123,11 +125,14 @@ def fit_roughness_gradient(
     scan
         Scan the bounds first (:mod:`.roughness_scan`); ``False`` starts the trust region at
         ``start``.
+    clip_sigma
+        Leave out measurements this many robust sigmas from the fit (:mod:`.fit_quality`);
+        None keeps every one.
     """
     problem = RoughnessProblem(model, measured, sigma, bounds, fit_scale=fit_scale,
                                derivatives=True, on_evaluation=on_iteration)  # fmt: skip
     return solve(problem, np.asarray(start, dtype=float), trust_region_refine, scan=scan,
-                 max_iterations=max_evaluations)  # fmt: skip
+                 max_iterations=max_evaluations, clip_sigma=clip_sigma)  # fmt: skip
 
 
 def trust_region_refine(

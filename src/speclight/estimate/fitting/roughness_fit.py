@@ -13,7 +13,9 @@ gradient method (:mod:`.gradient_fit`), which differs in the local stage only:
    first step is a Newton step rather than a jump to a bound); the gradient is a central
    difference (a forward one shifts the minimum by half a step) of half-step
    :data:`ROUGHNESS_STEP`, and when the fitted std is much smaller, SLSQP resumes with a
-   step of one std;
+   step of one std; it is repeated without the measurements that lie more than
+   ``clip_sigma`` robust sigmas from the fit (outliers, :mod:`.fit_quality`) while it
+   finds new ones;
 3. the **uncertainties** and what cannot be claimed (:mod:`.roughness_uncertainty`).
 """
 
@@ -26,6 +28,7 @@ from numpy.typing import NDArray
 from scipy.optimize import minimize
 
 from speclight.estimate.fitting.fit import F64, joint_std
+from speclight.estimate.fitting.fit_quality import CLIP_SIGMA, MAX_ROUNDS, outlier_mask
 from speclight.estimate.fitting.noise_model import PoissonNoise
 from speclight.estimate.fitting.roughness_problem import ROUGHNESS_RESOLUTION, RoughnessProblem
 from speclight.estimate.fitting.roughness_scan import SCAN_POINTS, coordinate_scan
@@ -61,6 +64,7 @@ def fit_roughness(
     max_iterations: int = 50,
     start_model: F64 | None = None,
     scan: bool = True,
+    clip_sigma: float | None = CLIP_SIGMA,
 ) -> RoughnessFit:
     """Fit roughness values (and the band scales): scan, SLSQP, uncertainties (module doc).
 
@@ -89,13 +93,16 @@ def fit_roughness(
     scan
         Scan the bounds first (:mod:`.roughness_scan`); ``False`` starts SLSQP at ``start``
         (to measure how far SLSQP alone converges from, bench/bench_fit_gradient.py).
+    clip_sigma
+        Leave out measurements this many robust sigmas from the fit (:mod:`.fit_quality`);
+        None keeps every one.
     """
     problem = RoughnessProblem(model, measured, sigma, bounds, fit_scale=fit_scale)
     x0 = np.clip(np.asarray(start, dtype=float), problem.lo, problem.hi)
     if start_model is not None:
         problem.seed(x0, start_model)
     return solve(problem, x0, slsqp_refine, scan=scan, on_iteration=on_iteration,
-                 max_iterations=max_iterations)  # fmt: skip
+                 max_iterations=max_iterations, clip_sigma=clip_sigma)  # fmt: skip
 
 
 #: A local method: (problem, start (K,), which to fit (K,), on_iteration, max_iterations) ->
@@ -114,8 +121,10 @@ def solve(
     scan: bool = True,
     on_iteration: Callable[[int, F64, float], None] | None = None,
     max_iterations: int = 50,
+    clip_sigma: float | None = CLIP_SIGMA,
 ) -> RoughnessFit:
-    """The three stages of a roughness fit (module doc) with the local method ``refine``."""
+    """The stages of a roughness fit (module doc) with the local method ``refine``; the local
+    method is repeated without the outliers (:mod:`.fit_quality`) while it finds new ones."""
     x = np.clip(np.asarray(start, dtype=float), problem.lo, problem.hi)
     flat = np.zeros(x.size, dtype=bool)
     if scan:
@@ -123,10 +132,20 @@ def solve(
         x, flat = found.best, found.flat
     free = ~flat
     success, message, iterations, fd = True, "not refined: the scan found chi2 flat", 0, None
-    if np.any(free):
-        x, success, message, iterations, fd = refine(problem, x, free, on_iteration, max_iterations)
-    return finish(problem, x, free=free, flat=flat, fd=fd, success=success, message=message,
-                  n_iterations=iterations)  # fmt: skip
+    drop = np.zeros(problem.likelihood.m.shape, dtype=bool)
+    for round_ in range(MAX_ROUNDS + 1):
+        if np.any(free):
+            x, success, message, n, fd = refine(problem, x, free, on_iteration, max_iterations)
+            iterations += n
+        new = outlier_mask(problem.likelihood, problem.fitted(x), clip_sigma)
+        if round_ == MAX_ROUNDS or not np.any(new):
+            break
+        drop |= new
+        problem = problem.without(drop)
+    fit = finish(problem, x, free=free, flat=flat, fd=fd, success=success, message=message,
+                 n_iterations=iterations)  # fmt: skip
+    fit.outliers = drop
+    return fit
 
 
 def slsqp_refine(

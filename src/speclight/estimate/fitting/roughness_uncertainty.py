@@ -28,6 +28,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import NDArray
 
 from speclight.estimate.fitting.fit import F64, ScaleFit, joint_std
 from speclight.estimate.fitting.roughness_problem import ROUGHNESS_RESOLUTION, RoughnessProblem
@@ -75,6 +76,8 @@ class RoughnessFit:
     ranges
         (K, 2, 2) the profile ranges (module doc) at the levels of :data:`PROFILE_LEVELS`,
         ``[k, level, low/high]`` [1]; NaN where the roughness is constrained.
+    outliers
+        (N, B) measurements left out as outliers (:mod:`.fit_quality`).
     """
 
     roughness: F64
@@ -89,6 +92,7 @@ class RoughnessFit:
     profile: F64 = field(default_factory=lambda: np.zeros((0, 2)))
     unconstrained: list[str] = field(default_factory=list)
     ranges: F64 = field(default_factory=lambda: np.zeros((0, 2, 2)))
+    outliers: NDArray[np.bool_] = field(default_factory=lambda: np.zeros((0, 0), dtype=bool))
 
 
 def finish(
