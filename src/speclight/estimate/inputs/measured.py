@@ -17,7 +17,8 @@ time index, the column or band and the value) and what is kept:
 * unreadable files, a missing ``time`` column, an empty or repeated column name, a
   ``_sigma`` column of no band, a row with fewer cells than the header or a value in a
   column without a name, unparseable numbers or times, a time with another UTC offset,
-  duplicate or unsorted times: refused;
+  duplicate times (NetCDF: unsorted ones too): refused; CSV rows out of time order are
+  sorted, with a notice;
 * epochs outside the Sun ephemeris, infinite, subnormal or huge rates, sigmas that are
   not above 0, below the rate's rounding or huge, a band without any rate above 0:
   refused (:mod:`.measured_checks` says why each);
