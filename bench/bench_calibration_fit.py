@@ -9,7 +9,8 @@ current and read noise; no sigma given, as a user's CSV without ``_sigma`` colum
 them with the default method from the start:
 
 * **albedo**: the Lambertian ``calsphere`` example at 32 px; reflectance ~ U(0.1, 0.95), a
-  window of 30-180 s anywhere in the lit part of the pass above 10 deg, fitted from 0.4 (``--free albedo``);
+  window of 30-180 s anywhere in the lit part of the pass above 10 deg, fitted from 0.4
+  (``--free albedo``);
 * **roughness**: the spinning Beckmann cube of the tests (``tests/estimate/data/
   spinning_cube.yaml``, 24 px, 0.5 s exposures over one minute); roughness ~ logU(0.04, 0.4),
   reflectance ~ U(0.2, 0.9), spin period ~ U(20, 45) s, initial phase ~ U(0, 360) deg, window
