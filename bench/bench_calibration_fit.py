@@ -112,11 +112,18 @@ def faces_draw(rng: np.random.Generator) -> tuple[dict, dict, tuple[str, ...], d
     return d, fit, free, truth
 
 
+def _pull(error: Any, std: Any) -> np.ndarray:
+    """error / std where std is a finite positive sigma; NaN where no sigma is claimed."""
+    e, s = np.asarray(error, dtype=float), np.asarray(std, dtype=float)
+    ok = np.isfinite(s) & (s > 0)
+    return np.where(ok, e / np.where(ok, s, 1.0), np.nan)
+
+
 def pulls(result: FitResult, truth: dict) -> dict[str, np.ndarray]:
-    out = {"albedo": (result.albedo - truth["albedo"]) / result.albedo_std}
+    out = {"albedo": _pull(result.albedo - truth["albedo"], result.albedo_std)}
     rough = truth.get("roughness")
     values = [
-        (v - (rough[name] if isinstance(rough, dict) else rough)) / s
+        float(_pull(v - (rough[name] if isinstance(rough, dict) else rough), s))
         for name, (v, s) in result.roughness.items()
     ]
     if values:
