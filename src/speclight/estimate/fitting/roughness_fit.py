@@ -6,10 +6,11 @@ roughness value is simulated once (cached). The fit runs in three stages, shared
 gradient method (:mod:`.gradient_fit`), which differs in the local stage only:
 
 1. the **scan** (:mod:`.roughness_scan`): a coordinate search over a log grid of every
-   roughness, which finds the basin of the minimum from any start in the bounds and marks
-   the roughness values the data do not pin (flat);
-2. the **local method** on the others: bounded SLSQP (:func:`scipy.optimize.minimize`,
-   Kraft 1988) on log chi2, in variables scaled by its curvature at the start (so that its
+   roughness, which finds the basin of the minimum from any start in the bounds;
+2. the **local method** on all of them (also those the scan found flat: its verdict is
+   taken far from the minimum, with a reduced chi2 that a misfit of another material
+   inflates; a box-wing's wings, which glint together, were left at a bound so): bounded
+   SLSQP (:func:`scipy.optimize.minimize`, Kraft 1988) on log chi2, in variables scaled by its curvature at the start (so that its
    first step is a Newton step rather than a jump to a bound); the gradient is a central
    difference (a forward one shifts the minimum by half a step) of half-step
    :data:`ROUGHNESS_STEP`, and when the fitted std is much smaller, SLSQP resumes with a
@@ -130,8 +131,9 @@ def solve(
     if scan:
         found = coordinate_scan(problem, x)
         x, flat = found.best, found.flat
-    free = ~flat
-    success, message, iterations, fd = True, "not refined: the scan found chi2 flat", 0, None
+    # every value is refined, the flat ones too: a misfit elsewhere can hide a slope
+    free = np.ones(x.size, dtype=bool)
+    success, message, iterations, fd = True, "", 0, None
     drop = np.zeros(problem.likelihood.m.shape, dtype=bool)
     for round_ in range(MAX_ROUNDS + 1):
         if np.any(free):
@@ -142,6 +144,9 @@ def solve(
             break
         drop |= new
         problem = problem.without(drop)
+    # the scan's flat verdict was taken far from the minimum, with a reduced chi2 that a
+    # misfit elsewhere inflates: what is constrained is judged at the fit (its std, profile)
+    flat = np.zeros(x.size, dtype=bool)
     fit = finish(problem, x, free=free, flat=flat, fd=fd, success=success, message=message,
                  n_iterations=iterations)  # fmt: skip
     fit.outliers = drop

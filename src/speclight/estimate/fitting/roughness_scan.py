@@ -17,9 +17,10 @@ converges").
 
 The last sweep is a profile of chi-square over each material's grid, the others held at the
 scan's best: a material whose chi-square at both grid neighbours of its best value is within
-one reduced chi-square of it (a factor 2.15 either way fits as well) is **flat**: the data do
-not pin it, so the local method leaves it where the scan put it and the fit says so
-(:mod:`.roughness_uncertainty` gives the range of values that fit).
+one reduced chi-square of it is **flat** (``Scan.flat``). The fit refines every material
+nonetheless and judges what is constrained at its end (:mod:`.roughness_uncertainty`): far
+from the minimum, a misfit of another material inflates the reduced chi-square and makes a
+material look flat that is not.
 """
 
 from __future__ import annotations

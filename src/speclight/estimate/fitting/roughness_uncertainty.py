@@ -8,8 +8,8 @@
   ``PROFILE_SIGMAS^2 = 4`` in units of the reduced chi2; a side that rises by less than 1,
   or falls, says that the linearised std does not hold (the data bound the roughness on one
   side only, or the fit stopped on a slope).
-* **Not constrained** is said of a roughness that the scan found flat
-  (:mod:`.roughness_scan`), whose std exceeds the bounds' range or whose derivative is zero,
+* **Not constrained** is said of a roughness marked ``flat`` by the caller, whose std
+  exceeds the bounds' range or whose derivative is zero,
   that stopped at a bound, or that fails the check. Its std is then not given (NaN);
   instead its **profile ranges**: the values whose chi2 (scales re-fitted, the other
   roughness values held at the fit) is within 1 and within 9 reduced chi2 of the minimum
