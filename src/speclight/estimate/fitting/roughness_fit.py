@@ -10,10 +10,10 @@ gradient method (:mod:`.gradient_fit`), which differs in the local stage only:
 2. the **local method** on all of them (also those the scan found flat: its verdict is
    taken far from the minimum, with a reduced chi2 that a misfit of another material
    inflates; a box-wing's wings, which glint together, were left at a bound so): bounded
-   SLSQP (:func:`scipy.optimize.minimize`, Kraft 1988) on log chi2, in variables scaled by its curvature at the start (so that its
-   first step is a Newton step rather than a jump to a bound); the gradient is a central
-   difference (a forward one shifts the minimum by half a step) of half-step
-   :data:`ROUGHNESS_STEP`, and when the fitted std is much smaller, SLSQP resumes with a
+   SLSQP (:func:`scipy.optimize.minimize`, Kraft 1988) on log chi2, in variables scaled by
+   its curvature at the start (so that its first step is a Newton step rather than a jump
+   to a bound); the gradient is a central difference (a forward one shifts the minimum by
+   half a step) of half-step :data:`ROUGHNESS_STEP`, and when the fitted std is much smaller, SLSQP resumes with a
    step of one std; it is repeated without the measurements that lie more than
    ``clip_sigma`` robust sigmas from the fit (outliers, :mod:`.fit_quality`) while it
    finds new ones;
