@@ -14,9 +14,9 @@ gradient method (:mod:`.gradient_fit`), which differs in the local stage only:
    its curvature at the start (so that its first step is a Newton step rather than a jump
    to a bound); the gradient is a central difference (a forward one shifts the minimum by
    half a step) of half-step :data:`ROUGHNESS_STEP`, and when the fitted std is much
-   smaller, SLSQP resumes with a step of one std; it is repeated without the measurements that lie more than
-   ``clip_sigma`` robust sigmas from the fit (outliers, :mod:`.fit_quality`) while it
-   finds new ones;
+   smaller, SLSQP resumes with a step of one std. It is repeated without the measurements
+   that lie more than ``clip_sigma`` robust sigmas from the fit (outliers,
+   :mod:`.fit_quality`) while it finds new ones;
 3. the **uncertainties** and what cannot be claimed (:mod:`.roughness_uncertainty`).
 """
 
