@@ -123,3 +123,31 @@ def test_bad_requests_are_input_errors():
     with pytest.raises(InputError, match="no material with a roughness"):
         fit_scenario(loaded, _measured(truth, [str(b) for b in truth["band"].values]),
                      free=("roughness",))  # fmt: skip
+
+
+def test_default_fit_recovers_two_materials_from_far_starts_on_either_side():
+    # issue 25 failure 1: the default method stalled at its start with several rough
+    # materials; the scan of every roughness finds the basin from anywhere in the bounds.
+    # Truth: face +x Beckmann 0.12, the other faces GGX 0.2; starts 0.6 (5x) and 0.01 (20x).
+    two = (
+        '"+x": {bsdf: beckmann, roughness: 0.12, reflectance: 0.6}\n'
+        '    "*": {bsdf: ggx, roughness: 0.2, reflectance: 0.6}'
+    )
+    one = '"*": {bsdf: beckmann, roughness: 0.12, reflectance: 0.6}'
+    text = (DATA / "spinning_cube.yaml").read_text()
+    text = text.replace("step_s: 0.25}", "step_s: 0.5}").replace(
+        "exposure_s: 0.25", "exposure_s: 0.5"
+    )
+    assert "step_s: 0.5}" in text and "exposure_s: 0.5" in text
+    truth = simulate(parse_scenario(text.replace(one, two), source="truth")).dataset
+    far = two.replace("0.12", "0.6").replace("0.2,", "0.01,")
+    fit = fit_scenario(
+        parse_scenario(text.replace(one, far), source="start"),
+        _measured(truth, ["B", "R"]),
+        free=("albedo", "roughness"),
+    )
+    assert fit.converged, fit.message
+    for name, true in (("+x", 0.12), ("*", 0.2)):
+        value, std = fit.roughness[name]
+        assert abs(value - true) < 0.02 and abs(value - true) < 4 * std + 1e-4, (name, value, std)
+    assert np.all(np.abs(fit.albedo - 0.6) < 4 * fit.albedo_std + 1e-4)

@@ -46,11 +46,28 @@ def test_csv_is_read_with_nan_cells_and_negative_rates_kept(tmp_path):
     assert np.all(np.isnan(lc.sigma_per_s[:, 0]))  # B has no sigma column
 
 
+def test_rows_out_of_time_order_are_sorted_with_a_notice(tmp_path):
+    # issue 25 item 7: sorted instead of refused; the rows keep their values
+    path = tmp_path / "unsorted.csv"
+    path.write_text(
+        "time,B\n2020-01-01T00:00:02Z,3\n2020-01-01T00:00:00Z,1\n2020-01-01T00:00:01Z,2\n"
+    )
+    with pytest.warns(UserWarning, match=r"line 3 comes before line 2\); sorted by time"):
+        lc = read_measured(path)
+    np.testing.assert_array_equal(lc.rate_per_s[:, 0], [1.0, 2.0, 3.0])
+    assert np.all(np.diff(lc.time_utc) == np.timedelta64(1, "s"))
+    # a repeated epoch is still refused, naming the lines it came from
+    path.write_text(
+        "time,B\n2020-01-01T00:00:01Z,1\n2020-01-01T00:00:00Z,2\n2020-01-01T00:00:01Z,3\n"
+    )
+    with pytest.warns(UserWarning), pytest.raises(InputError, match=r"line 4: .*repeats .*line 2"):
+        read_measured(path)
+
+
 @pytest.mark.parametrize(
     ("text", "match"),
     [
         ("t,B\n2020-01-01T00:00:00Z,1\n", "first column must be 'time'"),
-        ("time,B\n2020-01-01T00:00:01Z,1\n2020-01-01T00:00:00Z,2\n", "line 3: .*comes before"),
         ("time,B\n2020-01-01T00:00:00Z,1\n2020-01-01T00:00:00Z,2\n", "line 3: .*repeats"),
         ("time,B\n2020-01-01T00:00:00+02:00,1\n", "UTC offset \\+02:00"),
         ("time,B\nyesterday,1\n", "line 2: 'yesterday' is not an ISO 8601 time"),

@@ -158,6 +158,13 @@ def _spectrum_ok(out: Path) -> bool:
     return bool(rows) and _finite(*(float(r.split(",")[1]) for r in rows))
 
 
+def _period_ok(result: dict[str, object]) -> bool:
+    # a finite period, or no detection said as such (issue 25: null and trend-only data)
+    if result.get("detected") is False:
+        return bool(str(result.get("verdict") or "").strip())
+    return _finite(result["period_s"])
+
+
 def _frames_ok(out: Path) -> bool:
     frames = _json(out / "truth.json")["frames"]
     return bool(frames) and all(_finite(f["ra_deg"], f["dec_deg"]) for f in frames)
@@ -187,7 +194,7 @@ MEASURED = {
     "period": Command(
         ("period", "{IN}", "-o", "{OUT}", "--draws", "1"),
         "period.json",
-        lambda out: _finite(_json(out)["period_s"]),
+        lambda out: _period_ok(_json(out)),
     ),
     "spin-axis": Command(
         (

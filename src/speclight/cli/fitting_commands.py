@@ -25,7 +25,12 @@ from speclight.cli.options import (
 )
 
 #: Python parameter -> flag of the cores ``fit`` calls.
-FIT_FLAGS = {"free": "--free", "method": "--method", "bin_s": "--bin-s"}
+FIT_FLAGS = {
+    "free": "--free",
+    "method": "--method",
+    "bin_s": "--bin-s",
+    "clip_sigma": "--clip-sigma",
+}
 
 
 def fit(
@@ -55,6 +60,15 @@ def fit(
             "(analytic derivatives; single-scattering render, beckmann/ggx materials)."
         ),
     ] = "slsqp",
+    clip_sigma: Annotated[
+        float,
+        typer.Option(
+            "--clip-sigma",
+            help="Leave out (and name) measurements more than S robust sigmas from the fit "
+            "(cosmic rays, glints the model lacks); 0 keeps every one.",
+            metavar="S",
+        ),
+    ] = 5.0,
     force: Force = False,
 ) -> None:
     """Fit per-band albedos (with --free albedo,roughness also the roughness of every rough
@@ -85,12 +99,14 @@ def fit(
             output, plot_file, force, {"scenario file": scenario, "measurements": measured},
             compute=lambda: fit_scenario(
                 load_scenario(scenario), read_measured(measured), free=names, bin_s=bin_s,
-                progress=sys.stderr.isatty(), method=chosen,
+                progress=sys.stderr.isatty(), method=chosen, clip_sigma=clip_sigma,
             ),
             data=lambda r: json_bytes(r.to_json()), figure=_fit_figure, flags=FIT_FLAGS,
         )  # fmt: skip
         if not result.converged:
             typer.echo(f"not converged: {result.message}", err=True)
+        elif result.message != "ok":
+            typer.echo(f"notice: {result.message}", err=True)
         albedos = zip(result.band_names, result.albedo, strict=True)
         typer.echo("albedo: " + ", ".join(f"{b} {a:.4g}" for b, a in albedos))
         for name, (value, std) in result.roughness.items():

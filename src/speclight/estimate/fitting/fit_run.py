@@ -10,9 +10,10 @@ and the simulation flags none of ``orbit_failed``, ``below_min_elevation``,
 **Albedo.** ``albedo_j = scale_j x rho_j``, with ``rho_j`` the scenario's own reflectance of
 the target in band j: each part's material reflectance (``reflectance``; for ``plastic`` its
 ``diffuse_reflectance``; Fresnel reflectances at normal incidence) averaged over the parts
-weighted by their surface area, then averaged over the band with the photon weights of the
-reference paper's eq. 3 (band response x optics x QE x wavelength:
-:func:`speclight.estimate.spectra.upsampling.band_albedo`). For a constant reflectance r it is
+weighted by their surface area, then averaged over the band with the weights of the photons
+the measurement detects (the pass's mean Sun at the aperture x band response x optics x QE x
+wavelength: :func:`speclight.estimate.inputs.band_albedo.band_albedo`, the one definition
+shared with ``upsample``). For a constant reflectance r it is
 ``r x scale``. With several materials one scale per band multiplies all of them: the albedo
 is then the area-weighted mean, a summary rather than a per-material value.
 """
@@ -31,15 +32,23 @@ from numpy.typing import NDArray
 
 from speclight import schema
 from speclight.errors import InputError
-from speclight.estimate.fitting.fit import F64, fit_scales, shot_noise_sigma
+from speclight.estimate.fitting.fit import F64
 from speclight.estimate.fitting.fit_bins import EpochBins
+from speclight.estimate.fitting.fit_inputs import band_reflectance, noise_of
+from speclight.estimate.fitting.fit_quality import (
+    CLIP_SIGMA,
+    clipped_scales,
+    misfit_text,
+    outlier_text,
+    reduced_chi2,
+)
 from speclight.estimate.fitting.fit_run_roughness import (
     fit_rough_gradient,
     fit_rough_slsqp,
     roughness_problems,
 )
+from speclight.estimate.fitting.noise_model import Likelihood
 from speclight.estimate.inputs.measured import MeasuredLightCurve
-from speclight.estimate.spectra.upsampling import band_albedo
 from speclight.scenario import LoadedScenario
 from speclight.scenario.overrides import replace_fields
 
@@ -148,6 +157,7 @@ def fit_scenario(
     progress: bool = False,
     method: str = "slsqp",
     scan: bool = True,
+    clip_sigma: float | None = CLIP_SIGMA,
 ) -> FitResult:
     """Fit the scenario's band albedos (and roughness) to measured count rates.
 
@@ -171,13 +181,27 @@ def fit_scenario(
         ``gradient`` (analytic derivatives of the single-scattering render,
         :mod:`speclight.estimate.fitting.gradient_fit`). The albedos are in closed form either way.
     scan
-        ``slsqp`` with one roughness: scan the bounds before SLSQP (``False`` starts SLSQP
-        at the scenario's roughness).
+        Scan the bounds before the local method (:mod:`.roughness_scan`; ``False`` starts
+        it at the scenario's roughness).
+    clip_sigma
+        Leave out measurements more than this many robust sigmas from the fit, and say so
+        (:mod:`.fit_quality`); 0 or None keeps every one.
     """
     from speclight.simulation import simulate
 
     check_free(free)
     check_method(method)
+    if (
+        clip_sigma is not None
+        and clip_sigma != 0
+        and not (math.isfinite(clip_sigma) and clip_sigma >= 3)
+    ):
+        raise InputError(
+            f"clip_sigma = {clip_sigma!r}: give a number of sigmas >= 3, or 0 to keep every "
+            "measurement",
+            field="clip_sigma",
+        )
+    clip_sigma = clip_sigma or None
     sc = loaded.scenario
     if sc.target is None:
         raise InputError("the scenario has no target to fit", field="target")
@@ -209,22 +233,20 @@ def fit_scenario(
     show = progress and sys.stderr.isatty()
     first = simulate(base, progress=show, time_utc=lc.time_utc)
     ds = first.dataset
-    sigma = lc.sigma_per_s
-    shot = shot_noise_sigma(lc.rate_per_s, sc.instrument.exposure_s, lc.n_samples)
-    sigma = shot if sigma is None else np.where(np.isfinite(sigma), sigma, shot)
+    sigma = noise_of(loaded, lc, ds)
     usable = (ds["flags"].values.astype(np.int64) & _SKIP) == 0
     m = np.where(usable[:, None], lc.rate_per_s, np.nan)
     _check_some_usable(lc, m, ds, loaded)
     bins = None
     if bin_s is not None:
-        bins = EpochBins.of(lc.time_utc, bin_s, np.isfinite(m) & np.isfinite(sigma) & (sigma > 0))
-    rho = _band_reflectance(loaded, ds)
+        bins = EpochBins.of(lc.time_utc, bin_s, np.isfinite(m))
+    rho = band_reflectance(loaded, ds)
     notes: list[str] = []
     if rough:
         if method == "gradient":
             fit = fit_rough_gradient(
                 base, first, m=m, sigma=sigma, rough=rough, fit_scale="albedo" in free,
-                show=show, bins=bins,
+                show=show, scan=scan, bins=bins, clip_sigma=clip_sigma,
             )  # fmt: skip
             method_text = (
                 "gradient: least squares (trust region) over log roughness with the analytic "
@@ -233,7 +255,7 @@ def fit_scenario(
         else:
             fit = fit_rough_slsqp(
                 base, first, m=m, sigma=sigma, rough=rough, fit_scale="albedo" in free,
-                show=show, scan=scan, bins=bins,
+                show=show, scan=scan, bins=bins, clip_sigma=clip_sigma,
             )  # fmt: skip
             method_text = (
                 "SLSQP over roughness (variable projection), weighted least squares for scales"
@@ -245,6 +267,7 @@ def fit_scenario(
         }
         notes += roughness_problems(rough, fit)
         extra = {"n_simulations": fit.n_simulations, "n_iterations": fit.n_iterations}
+        drop, n_par = fit.outliers, len(rough)
     else:
         model = ds["count_rate"].transpose("time", "band").values.astype(float)
         model = np.where(usable[:, None], model, np.nan)
@@ -252,9 +275,9 @@ def fit_scenario(
             raise InputError("`free` must include albedo or roughness", field="free")
         if bins is not None:
             model = bins.mean(model)
-        m_fit, s_fit = (m, sigma) if bins is None else (bins.mean(m), bins.sigma(sigma))
-        scales = fit_scales(model, m_fit, s_fit)
-        roughness, extra = {}, {}
+        m_fit, s_fit = (m, sigma) if bins is None else (bins.mean(m), sigma.binned(bins))
+        scales, drop = clipped_scales(Likelihood(m_fit, s_fit), model, clip_sigma)
+        roughness, extra, n_par = {}, {}, 0
         method_text = "weighted least squares (closed form; linear in albedo)"
     if bins is not None:
         m = bins.mean(m)
@@ -262,7 +285,24 @@ def fit_scenario(
         method_text += f"; measurements and model averaged over the same {bin_s:g} s bins"
     notes += _scale_problems(names, scales.scale, scales.scale_std, scales.n_used)
     fitted = model * scales.scale[None, :]
-    return _result(lc, names, rho, scales, roughness, m, fitted, method_text, notes, extra)
+    n_par += len(names) if "albedo" in free else 0
+    notices = [
+        text
+        for text in (
+            outlier_text(drop, lc.time_utc, names, clip_sigma or 0.0),
+            misfit_text(float(np.sum(scales.chi2)), int(np.sum(scales.n_used)), n_par),
+        )
+        if text
+    ]
+    extra["n_outliers"] = int(np.count_nonzero(drop))
+    extra["chi2_per_dof"] = _num(
+        reduced_chi2(float(np.sum(scales.chi2)), int(np.sum(scales.n_used)), n_par)
+    )
+    m = np.where(drop, np.nan, m)
+    result = _result(lc, names, rho, scales, roughness, m, fitted, method_text, notes, extra)
+    if notices:
+        result.message = "; ".join(([] if result.converged else [result.message]) + notices)
+    return result
 
 
 def _check_some_usable(lc: MeasuredLightCurve, m: F64, ds: Any, loaded: LoadedScenario) -> None:
@@ -300,27 +340,6 @@ def _scale_problems(names: list[str], scale: F64, std: F64, n_used: NDArray) -> 
         elif scale[j] < 0:
             out.append(f"albedo of band '{name}' came out negative ({scale[j]:.3g} x start)")
     return out
-
-
-def _band_reflectance(loaded: LoadedScenario, ds: Any) -> F64:
-    """The scenario's target reflectance per band (module doc: Albedo) [1] (B,)."""
-    from speclight.simulation.reflection import build_target
-
-    target = build_target(loaded)
-    wl = ds["wavelength"].values.astype(float)
-    spectrum, total = np.zeros(wl.size), 0.0
-    for part in target.parts:
-        mat = part.material
-        refl = mat.diffuse_reflectance if mat.bsdf == "plastic" else mat.reflectance
-        assert refl is not None
-        spectrum += part.area_m2 * refl.evaluate(wl)
-        total += part.area_m2
-    response = (
-        ds["band_response"].transpose("band", "wavelength").values
-        * ds["optics_transmission"].values[None, :]
-        * ds["detector_qe"].transpose("band", "wavelength").values
-    )
-    return band_albedo(spectrum / total, response, wl)
 
 
 def _result(

@@ -16,7 +16,10 @@ from numpy.typing import NDArray
 
 from speclight.estimate.fitting.fit import F64
 from speclight.estimate.fitting.fit_bins import EpochBins
-from speclight.estimate.fitting.roughness_fit import PROFILE_SIGMAS, fit_roughness
+from speclight.estimate.fitting.fit_quality import CLIP_SIGMA
+from speclight.estimate.fitting.noise_model import PoissonNoise
+from speclight.estimate.fitting.roughness_fit import fit_roughness
+from speclight.estimate.fitting.roughness_uncertainty import unconstrained_text
 from speclight.scenario import LoadedScenario
 from speclight.scenario.overrides import replace_fields
 
@@ -34,12 +37,13 @@ def fit_rough_slsqp(
     first: Any,
     *,
     m: F64,
-    sigma: F64,
+    sigma: PoissonNoise,
     rough: list[str],
     fit_scale: bool,
     show: bool,
     scan: bool = True,
     bins: EpochBins | None = None,
+    clip_sigma: float | None = CLIP_SIGMA,
 ) -> Any:
     """SLSQP over the roughness (:mod:`.roughness_fit`), the scenario simulated at the
     measured epochs for every roughness value tried.
@@ -50,8 +54,11 @@ def fit_rough_slsqp(
         The scenario to fit (its roughness values are the start).
     first
         The simulation of ``base`` at the measured epochs (its geometry is reused).
-    m, sigma
-        Measured count rates and their standard deviations (N, B) [s-1]; NaN: not used.
+    m
+        Measured count rates (N, B) [s-1]; NaN: not used.
+    sigma
+        Their noise (:class:`.noise_model.PoissonNoise`, with the data's own sigmas where
+        given).
     rough
         Names of the materials whose roughness is fitted.
     fit_scale
@@ -59,9 +66,11 @@ def fit_rough_slsqp(
     show
         Print the iterations on a terminal.
     scan
-        With one roughness: scan the bounds before SLSQP.
+        Scan the bounds before the local method (:mod:`.roughness_scan`).
     bins
         Rates, model and measurements averaged over these bins (:mod:`.fit_bins`), or None.
+    clip_sigma
+        Leave out measurements this many robust sigmas from the fit (:mod:`.fit_quality`).
     """
     from speclight.simulation import simulate
 
@@ -82,7 +91,7 @@ def fit_rough_slsqp(
     on_iteration = _printer(rough, "iteration") if show else None
     c0 = first.dataset["count_rate"].transpose("time", "band").values.astype(float)
     c0 = np.where(usable[:, None], c0, np.nan)
-    m_fit, s_fit = (m, sigma) if bins is None else (bins.mean(m), bins.sigma(sigma))
+    m_fit, s_fit = (m, sigma) if bins is None else (bins.mean(m), sigma.binned(bins))
     return fit_roughness(
         model,
         m_fit,
@@ -93,6 +102,7 @@ def fit_rough_slsqp(
         on_iteration=on_iteration,
         start_model=c0 if bins is None else bins.mean(c0),
         scan=scan,
+        clip_sigma=clip_sigma,
     )
 
 
@@ -101,11 +111,13 @@ def fit_rough_gradient(
     first: Any,
     *,
     m: F64,
-    sigma: F64,
+    sigma: PoissonNoise,
     rough: list[str],
     fit_scale: bool,
     show: bool,
+    scan: bool = True,
     bins: EpochBins | None = None,
+    clip_sigma: float | None = CLIP_SIGMA,
 ) -> Any:
     """The trust-region fit with analytic derivatives (:mod:`.gradient_fit`).
 
@@ -115,16 +127,23 @@ def fit_rough_gradient(
         The scenario to fit (its roughness values are the start).
     first
         The simulation of ``base`` at the measured epochs (its geometry is reused).
-    m, sigma
-        Measured count rates and their standard deviations (N, B) [s-1]; NaN: not used.
+    m
+        Measured count rates (N, B) [s-1]; NaN: not used.
+    sigma
+        Their noise (:class:`.noise_model.PoissonNoise`, with the data's own sigmas where
+        given).
     rough
         Names of the materials whose roughness is fitted.
     fit_scale
         Fit a scale per band too (``free`` includes ``albedo``).
     show
         Print the iterations on a terminal.
+    scan
+        Scan the bounds before the local method (:mod:`.roughness_scan`).
     bins
         Rates, derivatives and measurements averaged over these bins, or None.
+    clip_sigma
+        Leave out measurements this many robust sigmas from the fit (:mod:`.fit_quality`).
     """
     from speclight.estimate.fitting.gradient_fit import fit_roughness_gradient
     from speclight.estimate.fitting.roughness_gradient import RoughnessRates
@@ -137,10 +156,11 @@ def fit_rough_gradient(
         assert bins is not None
         return bins.mean(c), bins.mean(dc, axis=1)
 
-    m_fit, s_fit = (m, sigma) if bins is None else (bins.mean(m), bins.sigma(sigma))
+    m_fit, s_fit = (m, sigma) if bins is None else (bins.mean(m), sigma.binned(bins))
     return fit_roughness_gradient(
         rates if bins is None else binned, m_fit, s_fit, start, ROUGHNESS_BOUNDS,
         fit_scale=fit_scale, on_iteration=_printer(rough, "evaluation") if show else None,
+        scan=scan, clip_sigma=clip_sigma,
     )  # fmt: skip
 
 
@@ -168,30 +188,15 @@ def _printer(rough: list[str], step: str) -> Any:
 
 
 def roughness_problems(rough: list[str], fit: Any) -> list[str]:
+    """What the roughness fit cannot claim, one line per problem (empty: nothing)."""
     out = []
-    span = ROUGHNESS_BOUNDS[1] - ROUGHNESS_BOUNDS[0]
-    if fit.flat:
-        return [f"roughness of material '{rough[0]}' is not constrained by the data: {fit.flat}"]
     if not fit.success:
         out.append(f"the roughness fit did not converge: {fit.message}")
+    lo, hi = ROUGHNESS_BOUNDS
     for k, name in enumerate(rough):
-        value, std = fit.roughness[k], fit.roughness_std[k]
-        if fit.derivative[k] == 0 or not np.isfinite(std) or std > span:
-            out.append(
-                f"roughness of material '{name}' is not constrained by the data "
-                f"(std {std:.3g} for bounds {ROUGHNESS_BOUNDS}: changing it changes the "
-                "light curve not at all or only in brightness, which the albedo absorbs)"
-            )
-        elif min(value - ROUGHNESS_BOUNDS[0], ROUGHNESS_BOUNDS[1] - value) < 1e-6:
-            out.append(f"roughness of material '{name}' stopped at a bound ({value:g})")
-        elif np.any(np.isfinite(fit.profile[k])) and np.nanmin(fit.profile[k]) < 1.0:
-            side = "below" if fit.profile[k, 0] < fit.profile[k, 1] else "above"
-            out.append(
-                f"roughness of material '{name}' is not at a well-defined minimum: chi2 "
-                f"{'falls' if np.nanmin(fit.profile[k]) < 0 else 'barely rises'} "
-                f"{PROFILE_SIGMAS:g} std {side} {value:.4g} (the data may bound it only on "
-                "one side)"
-            )
+        if fit.unconstrained[k]:
+            text = unconstrained_text(fit.unconstrained[k], fit.ranges[k], lo, hi)
+            out.append(f"roughness of material '{name}' is not constrained by the data: {text}")
     return out
 
 

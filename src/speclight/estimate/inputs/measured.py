@@ -17,7 +17,8 @@ time index, the column or band and the value) and what is kept:
 * unreadable files, a missing ``time`` column, an empty or repeated column name, a
   ``_sigma`` column of no band, a row with fewer cells than the header or a value in a
   column without a name, unparseable numbers or times, a time with another UTC offset,
-  duplicate or unsorted times: refused;
+  duplicate times (NetCDF: unsorted ones too): refused; CSV rows out of time order are
+  sorted, with a notice;
 * epochs outside the Sun ephemeris, infinite, subnormal or huge rates, sigmas that are
   not above 0, below the rate's rounding or huge, a band without any rate above 0:
   refused (:mod:`.measured_checks` says why each);
@@ -129,11 +130,11 @@ class MeasuredLightCurve:
         )
 
 
-def read_measured(path: str | Path, source: str = "sun", sort: bool = False) -> MeasuredLightCurve:
+def read_measured(path: str | Path, source: str = "sun") -> MeasuredLightCurve:
     """Read measured light curves from a CSV or a speclight NetCDF file (module doc).
 
-    ``source``: ``"sun"`` (the count rates) or ``"laser"`` (a NetCDF's laser return rates);
-    ``sort``: a CSV's rows out of time order are sorted (with a warning), not refused.
+    ``source``: ``"sun"`` (the count rates) or ``"laser"`` (a NetCDF's laser return rates).
+    A CSV's rows out of time order are sorted (with a warning), not refused.
     """
     p = Path(path)
     if source not in ("sun", "laser"):
@@ -147,7 +148,7 @@ def read_measured(path: str | Path, source: str = "sun", sort: bool = False) -> 
             source=str(p),
             field="source",
         )
-    c = read_csv_columns(p, sort)
+    c = read_csv_columns(p)
     ones = np.ones(c.time_utc.size, np.int64)
     return MeasuredLightCurve(
         c.time_utc,

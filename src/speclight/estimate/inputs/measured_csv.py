@@ -8,14 +8,15 @@ UTF-8 byte-order mark and Windows line ends are ignored, and so are empty cells 
 last named column (the trailing commas a spreadsheet writes). Refused, naming the line and
 the column: an empty or repeated column name, a ``_sigma`` column of no band, a row with
 fewer cells than the header (a line cut short) or with a value in a column without a name,
-unparseable numbers or times, a time with another UTC offset, and what
-:mod:`.measured_checks` refuses.
+unparseable numbers or times, a time with another UTC offset, a repeated time, and what
+:mod:`.measured_checks` refuses. Rows out of time order are sorted, with a notice.
 """
 
 from __future__ import annotations
 
 import csv
 import re
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -48,10 +49,8 @@ class CsvLightCurve:
     sigma_per_s: F64 | None
 
 
-def read_csv_columns(path: Path, sort: bool = False) -> CsvLightCurve:
-    """The epochs, band names, rates and sigmas of a CSV (module docstring), checked; with
-    ``sort``, rows out of time order are sorted by time (a warning says how many moved)
-    instead of refused."""
+def read_csv_columns(path: Path) -> CsvLightCurve:
+    """The epochs, band names, rates and sigmas of a CSV (module docstring), checked."""
     src = str(path)
     text = read_user_text(path, FIELD, what="measurements")
     numbered = [
@@ -89,17 +88,20 @@ def read_csv_columns(path: Path, sort: bool = False) -> CsvLightCurve:
         times.append(parse_utc_time(cells[0], f"line {k}", src))
         values.append([_number(c, k, col, src) for c, col in zip(cells[1:], names, strict=True)])
     t = np.array(times, dtype="datetime64[ns]")
-    if sort and np.any(np.diff(t) < np.timedelta64(0, "ns")):
-        import warnings
-
-        order = np.argsort(t, kind="stable")
-        moved = int(np.sum(order != np.arange(t.size)))
-        warnings.warn(f"{src}: {moved} rows out of time order; sorted by time", stacklevel=2)
-        t, values = t[order], [values[i] for i in order]
-        lines = [lines[0]] + [lines[1 + int(i)] for i in order]
+    order = np.argsort(t, kind="stable")
+    line_of = [lines[1:][i] for i in order]
+    if np.any(order != np.arange(t.size)):
+        k = int(np.flatnonzero(np.diff(t) < np.timedelta64(0, "ns"))[0])
+        warnings.warn(
+            f"{src}: rows not in time order (line {lines[k + 2]} comes before line "
+            f"{lines[k + 1]}); sorted by time",
+            stacklevel=2,
+        )
+        t = t[order]
+        values = [values[i] for i in order]
 
     def row(i: int) -> str:
-        return f"line {lines[i + 1]}"
+        return f"line {line_of[i]}"
 
     def column(j: int) -> str:
         return f"column '{names[j]}'"

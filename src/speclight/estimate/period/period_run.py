@@ -178,7 +178,7 @@ def estimate_period(
     notices: list[str] = []
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        lc = read_measured(measured, source, sort=True)
+        lc = read_measured(measured, source)
     for w in caught:
         notices.append(str(w.message))
         warnings.warn(str(w.message), stacklevel=2)
