@@ -141,6 +141,9 @@ def one_draw(seed: int, all_s: np.ndarray) -> dict[str, float]:
     truth = share if method == "nnls-norm" else a
     inside = (est > 0) & (checks.abundance_std > 0)
     z = ((est - truth) / checks.abundance_std)[inside]
+    pinned = est == 0
+    assert checks.abundance_upper is not None
+    covered = truth[pinned] <= checks.abundance_upper[pinned]
     drop = unmix(x, s[1:], method).abundance  # type: ignore[arg-type]
     missing = unmix_checks(x, drop, s[1:], sigma, method)
     pure = np.repeat(np.eye(k), 10, axis=0) * 0.2
@@ -153,6 +156,8 @@ def one_draw(seed: int, all_s: np.ndarray) -> dict[str, float]:
     return {
         "z_std": float(np.std(z)),
         "z_in3": float(np.mean(np.abs(z) < 3)),
+        "n_pinned": float(pinned.sum()),
+        "n_covered": float(covered.sum()),
         "false_alarm": float(checks.misfit.mean()),
         "note_all": float(bool(checks.notes())),
         "detected": float(missing.misfit.mean()),
@@ -181,6 +186,10 @@ def main() -> None:
     print(f"(est - truth)/sigma std: median {np.median(z):.3f}, range {z.min():.3f}-{z.max():.3f}")
     print(f"  draws with std in 0.8-1.25: {np.mean((z >= 0.8) & (z <= 1.25)):.0%}")
     print(f"  fraction |z| < 3: {np.mean(table['z_in3']):.4f}")
+    print(
+        f"contributions at 0: {int(table['n_pinned'].sum())}, truth below abundance_upper: "
+        f"{table['n_covered'].sum() / table['n_pinned'].sum():.3f} (nominal 0.95)"
+    )
     print(f"misfit epochs, all endmembers: {np.mean(table['false_alarm']):.2e} (expected 1e-3)")
     print(f"  set note fired with all endmembers: {np.mean(table['note_all']):.0%} of draws")
     print(f"misfit epochs, one endmember left out: {np.mean(table['detected']):.2f}")
