@@ -24,7 +24,10 @@ four-material cube 25 deg from the true spectra where the purest epochs were 0-7
    inverse-variance mean of the shapes within the noise of its pick, times their median
    brightness. Plain ATGP on the shapes took the noisy shape of a dark epoch (a shape's noise
    is its noise over its small band sum) before a bright material 1.3 deg from another (the
-   bench: 32 % -> 100 % of draws within 3 deg).
+   bench: 32 % -> 100 % of draws within 3 deg);
+4. each vertex in turn is exchanged for the candidate that makes the misfit of the
+   non-negative fits of all shapes smallest (:mod:`.endmember_refine`), which corrects a
+   pick at the far end of a material whose shape drifts along the pass.
 
 It says when the answer is doubtful: where no single shape's residual is significant any
 more after ``j`` vertices (the test on the shapes themselves, not on their local means,
@@ -40,6 +43,14 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from speclight.estimate.spectra.endmember_refine import refine
+from speclight.estimate.spectra.endmember_shapes import (
+    PUREST_CLUSTER_CHI2,
+    cluster,
+    local_means,
+    significant_residual,
+)
+
 F64 = NDArray[np.float64]
 #: Least signal-to-noise ratio ``|x| / |sigma|`` of a sample whose shape is used (the
 #: significance test of step 3 weighs the noise of the rest; 5 kept the pure epochs of a dark
@@ -47,18 +58,8 @@ F64 = NDArray[np.float64]
 PUREST_MIN_SNR = 5.0
 #: Without noise estimates: least norm, as a fraction of the 90th percentile of the norms.
 PUREST_MIN_BRIGHTNESS = 0.1
-#: A sample belongs to a chosen shape when its mean squared normalised distance is below this.
-PUREST_CLUSTER_CHI2 = 2.0
 #: Fewest epochs a signature should rest on before it is called supported.
 PUREST_MIN_EPOCHS = 3
-#: Most samples among which each sample's neighbours within its noise are sought (the cost
-#: grows as samples x neighbours x bands).
-PUREST_NEIGHBOURS = 5000
-#: Pairs in one block of the neighbour search (8 MB per temporary array).
-PUREST_CHUNK = 1_000_000
-#: Probability that noise alone makes any of the samples' residuals significant (divided by
-#: the number of samples for each one: Bonferroni).
-PUREST_DISTINCT_P = 1e-3
 
 
 def purest(
@@ -83,67 +84,15 @@ def purest(
         chosen = rows[atgp(shapes[rows], k)]  # type: ignore[operator]
         return chosen, x[chosen].copy(), ()
     shape_sigma = sigma[rows] / np.abs(total[rows])[:, None]
-    local = _local_means(shapes[rows], shape_sigma)
+    local = local_means(shapes[rows], shape_sigma)
     picked, means, mean_sigma, members, distinct = _vertices(shapes[rows], shape_sigma, k, local)
     scale = np.array([np.median(total[rows][m]) for m in members])
     notes = _notes([m.size for m in members], distinct, k, means, mean_sigma)
-    return rows[picked], means * scale[:, None], notes
-
-
-def _local_means(shapes: F64, sigma: F64) -> tuple[F64, F64]:
-    """Each shape's inverse-variance mean with the shapes within its noise (N, B), and its
-    standard deviation (N, B).
-
-    The neighbours are sought among at most ``PUREST_NEIGHBOURS`` evenly spaced samples, with
-    the noise written as a per-sample scale times one band profile, ``sigma_ib = c_i p_b``
-    (``c_i`` the sample's root mean square noise, ``p_b`` the median profile), so that the
-    distances of all pairs are one matrix product; the means use every band's own noise.
-    """
-    n, b = shapes.shape
-    ref = np.unique(np.linspace(0, n - 1, min(n, PUREST_NEIGHBOURS)).astype(np.intp))
-    scale = np.sqrt(np.mean(sigma**2, axis=1))
-    profile = np.sqrt(np.median((sigma / scale[:, None]) ** 2, axis=0))
-    white = shapes / profile
-    norm2 = np.einsum("nb,nb->n", white, white)
-    w_ref = 1.0 / sigma[ref] ** 2
-    mean = np.empty_like(shapes)
-    std = np.empty_like(shapes)
-    chunk = max(1, PUREST_CHUNK // len(ref))
-    for start in range(0, n, chunk):
-        blk = slice(start, start + chunk)
-        dist2 = norm2[blk, None] + norm2[None, ref] - 2.0 * white[blk] @ white[ref].T
-        d2 = dist2 / (b * (scale[blk, None] ** 2 + scale[None, ref] ** 2))
-        near = (d2 < PUREST_CLUSTER_CHI2).astype(np.float64)
-        own = 1.0 / sigma[blk] ** 2  # the shape itself (once more if among ``ref``: harmless)
-        wsum = near @ w_ref + own
-        mean[blk] = (near @ (w_ref * shapes[ref]) + own * shapes[blk]) / wsum
-        std[blk] = 1.0 / np.sqrt(wsum)
-    return mean, std
-
-
-def _cluster(shapes: F64, sigma: F64, i: int) -> tuple[F64, F64, NDArray[np.intp]]:
-    """Inverse-variance mean (B,) of the shapes within the noise of shape ``i``, its
-    standard deviation (B,) and the members."""
-    d2 = np.mean((shapes - shapes[i]) ** 2 / (sigma**2 + sigma[i] ** 2), axis=1)
-    member = np.flatnonzero(d2 < PUREST_CLUSTER_CHI2)
-    w = 1.0 / sigma[member] ** 2
-    return (shapes[member] * w).sum(axis=0) / w.sum(axis=0), 1.0 / np.sqrt(w.sum(axis=0)), member
-
-
-def _significant_residual(
-    shapes: F64, sigma: F64, means: F64, mean_sigma: F64
-) -> tuple[F64, NDArray[np.bool_]]:
-    """Squared norm (N,) of the shapes' residuals after the projection away from ``means``
-    (J, B), and whether each is significant against its noise and the means' (module doc)."""
-    from scipy.stats import chi2
-
-    n, b = shapes.shape
-    j = len(means)
-    coeff = shapes @ np.linalg.pinv(means) if j else np.zeros((n, 0))
-    residual = shapes - coeff @ means
-    variance = sigma**2 + coeff**2 @ mean_sigma**2
-    chi = np.sum(residual**2 / variance, axis=1)
-    return np.einsum("nb,nb->n", residual, residual), chi2.sf(chi, b - j) < PUREST_DISTINCT_P / n
+    return (
+        rows[picked],
+        means * scale[:, None],
+        notes,
+    )
 
 
 def _vertices(
@@ -159,19 +108,22 @@ def _vertices(
     picked, members = [], []
     distinct = k
     for j in range(k):
-        _, significant = _significant_residual(shapes, sigma, means, mean_sigma)
+        _, significant, _ = significant_residual(shapes, sigma, means, mean_sigma)
         if not np.any(significant):
             distinct = min(distinct, j)
-        score, local_significant = _significant_residual(*local, means, mean_sigma)
+        score, local_significant, _ = significant_residual(*local, means, mean_sigma)
         if not np.any(local_significant):
             local_significant[:] = True
         score = np.where(local_significant, score, -np.inf)
         i = int(np.argmax(score))
-        mean, std, member = _cluster(shapes, sigma, i)
+        mean, std, member = cluster(shapes, sigma, i)
         means = np.vstack([means, mean])
         mean_sigma = np.vstack([mean_sigma, std])
         picked.append(i)
         members.append(member)
+    picked, means, mean_sigma, members = refine(
+        shapes, sigma, local, (picked, means, mean_sigma, members)
+    )
     return np.asarray(picked, dtype=np.intp), means, mean_sigma, members, distinct
 
 
@@ -182,9 +134,9 @@ def _notes(
     if distinct < k:
         out.append(
             f"only {distinct} of the {k} endmembers differ from the others above the noise "
-            f"(from endmember {distinct + 1} on, every epoch is a mixture of the first "
-            f"{distinct} within its noise): two materials may have nearly the same spectral "
-            f"shape, or the data hold fewer materials than asked; ask for at most {distinct}"
+            f"(every epoch is a mixture of {distinct} of them within its noise): two "
+            "materials may have nearly the same spectral shape, or the data hold fewer "
+            f"materials than asked; ask for at most {distinct}"
         )
     for a in range(k):
         for c in range(a + 1, k):
