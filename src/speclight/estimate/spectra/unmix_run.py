@@ -75,7 +75,7 @@ def check_unmix_options(
     endmembers
         Endmember spectrum files, or ``["scenario"]``; or None with ``extract``.
     extract
-        ``atgp``, ``pca`` or ``nfindr``, or None with ``endmembers``.
+        ``purest``, ``atgp``, ``pca`` or ``nfindr``, or None with ``endmembers``.
     n
         Endmembers to extract (with ``extract`` only).
     method
@@ -135,8 +135,8 @@ def unmix_measured(
         Reflectance CSV files (``wavelength_nm,reflectance``), or ``["scenario"]`` for the
         scenario's materials (then ``loaded`` is required).
     extract, n
-        Instead of ``endmembers``: extract ``n`` endmembers with ``atgp``, ``pca`` or
-        ``nfindr``.
+        Instead of ``endmembers``: extract ``n`` endmembers with ``purest`` (recommended),
+        ``atgp``, ``pca`` or ``nfindr``.
     method
         ``ls``, ``nnls``, ``nnls-norm`` (default, the reference paper's best) or ``fcls``.
     loaded
