@@ -31,10 +31,12 @@ non-finite value are left out and the returned indices count the rows of ``x`` a
     vertex replaced is linear in the new vertex (cofactor expansion along its column), so each
     trial over all samples is one (N, K) product.
 ``purest``
-    ATGP on the shapes (each sample divided by its band sum) of the samples above the noise,
-    each pick averaged with the shapes within its noise
-    (:mod:`speclight.estimate.spectra.endmember_purest`): the purest epochs, not the
-    brightest; it says when the data hold fewer pure epochs than endmembers asked.
+    The vertices of the shapes (each sample divided by its band sum) of the samples above
+    the noise, by successive projections that weigh the noise, each averaged with the shapes
+    within its noise (:mod:`speclight.estimate.spectra.endmember_purest`): the purest
+    epochs, not the brightest; it says when fewer shapes than endmembers asked differ above
+    the noise, when two have the same shape within it, and when an endmember rests on fewer
+    than 3 epochs.
 """
 
 from __future__ import annotations
@@ -177,7 +179,7 @@ def _nfindr(x: F64, k: int) -> tuple[NDArray[np.intp], F64]:
 
 
 def extract_endmembers(
-    x: ArrayLike, k: int, method: EndmemberMethod = "atgp", sigma: ArrayLike | None = None
+    x: ArrayLike, k: int, method: EndmemberMethod = "purest", sigma: ArrayLike | None = None
 ) -> EndmemberResult:
     """Extract ``k`` endmember signatures from the samples ``x``.
 
@@ -190,10 +192,12 @@ def extract_endmembers(
         Number of endmembers, ``1 <= k <= min(B, number of finite rows)`` (``k >= 2`` for
         ``nfindr``).
     method
-        ``"atgp"`` (Ren & Chang 2003, doi:10.1109/TAES.2003.1261119), ``"pca"`` (mean and
-        K - 1 principal directions) or ``"nfindr"`` (Winter 1999, doi:10.1117/12.366289);
-        see the module docstring for how each forms the signatures; ``"purest"`` (the
-        shapes of the samples above the noise, :mod:`.endmember_purest`).
+        ``"purest"`` (default: the vertices of the samples' shapes above the noise,
+        :mod:`.endmember_purest`; the best on the calibration bench, within 3 deg of the
+        true signatures in all 60 draws where ATGP was in none), ``"atgp"`` (Ren & Chang
+        2003, doi:10.1109/TAES.2003.1261119), ``"pca"`` (mean and K - 1 principal
+        directions) or ``"nfindr"`` (Winter 1999, doi:10.1117/12.366289); see the module
+        docstring for how each forms the signatures.
     sigma
         (N, B) standard deviation of ``x`` [m2 sr-1], for ``purest`` (None: unknown).
 

@@ -7,10 +7,12 @@ solver of :mod:`.unmixing` is a linear function of the epoch's factors ``x``:
 term ``(1 - x S_P^T g) g^T / (1^T g)`` (``g = G 1``) for ``fcls``. With the noise covariance
 ``Sigma = diag(sigma^2)`` of ``x`` the covariance of ``a_P`` is ``M^T Sigma M`` for that
 linear map ``M`` (the sandwich form: the solvers are unweighted). ``nnls-norm`` divides by the
-sum ``s``: its Jacobian ``(I - a 1^T) / s`` carries the covariance over. An endmember at the
-bound (contribution 0) gets the standard deviation of the unconstrained fit of all ``K``
-(its one-sided uncertainty is of that size). The support is held fixed: near a bound the
-standard deviation describes the estimator only to first order.
+sum ``s``: its Jacobian ``(I - a 1^T) / s`` carries the covariance over. That standard
+deviation holds the support fixed; it is exact for ``ls`` and is what ``abundance_std`` gives
+there (and beyond ``MAX_ENUMERATED_ENDMEMBERS``, where an endmember at the bound gets the
+standard deviation of the unconstrained fit of all ``K``). Near a bound noise changes the
+support, so for the constrained methods ``abundance_std`` and the one-sided upper bound
+``abundance_upper`` come from the parametric bootstrap of :mod:`.unmix_bootstrap`.
 
 **Misfit.** ``chi2 = sum_j ((x - S a)_j / sigma_j)^2`` has ``B - |P|`` degrees of freedom
 (``B - |P| + 1`` for ``fcls``, whose sum-to-one costs one parameter) where the endmembers
@@ -31,6 +33,13 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
+
+from speclight.estimate.spectra.unmix_bootstrap import (
+    UPPER_QUANTILE,
+    bootstrap_abundance,
+    bootstrap_applies,
+    support_map,
+)
 
 F64 = NDArray[np.float64]
 #: An epoch's misfit is marked when its chi-square is this improbable under the noise alone.
@@ -58,6 +67,10 @@ class UnmixChecks:
         (N,) whether ``P(chi2) < MISFIT_P_VALUE``.
     condition_number
         Condition number of the (mean) signature matrix [1].
+    abundance_upper
+        (N, K) one-sided upper bound (the ``UPPER_QUANTILE`` quantile of the bootstrap,
+        :mod:`.unmix_bootstrap`) [unit of the abundance]; None where not bootstrapped
+        (``ls``, more than ``MAX_ENUMERATED_ENDMEMBERS`` endmembers).
     """
 
     abundance_std: F64
@@ -65,6 +78,7 @@ class UnmixChecks:
     dof: NDArray[np.int64]
     misfit: NDArray[np.bool_]
     condition_number: float
+    abundance_upper: F64 | None = None
 
     def notes(self) -> list[str]:
         """Sentences for a user: a missing endmember, bad conditioning."""
@@ -95,20 +109,9 @@ def marked_beyond_chance(marked: int, n: int) -> bool:
     return bool(marked > 0 and binom.sf(marked - 1, n, MISFIT_P_VALUE) < SET_P_VALUE)
 
 
-def _support_map(s: F64, sum_to_one: bool) -> F64:
-    """The linear map M (n, B, P) of the solution on a support: ``a_P = x M (+ const)``."""
-    gram_inv = np.linalg.inv(np.einsum("npb,nqb->npq", s, s))
-    m = np.einsum("npb,npq->nbq", s, gram_inv)
-    if sum_to_one:
-        g = gram_inv.sum(axis=2)  # (n, P)
-        sg = np.einsum("npb,np->nb", s, g)
-        m = m - sg[:, :, None] * (g / g.sum(axis=1, keepdims=True))[:, None, :]
-    return np.asarray(m)
-
-
 def _covariance(s: F64, sigma: F64, sum_to_one: bool) -> F64:
     """Covariance (n, P, P) of the support solution: ``M^T diag(sigma^2) M``."""
-    m = _support_map(s, sum_to_one)
+    m, _ = support_map(s, sum_to_one)
     return np.asarray(np.einsum("nbp,nb,nbq->npq", m, sigma**2, m))
 
 
@@ -167,7 +170,14 @@ def unmix_checks(x: F64, abundance: F64, signatures: F64, sigma: F64, method: st
     has_dof = ok & (dof > 0)
     misfit[has_dof] = chi2_dist.sf(chi2[has_dof], dof[has_dof]) < MISFIT_P_VALUE
     mean_s = s[ok].mean(axis=0) if np.any(ok) else s[0]
-    return UnmixChecks(std, chi2, dof, misfit, condition_number(mean_s))
+    upper = None
+    if bootstrap_applies(method, k) and np.any(ok):
+        upper = np.full((n, k), np.nan)
+        model = x[ok] - resid[ok]
+        std[ok], upper[ok] = bootstrap_abundance(
+            model, abundance[ok], np.ascontiguousarray(s[ok]), sigma[ok], method
+        )
+    return UnmixChecks(std, chi2, dof, misfit, condition_number(mean_s), upper)
 
 
 def _nnls_of_normalised(x: F64, fractions: F64, s: F64) -> F64:
@@ -221,9 +231,20 @@ def with_checks(
             checks.abundance_std,
             {
                 "units": ds["abundance"].attrs["units"],
-                "long_name": "standard deviation of abundance (noise propagated, support fixed)",
+                "long_name": "standard deviation of abundance (parametric bootstrap for "
+                "nnls, nnls-norm, fcls; noise propagated for ls)",
             },
         )
+        if checks.abundance_upper is not None:
+            ds["abundance_upper"] = (
+                ("time", "endmember"),
+                checks.abundance_upper,
+                {
+                    "units": ds["abundance"].attrs["units"],
+                    "long_name": f"one-sided upper bound of abundance ({UPPER_QUANTILE:g} "
+                    "quantile of the bootstrap; the value to quote where abundance is 0)",
+                },
+            )
         ds["chi2"] = (
             "time",
             checks.chi2,

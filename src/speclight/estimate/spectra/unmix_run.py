@@ -75,7 +75,7 @@ def check_unmix_options(
     endmembers
         Endmember spectrum files, or ``["scenario"]``; or None with ``extract``.
     extract
-        ``atgp``, ``pca`` or ``nfindr``, or None with ``endmembers``.
+        ``purest``, ``atgp``, ``pca`` or ``nfindr``, or None with ``endmembers``.
     n
         Endmembers to extract (with ``extract`` only).
     method
@@ -135,8 +135,8 @@ def unmix_measured(
         Reflectance CSV files (``wavelength_nm,reflectance``), or ``["scenario"]`` for the
         scenario's materials (then ``loaded`` is required).
     extract, n
-        Instead of ``endmembers``: extract ``n`` endmembers with ``atgp``, ``pca`` or
-        ``nfindr``.
+        Instead of ``endmembers``: extract ``n`` endmembers with ``purest`` (recommended),
+        ``atgp``, ``pca`` or ``nfindr``.
     method
         ``ls``, ``nnls``, ``nnls-norm`` (default, the reference paper's best) or ``fcls``.
     loaded
@@ -179,6 +179,7 @@ def unmix_measured(
             )
         sigma = factor_sigma(data.factor, data.rates, loaded or _carried(measured), data.bands)
         found = extract_endmembers(data.factor, n, extract, sigma)  # type: ignore[arg-type]
+        _check_independent(found.signatures, found.notes)
         names = [f"{extract}-{k + 1}" for k in range(n)]
         members = Endmembers(names, np.full((n, 0), np.nan), found.signatures)
         origin = f"extracted by {extract} from the reflectance factors"
@@ -217,6 +218,19 @@ def _carried(measured: str | Path) -> LoadedScenario | None:
         return None
     head = read_user_dataset(measured, "MEASURED", what="measurements", variables=())
     return dataset_scenario(head, str(measured)) if "scenario_yaml" in head.attrs else None
+
+
+def _check_independent(signatures: np.ndarray, notes: tuple[str, ...]) -> None:
+    """Refuse extracted signatures that are linearly dependent (the same shape picked twice
+    where the data show fewer distinct shapes than asked), with the extraction's notes."""
+    rank = int(np.linalg.matrix_rank(signatures))
+    if rank < len(signatures):
+        why = "; ".join(notes) if notes else "the data span fewer directions"
+        raise InputError(
+            f"n = {len(signatures)} extracted endmembers are linearly dependent (rank {rank}): "
+            f"{why}; ask for n <= {rank}",
+            field="n",
+        )
 
 
 def check_distinct(members: Endmembers) -> None:
