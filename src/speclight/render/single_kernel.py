@@ -208,7 +208,11 @@ class SingleKernel:
 
         # each lit lane evaluates its own group's weights only (one call per group and
         # packet of lanes, not every group's formula on every lane)
-        weight, dw = dr.switch(per_material(group_of), [main(ks) for ks in groups], *cosines, lit)
+        if len(groups) == 1:
+            weight, dw = main(groups[0])(*cosines, lit)
+        else:
+            targets = [main(ks) for ks in groups]
+            weight, dw = dr.switch(per_material(group_of), targets, *cosines, lit)
         entries.append((mat, weight, lit))
         if layout.grad:
             entries.append((per_material(layout.grad), dw, lanes(sorted(layout.grad))))
