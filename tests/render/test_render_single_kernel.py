@@ -212,3 +212,25 @@ def test_materials_sharing_a_weight_function_are_summed_apart(monkeypatch):
     assert len(single_kernel._groups(layout, main=True)) == 2  # Lambert, the one lobe
     assert np.all(np.any(w_numpy > 0, axis=0))  # every material's channel
     assert np.all(np.abs(w_kernel - w_numpy) <= _tolerance(np.abs(w_numpy)))
+
+
+def test_roughness_derivatives_of_several_weight_groups(monkeypatch):
+    # Lanes of different weight groups (two lobes, Lambert) each evaluate their own group's
+    # weight and derivative in the kernel (one dr.switch): the derivative channels of both
+    # lobes equal the numpy path's, the Lambert lanes add none.
+    spec = {
+        "+x": {"bsdf": "ggx", "roughness": 0.2, "reflectance": 0.7},
+        "-x": {"bsdf": "beckmann", "roughness": 0.4, "reflectance": 0.5},
+        "*": {"bsdf": "lambertian", "reflectance": 0.5},
+    }
+    names = {"+x": "px", "-x": "mx", "*": "rest"}
+    target = cube(1.0, {p: material_from_spec(names[p], s) for p, s in spec.items()})
+    caster = MitsubaCaster(target, VARIANT)
+    sun, obs = _geometry(12, seed=3)
+    layout = ChannelLayout(target, [0, 1])
+    assert len(single_kernel._groups(layout, main=True)) == 3
+    w_kernel = geometric_weights(target, sun, obs, caster, RESOLUTION_PX, layout=layout)[0]
+    w_numpy = _numpy_path(monkeypatch, target, sun, obs, caster, RESOLUTION_PX, layout=layout)
+    assert all(np.any(w_numpy[:, layout.grad[k]] != 0) for k in (0, 1))
+    magnitude = _magnitudes(monkeypatch, target, sun, obs, caster, layout=layout)
+    assert np.all(np.abs(w_kernel - w_numpy) <= _tolerance(magnitude))

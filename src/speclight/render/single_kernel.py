@@ -19,14 +19,18 @@ are the numpy path's to the bit (the same float64 arithmetic rounded to float32)
 
 **Deterministic sums.** Atomic float additions would sum in an order that depends on the
 threads' schedule. The sums are instead fixed point, made exact with integer atomics and so
-independent of the order (bit-for-bit reproducible on any thread count), in two passes over
-the stored shading cosines (the rays are cast once):
+independent of the order (bit-for-bit reproducible on any thread count), in two passes (the
+rays are cast and the weights evaluated once):
 
-1. the largest |weight| of every (epoch, channel) sum, by an atomic maximum of the high 32
-   bits of its float64 (a maximum is order-independent too);
-2. every weight times the power of two 2^k of its sum (exact) that puts that largest
-   weight below 2^bits (:func:`fraction_bits`: 76 at 256 px), rounded to a whole number
-   held in two 64-bit integers (the high part, the low 32 bits), summed with integer atomics.
+1. with the cast and the shading, every lane's weights are evaluated (each lane only its
+   own material's main weight: one ``dr.switch`` over the groups of :func:`_groups`) and
+   stored with their channels, and the largest |weight| of every (epoch, channel) sum found
+   by an atomic maximum of the high 32 bits of its float64 (a maximum is order-independent
+   too);
+2. from the stored weights, every weight times the power of two 2^k of its sum (exact)
+   that puts that largest weight below 2^bits (:func:`fraction_bits`: 76 at 256 px),
+   rounded to a whole number held in two 64-bit integers (the high part, the low 32 bits),
+   summed with integer atomics.
 
 Each pixel's weight is rounded to at most 2^-bits of its sum's largest weight, so a sum is
 within ``pixels * 2^-bits`` of that weight of the exact sum (2^-60 at 256 px, below
@@ -170,7 +174,7 @@ class SingleKernel:
         """Every lane's (channel, weight [sr-1], active) of every model's channels: main
         weights, roughness derivatives, block entries (lazy Dr.Jit expressions)."""
         mi, dr, layout, ops = self.mi, self.dr, self.layout, self.ops
-        cos_i, cos_o, cos_h, cos_d, mirror_ok = cosines
+        cos_i, cos_o, cos_h, cos_d = cosines[:4]
         entries: list[tuple[Any, Any, Any]] = []
 
         def lanes(ks: list[int]) -> Any:
@@ -187,13 +191,31 @@ class SingleKernel:
                 table[k] = c
             return dr.gather(mi.UInt32, mi.UInt32(table), mat)
 
-        for ks in _groups(layout, main=True):
-            bsdf, mine = layout.bsdfs[ks[0]], lanes(ks)
-            weight = bsdf.main_weight(cos_i, cos_o, cos_h, cos_d, mirror_ok, ops)
-            entries.append((mat, weight, mine))
-            if ks[0] in layout.grad:
-                dw = bsdf.roughness_derivative(cos_i, cos_o, cos_h, ops)
-                entries.append((per_material(layout.grad), dw, mine))
+        groups = _groups(layout, main=True)
+        group_of = {k: g for g, ks in enumerate(groups) for k in ks}
+
+        def main(ks: list[int]) -> Any:
+            """The main weight (and roughness derivative, 0 without) of materials ``ks``."""
+            bsdf = layout.bsdfs[ks[0]]
+
+            def weights(i: Any, o: Any, h: Any, d: Any, m: Any, _active: Any) -> tuple[Any, Any]:
+                weight = bsdf.main_weight(i, o, h, d, m, ops)
+                if ks[0] not in layout.grad:
+                    return weight, dr.zeros(mi.Float64, dr.width(weight))
+                return weight, bsdf.roughness_derivative(i, o, h, ops)
+
+            return weights
+
+        # each lit lane evaluates its own group's weights only (one call per group and
+        # packet of lanes, not every group's formula on every lane)
+        if len(groups) == 1:
+            weight, dw = main(groups[0])(*cosines, lit)
+        else:
+            targets = [main(ks) for ks in groups]
+            weight, dw = dr.switch(per_material(group_of), targets, *cosines, lit)
+        entries.append((mat, weight, lit))
+        if layout.grad:
+            entries.append((per_material(layout.grad), dw, lanes(sorted(layout.grad))))
         for ks in _groups(layout, main=False):
             bsdf, mine = layout.bsdfs[ks[0]], lanes(ks)
             start = per_material(layout.block)
@@ -213,13 +235,14 @@ class SingleKernel:
         for index, weight, active in entries:
             bits = dr.reinterpret_array(mi.UInt64, dr.abs(weight)) >> 32
             dr.scatter_reduce(dr.ReduceOp.Max, peak, mi.UInt32(bits), index, active)
-        dr.schedule(*cosines, mat, lit)  # kept for pass 2: the rays are cast once
+        dr.schedule(*[x for entry in entries for x in entry])  # stored for pass 2
         dr.eval(peak)
         shift = scale_exponents(np.asarray(peak), self.fraction_bits)
         if shift is None:
             return None
-        # pass 2: every weight times 2^shift of its sum (exact), rounded to a whole number
-        # held in two words (the high part's floor and the low 32 bits), integer atomics
+        # pass 2 (from the stored weights): every weight times 2^shift of its sum (exact),
+        # rounded to a whole number held in two words (the high part's floor and the low
+        # 32 bits), integer atomics
         high = dr.zeros(mi.Int64, b * n_ch)
         low = dr.zeros(mi.Int64, b * n_ch)
         shifts = mi.Int32(shift)
