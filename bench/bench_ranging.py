@@ -25,6 +25,7 @@ import yaml
 from speclight.constants import AU_M
 from speclight.illumination import solar_irradiance_W_m2_nm
 from speclight.render import render_intensity
+from speclight.render.session import RenderSession
 from speclight.scenario import parse_scenario
 from speclight.scenario.builtin_examples import example_text
 from speclight.simulation.geometry_stage import scenario_geometry
@@ -75,6 +76,16 @@ def sun_render(loaded: Any, geo: Any, wl: np.ndarray, on_hits: Any = None) -> An
     )
 
 
+def target_session(loaded: Any) -> tuple[Any, Any]:
+    """The run's target and render session, as ``simulation.pipeline`` builds them."""
+    sc = loaded.scenario
+    target = build_target(loaded)
+    session = RenderSession.create(
+        sc.render.mode, sc.render.variant, target.materials, sc.render.polarization
+    )
+    return target, session
+
+
 def timed(fn: Any) -> tuple[Any, float]:
     """Result and CPU time of this process (all threads) [s]: robust to other load on the
     machine, unlike wall time; Dr.Jit's worker threads are counted."""
@@ -115,13 +126,13 @@ def run(n_epochs: int, bistatic: bool, repeats: int) -> None:
 
         def shared(rad: Any = rad) -> Any:
             t0 = time.process_time()
-            setup = prepare_ranging(loaded, geo, wl)
+            setup = prepare_ranging(loaded, geo, wl, *target_session(loaded))
             assert setup is not None
             hook = Hook(setup)
             t_prep = time.process_time() - t0
             sun_render(loaded, geo, wl, on_hits=hook)
             t0 = time.process_time()
-            out = laser_ranging(loaded, geo, wl, setup, trans, rad)
+            out = laser_ranging(loaded, geo, setup, trans, rad)
             inside.append(t_prep + hook.cpu_s + time.process_time() - t0)
             return out
 
@@ -129,9 +140,9 @@ def run(n_epochs: int, bistatic: bool, repeats: int) -> None:
         both.append(dt)
 
         def own(rad: Any = rad) -> Any:
-            setup = prepare_ranging(loaded, geo, wl)
+            setup = prepare_ranging(loaded, geo, wl, *target_session(loaded))
             assert setup is not None
-            return laser_ranging(loaded, geo, wl, setup, trans, rad)
+            return laser_ranging(loaded, geo, setup, trans, rad)
 
         _, dt = timed(own)
         alone.append(dt)
