@@ -4,6 +4,7 @@ through speclight's torque-free propagation (issue 27, "Tumbling")."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy.spatial.transform import Rotation
 
 from conftest import WHITE, render_mesh
@@ -34,6 +35,11 @@ def _two_passes():
     return t_s, sun, obs
 
 
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 27 item 3 open: the grid + continuation does not yet reach the truth's "
+    "family from this far start (BENCHMARKS.md, 'Tumbling from far starts')",
+)
 def test_torque_free_box_wing_state_recovered():
     tgt = shapes.box_wing(WHITE, dish=False)
     parts = [(p.vertices_m, p.faces) for p in tgt.parts]
