@@ -4,6 +4,7 @@ through speclight's torque-free propagation (issue 27, "Tumbling")."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy.spatial.transform import Rotation
 
 from conftest import WHITE, render_mesh
@@ -34,6 +35,11 @@ def _two_passes():
     return t_s, sun, obs
 
 
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 27 item 3 open: the grid + continuation does not yet reach the truth's "
+    "family from this far start (BENCHMARKS.md, 'Tumbling from far starts')",
+)
 def test_torque_free_box_wing_state_recovered():
     tgt = shapes.box_wing(WHITE, dish=False)
     parts = [(p.vertices_m, p.faces) for p in tgt.parts]
@@ -58,15 +64,17 @@ def test_torque_free_box_wing_state_recovered():
         "tf",
     )
     truth = TumblingState(Q0, W0, MOMENTS, 0.0)
-    # a prior 25 deg off in attitude, 1 % in rate, 10 deg in the rates' direction
-    off = Rotation.from_rotvec(np.deg2rad(25.0) * _unit(np.array([1.0, -1.0, 0.5])))
-    w_off = Rotation.from_rotvec(np.deg2rad(10.0) * _unit(np.array([0.0, 1.0, 1.0]))).apply(W0)
-    prior = TumblingState(
+    # a start far from the truth: the attitude turned by 120 deg, the rates 60 deg off and
+    # 30 % slower, moments (0.3, 0.9, 1): the fit's grid and continuation must find the way
+    off = Rotation.from_rotvec(np.deg2rad(120.0) * _unit(np.array([1.0, -1.0, 0.5])))
+    w_off = Rotation.from_rotvec(np.deg2rad(60.0) * _unit(np.array([0.0, 1.0, 1.0]))).apply(W0)
+    far = TumblingState(
         (Rotation.from_quat(Q0, scalar_first=True) * off).as_quat(scalar_first=True),
-        1.01 * w_off,
-        np.array([0.5, 0.75, 1.0]),
+        0.7 * w_off,
+        np.array([0.3, 0.9, 1.0]),
         0.0,
     )
+    assert not same_family(far, truth)
     normals, areas = mesh_facets(parts)
     fit = fit_tumbling(
         data,
@@ -75,13 +83,41 @@ def test_torque_free_box_wing_state_recovered():
         scattering_law("lambert"),
         min_period_h=0.03,
         max_period_h=0.1,
-        n_starts=2,
-        initial_states=[prior],
+        n_starts=0,
+        initial_states=[far],
         t0_jd=t_jd[0],
-        rate_span=0.015,  # the prior's rate is 1 % off
+        rate_span=0.015,
     )
-    assert fit.families
     assert any(same_family(fam[0], truth) for fam in fit.families)
+    assert fit.detected  # better than any rotation about a principal axis (F-test)
+
+
+def test_principal_axis_rotation_is_not_tumbling():
+    """A box-wing spinning about its axis of largest moment (no nutation): the torque-free
+    fit must not claim a tumbling state (F-test against a principal-axis rotation)."""
+    tgt = shapes.box_wing(WHITE, dish=False)
+    normals, areas = mesh_facets([(p.vertices_m, p.faces) for p in tgt.parts])
+    t_s, sun, obs = _two_passes()
+    w0 = np.array([0.0, 0.0, 0.035])  # about body z, the largest moment of MOMENTS
+    q, _ = torque_free_attitude(t_s, MOMENTS[[1, 0, 2]], Q0, w0)
+    qc = quat_conjugate(q)
+    law = scattering_law("lambert")
+    chp = np.sqrt(0.5 * (1 + np.sum(sun * obs, axis=1)))
+    from speclight.estimate.shape.convex_model import facet_brightness
+
+    y = facet_brightness(quat_rotate(qc, sun), quat_rotate(qc, obs), normals, areas, law, chp)
+    rng = np.random.default_rng(1)
+    sigma = 0.01 * np.mean(y)
+    t_jd = 2459000.5 + t_s / 86400.0
+    data = build_inversion_data(
+        t_jd, y + sigma * rng.normal(size=y.size), np.full(y.size, sigma), sun, obs,
+        np.repeat([0, 1], 60), np.array([False, False]), "pa",
+    )  # fmt: skip
+    fit = fit_tumbling(
+        data, normals, areas, law, min_period_h=0.03, max_period_h=0.1, n_starts=0,
+        t0_jd=t_jd[0], rate_span=0.015,
+    )  # fmt: skip
+    assert not fit.detected
 
 
 def test_body_symmetry_keeps_the_family():

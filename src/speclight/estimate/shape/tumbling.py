@@ -39,6 +39,14 @@ from speclight.estimate.shape.convex_model import facet_brightness, relative_res
 from speclight.estimate.shape.ecliptic import angular_distance_deg
 from speclight.estimate.shape.inversion_data import InversionData
 from speclight.estimate.shape.scattering import ScatteringLaw
+from speclight.estimate.shape.tumbling_principal import ALPHA as PRINCIPAL_ALPHA
+from speclight.estimate.shape.tumbling_principal import principal_axis_test
+from speclight.estimate.shape.tumbling_search import (
+    N_CARRY,
+    grid_starts,
+    moments_from_u,
+    window_schedule,
+)
 
 F64 = NDArray[np.float64]
 N_STARTS = 32
@@ -48,6 +56,7 @@ SECONDS_PER_DAY = 86400.0
 MOMENT_SPREAD = 2.0  # second moments drawn log-uniform within e^(+-2)
 MOMENT_BOUND = 6.0  # and kept within e^(+-6) (a needle or a disk: moment ratios to 5e-3)
 MAX_EVALUATIONS = 200
+FIRST_EVALUATIONS = 60  # in the continuation's first window (many grid starts)
 N_SEEDS = 6
 PHASE_DRIFT = 0.2  # turns of phase drift over the gap between rate-scale trials
 RATE_SPAN = 0.03  # relative rate error of a seed curve's solution covered by the trials
@@ -99,18 +108,21 @@ class TumblingState:
 class TumblingFit:
     """Result of :func:`fit_tumbling`: ``families`` (each a list of states, lowest chi-square
     first; families ordered by their best), ``worst_kept_chi2`` (the largest chi-square kept),
-    ``solutions`` (every final fit) and ``t0_jd`` (the states' epoch [d])."""
+    ``solutions`` (every final fit), ``t0_jd`` (the states' epoch [d]), and the test
+    against a principal-axis rotation (its chi-square and the p-value)."""
 
     families: list[list[TumblingState]]
     worst_kept_chi2: float
     solutions: list[TumblingState]
     t0_jd: float
+    principal_axis_chi2: float = float("nan")
+    p_value: float = float("nan")
 
-
-def _moments(u: F64) -> F64:
-    m = np.array([np.exp(u[0]), np.exp(u[1]), 1.0])
-    inertia = np.sum(m) - m
-    return np.asarray(inertia / np.max(inertia))
+    @property
+    def detected(self) -> bool:
+        """True when the best state fits significantly better than a rotation about a
+        principal axis (:mod:`.tumbling_principal`): only then is it a tumbling state."""
+        return bool(self.p_value < PRINCIPAL_ALPHA)
 
 
 class _Problem:
@@ -118,13 +130,14 @@ class _Problem:
         self, data: InversionData, normals: F64, areas: F64, law: ScatteringLaw, t0_jd: float
     ) -> None:
         self.data, self.normals, self.areas, self.law = data, normals, areas, law
+        self.t0_jd = t0_jd
         self.t_s = (data.time_jd - t0_jd) * SECONDS_PER_DAY
         self.calibrated = bool(np.any(data.calibrated))
 
     def state(self, x: F64) -> tuple[F64, F64, F64, float]:
         q = Rotation.from_rotvec(x[:3]).as_quat(scalar_first=True)
         scale = float(np.exp(x[8])) if self.calibrated else 1.0
-        return q, x[3:6], _moments(x[6:8]), scale
+        return q, x[3:6], moments_from_u(x[6:8]), scale
 
     def residuals(self, x: F64) -> F64:
         q0, w0, moments, scale = self.state(x)
@@ -151,6 +164,7 @@ def fit_tumbling(
     initial_states: list[TumblingState] | None = None,
     t0_jd: float | None = None,
     rate_span: float = RATE_SPAN,
+    grid: bool = True,
 ) -> TumblingFit:
     """Multi-start fit of the torque-free state and its families (module doc).
 
@@ -183,6 +197,7 @@ def fit_tumbling(
             initial_states,
             t0_jd,
             rate_span,
+            grid,
         )
 
 
@@ -198,6 +213,7 @@ def _fit_tumbling(
     initial_states: list[TumblingState] | None,
     t0_jd: float | None,
     rate_span: float,
+    grid: bool,
 ) -> TumblingFit:
     counts = np.bincount(data.curve)
     seed_curve = int(np.argmax(counts))
@@ -205,10 +221,11 @@ def _fit_tumbling(
     if t0_jd is None:
         t0_jd = float(np.mean(data.time_jd[in_seed][[0, -1]]))
     rng = np.random.default_rng(seed)
-    seed_prob = _Problem(data.subset(in_seed), normals, areas, law, t0_jd)
+    seed_data = data.subset(in_seed)
+    seed_prob = _Problem(seed_data, normals, areas, law, t0_jd)
     x_starts = [_state_vector(s, 1.0) for s in initial_states or []]
     x_starts += [_random_start(rng, min_period_h, max_period_h) for _ in range(n_starts)]
-    first = _fit_all(seed_prob, x_starts)
+    first = _continued(seed_prob, x_starts, min_period_h, max_period_h, grid, rng)
     seeds = [fam[0] for fam in _families(_within(first, seed_prob))][:N_SEEDS]
     prob = _Problem(data, normals, areas, law, t0_jd)
     if data.n_curves == 1:
@@ -223,7 +240,44 @@ def _fit_tumbling(
                 x_next.append(_state_vector(sol, 1.0 + j * dc))
         final = _fit_all(prob, x_next)
     kept = _within(final, prob)
-    return TumblingFit(_families(kept), kept[-1].chi2, final, t0_jd)
+    n_par = 9 if prob.calibrated else 8
+    chi_pa, p = principal_axis_test(prob.residuals, _state_vector(kept[0], 1.0)[:n_par], n_par)
+    return TumblingFit(_families(kept), kept[-1].chi2, final, t0_jd, chi_pa, p)
+
+
+def _continued(
+    prob: _Problem,
+    x_starts: list[F64],
+    min_period_h: float,
+    max_period_h: float,
+    grid: bool,
+    rng: np.random.Generator,
+) -> list[TumblingState]:
+    """The starts (plus, with ``grid``, the grid's, :mod:`.tumbling_search`) fitted to
+    windows around ``t0`` growing to the whole of ``prob``'s points (continuation); the
+    best of each window's :data:`N_CARRY` best families (and every given start) go on to
+    the next."""
+    halves = window_schedule(prob.t_s, 3600.0 * min_period_h)
+    d, t0_jd = prob.data, prob.t0_jd
+    starts = list(x_starts)
+    for k, half in enumerate(halves):
+        index = np.flatnonzero(np.abs(prob.t_s) <= half)
+        window = _Problem(d.subset(index), prob.normals, prob.areas, prob.law, t0_jd)
+        if k == 0 and grid:
+            starts += grid_starts(
+                window.data,
+                window.t_s,
+                prob.normals,
+                prob.areas,
+                prob.law,
+                min_period_h=min_period_h,
+                max_period_h=max_period_h,
+                rng=rng,
+            )
+        sols = _fit_all(window, starts, FIRST_EVALUATIONS if k == 0 else MAX_EVALUATIONS)
+        carried = [fam[0] for fam in _families(sols)][: max(N_CARRY, len(x_starts))]
+        starts = [_state_vector(s, 1.0) for s in carried]
+    return sols
 
 
 def _random_start(rng: np.random.Generator, min_period_h: float, max_period_h: float) -> F64:
@@ -251,7 +305,9 @@ def _state_vector(s: TumblingState, rate_scale: float) -> F64:
     )
 
 
-def _fit_all(prob: _Problem, starts: list[F64]) -> list[TumblingState]:
+def _fit_all(
+    prob: _Problem, starts: list[F64], max_evaluations: int = MAX_EVALUATIONS
+) -> list[TumblingState]:
     n_par = 9 if prob.calibrated else 8
     lower, upper = np.full(n_par, -np.inf), np.full(n_par, np.inf)
     lower[6:8], upper[6:8] = -MOMENT_BOUND, MOMENT_BOUND
@@ -265,7 +321,7 @@ def _fit_all(prob: _Problem, starts: list[F64]) -> list[TumblingState]:
             bounds=(lower, upper),
             method="trf",
             x_scale="jac",
-            max_nfev=MAX_EVALUATIONS,
+            max_nfev=max_evaluations,
         )
         q0, w0, moments, scale = prob.state(np.append(res.x, 0.0)[:9])
         out.append(TumblingState(q0, w0, moments, float(2.0 * res.cost), scale))

@@ -134,4 +134,6 @@ def add_tumbling(ds: xr.Dataset, fit: TumblingFit) -> xr.Dataset:
     out = ds.assign(v)
     out.attrs["tumbling_t0_jd"] = fit.t0_jd
     out.attrs["tumbling_families"] = len(fit.families)
+    out.attrs["tumbling_detected"] = int(fit.detected)
+    out.attrs["tumbling_p_value"] = fit.p_value
     return out
