@@ -3,6 +3,8 @@ through speclight's torque-free propagation (issue 27, "Tumbling")."""
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -35,6 +37,16 @@ def _two_passes():
     return t_s, sun, obs
 
 
+#: The far-start recovery and the principal-axis check run the full grid search (~1 and ~4
+#: minutes on 2 cores): too long for the suite's 12-minute budget. They run where
+#: SPECLIGHT_LONG_TESTS=1 is set; bench/bench_tumbling_far.py measures the same over draws.
+LONG = pytest.mark.skipif(
+    not os.environ.get("SPECLIGHT_LONG_TESTS"),
+    reason="the tumbling grid search takes minutes: set SPECLIGHT_LONG_TESTS=1",
+)
+
+
+@LONG
 @pytest.mark.xfail(
     strict=True,
     reason="issue 27 item 3 open: the grid + continuation does not yet reach the truth's "
@@ -92,6 +104,7 @@ def test_torque_free_box_wing_state_recovered():
     assert fit.detected  # better than any rotation about a principal axis (F-test)
 
 
+@LONG
 def test_principal_axis_rotation_is_not_tumbling():
     """A box-wing spinning about its axis of largest moment (no nutation): the torque-free
     fit must not claim a tumbling state (F-test against a principal-axis rotation)."""
