@@ -5,6 +5,7 @@ recovered by ``speclight shape``'s run from the NetCDF and its scenario."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import yaml
 from astropy import units as u
 from astropy.coordinates import BarycentricMeanEcliptic, SkyCoord
@@ -79,3 +80,22 @@ def test_spinning_cube_from_a_speclight_dataset(tmp_path):
         column = next(i for i, n in enumerate(names) if face in n.split(","))
         # the face's own material holds the majority of the facets around its normal
         assert share[column] > 0.5, (face, material, dict(zip(names, share, strict=True)))
+
+
+def test_materials_with_proportional_signatures_are_not_unmixed():
+    # Two grey Lambertian materials (albedo 0.2 and 0.6): their band signatures are
+    # proportional in any bands (rank 1), so per-facet shares are undetermined: the shape run
+    # keeps its facet spectra and says why instead of failing at the end (exit 2).
+    from speclight.estimate.inputs.band_responses import scenario_band_responses
+    from speclight.estimate.shape.facet_spectra import facet_materials
+
+    d = yaml.safe_load(example_text("cube-materials"))
+    d["target"]["materials"] = {
+        k: {"bsdf": "lambertian", "reflectance": 0.2 if j % 2 else 0.6}
+        for j, k in enumerate(d["target"]["materials"])
+    }
+    loaded = parse_scenario(yaml.safe_dump(d), source="grey-cube")
+    bands = scenario_band_responses(loaded)
+    facet_band_area = np.full((12, len(bands.band_names)), 0.5)
+    with pytest.warns(UserWarning, match="linearly dependent"):
+        assert facet_materials(facet_band_area, loaded, bands) is None

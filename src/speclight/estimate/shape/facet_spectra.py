@@ -19,6 +19,7 @@ material's area on the facet [m2].
 
 from __future__ import annotations
 
+import warnings
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -69,8 +70,13 @@ def facet_band_factors(
 
 def facet_materials(
     facet_band_area: F64, loaded: LoadedScenario, bands: BandResponses
-) -> tuple[list[str], F64]:
-    """Material names (M,) and each facet's area of each material (K, M) (module doc)."""
+) -> tuple[list[str], F64] | None:
+    """Material names (M,) and each facet's area of each material (K, M) (module doc).
+
+    None, with a warning, where the materials' band signatures are linearly dependent in
+    these bands (e.g. two grey materials of different albedo seen in few bands): their shares
+    are then not determined, and the facet spectra stand alone.
+    """
     from speclight.estimate.spectra.endmember_spectra import endmembers_from_scenario
     from speclight.estimate.spectra.unmixing import unmix
 
@@ -81,4 +87,14 @@ def facet_materials(
             f"{facet_band_area.shape[1]} bands (give at least as many bands as materials)",
             field="bands",
         )
+    rank = int(np.linalg.matrix_rank(np.asarray(ends.signatures, dtype=float)))
+    if rank < len(ends.names):
+        warnings.warn(
+            f"facet materials not unmixed: the band signatures of the scenario's "
+            f"{len(ends.names)} materials ({', '.join(ends.names)}) are linearly dependent in "
+            f"these {facet_band_area.shape[1]} bands (rank {rank}), so their shares are not "
+            "determined; the facet spectra (facet_band_area) are written without them",
+            stacklevel=2,
+        )
+        return None
     return ends.names, unmix(facet_band_area, ends.signatures, "nnls").abundance
