@@ -162,7 +162,7 @@ def _simulate(
             geo,
             wavelength_nm,
             progress=progress,
-            on_hits=setup.on_hits_for if setup is not None else None,
+            on_hits=setup.on_hits_for if setup is not None and _share_rays(session) else None,
             target=target,
             session=session,
         )
@@ -233,3 +233,16 @@ def _simulate(
         ds = ranging.add_to(ds)
         notes += ranging.notes
     return SimulationResult(dataset=ds, geometry=geo, notes=notes)
+
+
+def _share_rays(session: RenderSession | None) -> bool:
+    """Whether the lasers reuse the Sun render's primary rays (``on_hits``).
+
+    Sharing saves the lasers' own ray casts but makes the Sun render read every primary hit
+    in numpy; where the single mode runs in Dr.Jit (LLVM or CUDA variants) the lasers' own
+    rays cost less than that (BENCHMARKS.md, "Laser ranging"), so only the numpy and scalar
+    casters share.
+    """
+    if session is None:
+        return True
+    return not session.variant.startswith(("llvm", "cuda"))
