@@ -62,6 +62,31 @@ def test_lm_holds_fixed_parameters():
     assert out.x[1] == pytest.approx(4.0, abs=1e-4)
 
 
+def test_lm_rejects_an_overflowing_trial_step_quietly():
+    # A trial step into a region whose residuals are finite but huge (1e200: their sum of
+    # squares overflows to inf) is rejected like any worse step (more damping), with no
+    # RuntimeWarning reaching the user (it printed "overflow encountered in matmul").
+    import warnings
+
+    calls = {"wild": 0}
+
+    def fun(x):
+        if abs(x[0] - 2.0) > 1.0:  # far from the minimum at 2: a wild region
+            calls["wild"] += 1
+            return np.array([1e200, 1e200]), lambda: np.array([[1.0], [1.0]])
+        return np.array([x[0] - 2.0, 0.0]), lambda: np.array([[1.0], [0.0]])
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        # a Jacobian 1000x too small makes the first, weakly damped step overshoot from 1.5
+        # into the wild region; damping then brings the steps back
+        out = levenberg_marquardt(
+            lambda x: (fun(x)[0], lambda: 1e-3 * fun(x)[1]()), np.array([1.5]), np.ones(1, bool)
+        )
+    assert calls["wild"] >= 1
+    assert out.x[0] == pytest.approx(2.0, abs=1e-3)
+
+
 def _passive(axis: int, angle: float) -> np.ndarray:
     """The matrix turning coordinates by ``angle`` about ``axis`` (a frame rotation)."""
     c, s = np.cos(angle), np.sin(angle)

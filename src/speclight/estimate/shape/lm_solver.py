@@ -109,7 +109,8 @@ def levenberg_marquardt(
                 trial[idx] += step
                 r_new, jac_new_of = fun(trial)
                 evaluations += 1
-                new_cost = float(r_new @ r_new)
+                with np.errstate(over="ignore"):  # a wild trial step: inf, rejected below
+                    new_cost = float(r_new @ r_new)
             if np.isfinite(new_cost) and new_cost < cost:
                 break
             lam *= nu
