@@ -76,6 +76,7 @@ def test_fit_writes_the_spec_json_and_the_figure(files: dict[str, Path], kind: s
         (["--bin-s", "-1"], "--bin-s"),
         (["--plot", "fig.txt"], "--plot"),
         (["--method", "newton"], "--method = 'newton': give one of slsqp, gradient"),
+        (["--clip-sigma", "-3"], "--clip-sigma"),
     ],
 )
 def test_bad_options_exit_2_and_write_nothing(

@@ -82,6 +82,7 @@ def test_csv_period_json_has_the_spec_keys_and_the_period(tmp_path: Path) -> Non
         (["--harmonics", "0"], "--harmonics"),
         (["--if-symmetric", "maybe"], "--if-symmetric"),
         (["--synodic", "yes"], "--synodic"),
+        (["--fap", "baluev"], "--fap"),
     ],
 )
 def test_bad_options_exit_2_with_one_line(tmp_path: Path, args: list[str], words: str) -> None:

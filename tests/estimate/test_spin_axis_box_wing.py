@@ -163,6 +163,7 @@ def test_cli_run_and_bad_input(folder) -> None:
     _one_line_error(runner.invoke(app, [*base, *new, "--period-s", "-3"]), "--period-s")
     _one_line_error(runner.invoke(app, [*base, *new, "--bands", "G-999/1"]), "G-999/1")
     _one_line_error(runner.invoke(app, [*base, *new, "--refine", "newton"]), "--refine")
+    _one_line_error(runner.invoke(app, [*base, *new, "--period-kind", "solar"]), "--period-kind")
     bad_bound = ["--free-period", "--period-bound", "0.9"]
     _one_line_error(runner.invoke(app, [*base, *new, *bad_bound]), "--period-bound")
     # no period: a fixed attitude and no --period-s
