@@ -129,7 +129,10 @@ def shape_figure(ds: xr.Dataset, poly: Polyhedron | None = None) -> Any:
         ax.plot(hours, ds["brightness_fit"].values[m], "-", lw=0.8, color="tab:red")
         ax.set_title(f"curve {c}: JD {t[m][0]:.3f}", fontsize="x-small")
         ax.tick_params(labelsize="x-small")
-        ax.set_xlabel("hours", fontsize="x-small")
+        ax.set_xlabel("time since its first point [h]", fontsize="x-small")
+        if k % CURVES_PER_ROW == 0:  # the measured and fitted brightness, in the data's unit
+            unit = ds["brightness"].attrs.get("units", "")
+            ax.set_ylabel(f"brightness [{unit}]" if unit else "brightness", fontsize="x-small")
     return fig
 
 
