@@ -65,3 +65,34 @@ def test_vega_band_and_plot_claims_do_not_import_astropy_or_matplotlib() -> None
         """
     )
     assert out.split() == ["False", "False", "False"]
+
+
+def test_help_imports_no_engine_or_data_library() -> None:
+    out = _fresh(
+        """
+        import sys
+        from typer.testing import CliRunner
+        from speclight.cli import app
+        assert CliRunner().invoke(app, ["--help"]).exit_code == 0
+        heavy = ("numpy", "xarray", "dask", "pandas", "scipy", "pvlib", "astropy", "skyfield",
+                 "mitsuba", "drjit", "matplotlib", "speclite", "h5py")
+        print([m for m in heavy if m in sys.modules])
+        """
+    )
+    assert out.split() == ["[]"]
+
+
+def test_a_simulation_without_dask_arrays_does_not_import_dask_array() -> None:
+    # xarray would import dask.array (0.15-0.35 s) when it builds the first variable
+    out = _fresh(
+        """
+        import sys
+        import speclight
+        overrides = {"time.stop": "2020-02-29T21:16:10Z", "time.step_s": 60.0,
+                     "render.resolution_px": 16, "render.samples_per_pixel": 1}
+        scenario = speclight.with_overrides(speclight.load("calsphere"), overrides)
+        result = speclight.simulate(scenario)
+        print(result.dataset.sizes["time"], "dask.array" in sys.modules)
+        """
+    )
+    assert out.split() == ["4", "False"]

@@ -10,6 +10,7 @@ from numpy.typing import NDArray
 
 from speclight import schema as v
 from speclight.errors import InputError
+from speclight.io.deferred_dask import defer_dask_array_import
 from speclight.progress import stage
 from speclight.render.session import RenderSession
 from speclight.scenario import LoadedScenario
@@ -112,6 +113,7 @@ def simulate(
     """
     if geometry is not None and time_utc is not None:
         raise InputError("give time_utc or geometry, not both", field="time_utc")
+    defer_dask_array_import()  # a run without dask arrays never imports dask.array
     try:
         return _simulate(loaded, progress, time_utc, geometry)
     except InputError as exc:
