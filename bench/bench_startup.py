@@ -2,7 +2,8 @@
 
 Each run is a fresh interpreter with ``-X importtime``; the start-up is the sum of the
 top-level imports' cumulative times (everything imported, whenever it is imported: the
-modules a command loads lazily count too), beside the run's wall time. On a loaded machine
+modules a command loads lazily count too; an import that failed, such as the ``distributed``
+that the NetCDF writer keeps out, does not), beside the run's wall time. On a loaded machine
 those wall-clock figures grow with the load, so the same modules are then imported again, in
 the same order, in a fresh interpreter that reports the CPU time it took (user + system):
 the import CPU time, which the load barely changes. Runs alternate between the given source
@@ -30,19 +31,33 @@ COMMANDS = {
 }
 
 
-def import_seconds(stderr: str) -> tuple[float, dict[str, float]]:
-    """Sum of the top-level imports' cumulative times [s], and the largest of them."""
+def import_seconds(stderr: str, loaded: set[str]) -> tuple[float, dict[str, float]]:
+    """Sum of the top-level imports' cumulative times [s], and each of them, counting only
+    the modules in ``loaded`` (the run's modules: not an import that failed)."""
     total, top = 0.0, {}
     for line in stderr.splitlines():
         if not line.startswith("import time:") or "|" not in line:
             continue
         _, cumulative, name = line.split("|", 2)
-        if name.startswith(" ") and not name.startswith("  ") and cumulative.strip().isdigit():
+        top_level = name.startswith(" ") and not name.startswith("  ")
+        if top_level and name.strip() in loaded and cumulative.strip().isdigit():
             seconds = int(cumulative) * 1e-6
             total += seconds
             top[name.strip()] = seconds
     return total, top
 
+
+#: Runs the command line as ``python -m speclight`` does, then lists the modules it loaded
+#: (an import that failed, such as the ``distributed`` that the writer keeps out, is not one).
+_RUN_LISTING_MODULES = """
+import atexit, os, runpy, sys
+def _listing():
+    with open(os.environ["SPECLIGHT_BENCH_MODULES"], "w") as f:
+        f.write("\\n".join(k for k, m in sys.modules.items() if m is not None))
+atexit.register(_listing)
+sys.argv = ["speclight", *sys.argv[1:]]
+runpy.run_module("speclight", run_name="__main__", alter_sys=True)
+"""
 
 _IMPORT_CPU = """
 import importlib, resource, sys
@@ -70,18 +85,20 @@ def import_cpu_seconds(src: str, modules: list[str]) -> float:
 
 
 def one_run(src: str, args: list[str], out: Path) -> tuple[float, float, float, dict[str, float]]:
-    env = dict(os.environ, PYTHONPATH=src)
+    listing = out.with_suffix(".modules")
+    env = dict(os.environ, PYTHONPATH=src, SPECLIGHT_BENCH_MODULES=str(listing))
     extra = ["-o", str(out)] if args[0] == "simulate" else []
     start = time.perf_counter()
     run = subprocess.run(
-        [sys.executable, "-X", "importtime", "-m", "speclight", *args, *extra],
+        [sys.executable, "-X", "importtime", "-c", _RUN_LISTING_MODULES, *args, *extra],
         env=env,
         capture_output=True,
         text=True,
         check=True,
     )
     wall = time.perf_counter() - start
-    total, top = import_seconds(run.stderr)
+    loaded = set(listing.read_text().split())
+    total, top = import_seconds(run.stderr, loaded)
     return wall, total, import_cpu_seconds(src, list(top)), top
 
 
