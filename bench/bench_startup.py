@@ -10,6 +10,13 @@ the import CPU time, which the load barely changes. Runs alternate between the g
 trees (``--src`` twice compares two checkouts under the same load) and the median of
 ``--repeat`` runs is reported.
 
+Modules are imported from bytecode, as an installed package is (pip compiles it at install
+time): the runs write and read their bytecode in a temporary folder
+(``PYTHONPYCACHEPREFIX``), so no source tree is written to, and one unmeasured run per tree
+fills it first. Where ``PYTHONDONTWRITEBYTECODE`` is set (it is on the project's build
+machines) an editable install compiles all of speclight from source on every run instead
+(about 0.1 s more CPU); ``--compile-each-run`` measures that case.
+
     python bench/bench_startup.py --repeat 5
     python bench/bench_startup.py --src /path/to/old/src --src src --repeat 7
 """
@@ -71,9 +78,13 @@ print(use.ru_utime + use.ru_stime)
 """
 
 
+#: The environment of the measured runs (:func:`main` sets where bytecode is kept).
+_ENV = dict(os.environ)
+
+
 def import_cpu_seconds(src: str, modules: list[str]) -> float:
     """CPU time [s] of a fresh interpreter importing ``modules`` in order (start included)."""
-    env = dict(os.environ, PYTHONPATH=src)
+    env = dict(_ENV, PYTHONPATH=src)
     run = subprocess.run(
         [sys.executable, "-c", _IMPORT_CPU, *modules],
         env=env,
@@ -86,7 +97,7 @@ def import_cpu_seconds(src: str, modules: list[str]) -> float:
 
 def one_run(src: str, args: list[str], out: Path) -> tuple[float, float, float, dict[str, float]]:
     listing = out.with_suffix(".modules")
-    env = dict(os.environ, PYTHONPATH=src, SPECLIGHT_BENCH_MODULES=str(listing))
+    env = dict(_ENV, PYTHONPATH=src, SPECLIGHT_BENCH_MODULES=str(listing))
     extra = ["-o", str(out)] if args[0] == "simulate" else []
     start = time.perf_counter()
     run = subprocess.run(
@@ -106,11 +117,23 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--src", action="append", help="source tree(s) (default: ./src)")
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument(
+        "--compile-each-run",
+        action="store_true",
+        help="keep the environment's PYTHONDONTWRITEBYTECODE (speclight compiled on every run)",
+    )
     opts = parser.parse_args()
     sources = [str(Path(s).resolve()) for s in (opts.src or ["src"])]
     print(f"load average: {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "calsphere.nc"
+        if opts.compile_each_run:
+            print("bytecode: as the environment says (PYTHONDONTWRITEBYTECODE kept)")
+        else:
+            _ENV.pop("PYTHONDONTWRITEBYTECODE", None)
+            _ENV["PYTHONPYCACHEPREFIX"] = str(Path(tmp) / "bytecode")
+            for src in sources:  # unmeasured: fills the bytecode folder
+                one_run(src, COMMANDS["simulate --example calsphere"], out)
         for label, args in COMMANDS.items():
             results: dict[str, list[tuple[float, float, float, dict[str, float]]]] = {}
             for _ in range(opts.repeat):
