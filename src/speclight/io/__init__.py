@@ -1,4 +1,8 @@
-"""Input/output: the NetCDF dataset writer and the claim on an output file."""
+"""Input/output: the NetCDF dataset writer and the claim on an output file.
+
+``deferred_dask`` keeps xarray from importing ``dask.array`` before a dask array can exist
+(the simulation's start-up).
+"""
 
 from __future__ import annotations
 
