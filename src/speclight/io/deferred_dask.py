@@ -2,10 +2,10 @@
 
 For every variable it builds, xarray asks whether the data is a dask array
 (``xarray.namedarray.pycompat.array_type("dask")``), and the first time it asks it imports
-``dask.array`` whenever dask is installed: 0.15-0.35 s of CPU, the largest single import of
-a simulation's start-up, in runs that never make a dask array. A dask array can exist only
-once ``dask.array`` has been imported (its class lives there), so until then the answer is
-"no" without importing anything. :func:`defer_dask_array_import` puts into xarray's cache of
+``dask.array`` whenever dask is installed: about 0.08 s of CPU within a simulation's
+start-up (0.15-0.35 s alone), in runs that never make a dask array (BENCHMARKS.md). A dask
+array can exist only once ``dask.array`` has been imported (its class lives there), so until
+then the answer is "no" without importing anything. :func:`defer_dask_array_import` puts into xarray's cache of
 duck-array modules an entry for dask that answers from ``sys.modules``: no dask array type
 while ``dask.array`` is not imported, ``dask.array.Array`` as soon as it is (by the
 reflectivity maps' writer, a Dask cluster, the user). xarray's answers are therefore the same
