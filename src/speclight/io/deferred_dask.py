@@ -5,12 +5,13 @@ For every variable it builds, xarray asks whether the data is a dask array
 ``dask.array`` whenever dask is installed: about 0.08 s of CPU within a simulation's
 start-up (0.15-0.35 s alone), in runs that never make a dask array (BENCHMARKS.md). A dask
 array can exist only once ``dask.array`` has been imported (its class lives there), so until
-then the answer is "no" without importing anything. :func:`defer_dask_array_import` puts into xarray's cache of
-duck-array modules an entry for dask that answers from ``sys.modules``: no dask array type
-while ``dask.array`` is not imported, ``dask.array.Array`` as soon as it is (by the
-reflectivity maps' writer, a Dask cluster, the user). xarray's answers are therefore the same
-as without the entry at every moment, and nothing is kept from being imported: a broken
-dask install fails where dask is used, as before.
+then the answer is "no" without importing anything. :func:`defer_dask_array_import` puts
+into xarray's cache of duck-array modules an entry for dask that answers from
+``sys.modules``: no dask array type while ``dask.array`` is not imported,
+``dask.array.Array`` as soon as it is (by the reflectivity maps' writer, a Dask cluster, the
+user). xarray's answers are therefore the same as without the entry at every moment, and
+nothing is kept from being imported: a broken dask install fails where dask is used, as
+before.
 
 The cache is xarray's own (``_cached_duck_array_modules``, since xarray 2023.x); where it is
 missing or shaped otherwise (another xarray version) nothing is changed and xarray imports
