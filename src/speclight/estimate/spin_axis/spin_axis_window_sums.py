@@ -41,27 +41,18 @@ def compiled_available() -> bool:
 
 
 def _epoch_sums_loop(
-    flat: F32,
-    width: int,
-    rows: I64,
-    weights: F32,
-    bad: BOOL,
-    fill: float,
-    n_t: int,
-    y: F32,
-    ok: F32,
-    out: F32,
+    flat: F32, width: int, rows: I64, weights: F32, n_t: int, y: F32, ok: F32, out: F32
 ) -> None:  # pragma: no cover - run compiled by numba (tests call it through the grid pass)
     """Sums over the ``n_t`` epochs of each axis into ``out`` (S, A, J).
 
     Lookup ``i = a n_t + t`` (axis ``a``, epoch ``t``) is the window ``p`` of ``J`` floats
-    ``sum_c weights[i, c] flat[rows[i, c] width : rows[i, c] width + J]`` (``fill`` where
-    ``bad[i]``). With ``S = 3``: ``out[:, a] = sum_t p, sum_t p^2, sum_t p y[t]``; with
-    ``S = 1``: ``out[0, a] = sum_t ((p - y[t]) ok[t])^2``.
+    ``sum_c weights[i, c] flat[rows[i, c] width : rows[i, c] width + J]`` over its 4 corners
+    (added in order; only the first where ``rows`` has one column). With ``S = 3``:
+    ``out[:, a] = sum_t p, sum_t p^2, sum_t p y[t]``; with ``S = 1``: ``out[0, a] =
+    sum_t ((p - y[t]) ok[t])^2``.
     """
     n_sums, n_ax, n_j = out.shape
-    n_c = rows.shape[1]
-    p = np.empty(n_j, np.float32)
+    four = rows.shape[1] == 4
     s1 = np.empty(n_j, np.float32)
     s2 = np.empty(n_j, np.float32)
     sy = np.empty(n_j, np.float32)
@@ -71,30 +62,32 @@ def _epoch_sums_loop(
         sy[:] = 0.0
         for t in range(n_t):
             i = a * n_t + t
-            o = rows[i, 0] * width
-            w = weights[i, 0]
-            src = flat[o : o + n_j]  # a slice: unit stride, no index wrap-around (vectorised)
-            for j in range(n_j):
-                p[j] = w * src[j]
-            for c in range(1, n_c):
-                o = rows[i, c] * width
-                w = weights[i, c]
-                src = flat[o : o + n_j]
-                for j in range(n_j):
-                    p[j] += w * src[j]
-            if bad[i]:
-                p[:] = fill
+            # slices: unit stride and no index wrap-around, so the loops below vectorise
+            k = 3 if four else 0  # one corner: q1..q3 are q0, never read
+            q0 = flat[rows[i, 0] * width : rows[i, 0] * width + n_j]
+            q1 = flat[rows[i, min(1, k)] * width : rows[i, min(1, k)] * width + n_j]
+            q2 = flat[rows[i, min(2, k)] * width : rows[i, min(2, k)] * width + n_j]
+            q3 = flat[rows[i, k] * width : rows[i, k] * width + n_j]
+            w0, w1, w2, w3 = (
+                weights[i, 0],
+                weights[i, min(1, k)],
+                weights[i, min(2, k)],
+                weights[i, k],
+            )
             yt = y[t]
-            if n_sums == 3:
-                for j in range(n_j):
-                    v = p[j]
+            okt = ok[min(t, ok.shape[0] - 1)]
+            for j in range(n_j):  # the branches are the same for every j: hoisted by LLVM
+                v = w0 * q0[j]
+                if four:
+                    v += w1 * q1[j]
+                    v += w2 * q2[j]
+                    v += w3 * q3[j]
+                if n_sums == 3:
                     s1[j] += v
                     s2[j] += v * v
                     sy[j] += v * yt[j]
-            else:
-                okt = ok[t]
-                for j in range(n_j):
-                    d = (p[j] - yt[j]) * okt[j]
+                else:
+                    d = (v - yt[j]) * okt[j]
                     s2[j] += d * d
         if n_sums == 3:
             out[0, a] = s1
@@ -127,6 +120,11 @@ def epoch_sums(
 ) -> F32:
     """Sums over the epochs of interpolated windows of ``flat``, compiled (module docstring).
 
+    The loop adds 1 or 4 corners: 2 are padded with the first corner at weight 0, and a bad
+    lookup has the weights (``fill``, 0, ...) for a NaN window or zeros for a zero one. On a
+    finite table both are exact (``v + 0 x = v``, ``0 x = 0``), so the windows are those of
+    :func:`.spin_axis_grid.gather`.
+
     Parameters
     ----------
     flat
@@ -134,7 +132,7 @@ def epoch_sums(
     width
         Floats per cell (the table's channels).
     rows
-        First cell of each corner window (A T, corners), axis slowest.
+        First cell of each corner window (A T, corners <= 4), axis slowest.
     weights
         Corner weights (A T, corners) float32, or None for one corner of weight 1.
     bad
@@ -148,23 +146,29 @@ def epoch_sums(
         None: return ``sum p``, ``sum p^2``, ``sum p y`` (3, A, J); else the weights (T, J)
         of ``sum ((p - y) ok)^2`` (1, A, J).
     fill
-        The window of a bad lookup.
+        The window of a bad lookup: NaN or 0.
 
     Returns
     -------
     The sums (S, A, J) float32.
     """
-    n_ax = rows.shape[0] // n_t
-    w = np.ones(rows.shape, np.float32) if weights is None else weights
-    out = np.empty((3 if ok is None else 1, n_ax, y.shape[1]), np.float32)
+    if not (np.isnan(fill) or fill == 0.0):
+        raise ValueError(f"fill = {fill} must be NaN or 0 (the window of a bad lookup)")
+    n_look, n_c = rows.shape
+    n_pad = 1 if n_c == 1 else 4
+    rows4 = np.repeat(rows[:, :1], n_pad, axis=1)
+    rows4[:, :n_c] = rows
+    w4 = np.zeros((n_look, n_pad), np.float32)
+    w4[:, :n_c] = 1.0 if weights is None else weights
+    w4[bad] = 0.0
+    w4[bad, 0] = fill
+    out = np.empty((3 if ok is None else 1, n_look // n_t, y.shape[1]), np.float32)
     ok_arr = np.ones((1, 1), np.float32) if ok is None else ok
     _compiled()(
         flat,
         int(width),
-        np.ascontiguousarray(rows, dtype=np.int64),
-        np.ascontiguousarray(w, dtype=np.float32),
-        np.ascontiguousarray(bad),
-        float(fill),
+        rows4,
+        w4,
         int(n_t),
         np.ascontiguousarray(y, dtype=np.float32),
         np.ascontiguousarray(ok_arr, dtype=np.float32),
