@@ -232,6 +232,8 @@ def test_compiled_loop_equals_numpy_blocks_with_an_epoch_without_phase_vector() 
     assert np.all(np.isinf(i_np)) and np.all(np.isinf(i_c))
     assert r_np is not None and r_c is not None
     _check(r_c, r_np)
-    i_np, _ = grid_pass(sfm, geo, y, ra, dec, 5, compiled=False)
-    i_c, _ = grid_pass(sfm, geo, y, ra, dec, 5, compiled=True)
-    _check(i_c, i_np)
+    for angles, n_rolls in (([20.0, 50.0, 90.0], 4), ([20.0, 50.0, 90.0], 1), ([40.0], 4)):
+        sfm = spin_frame_map(_map(4, angles, n_rolls, n_b), BODY_AXIS, N_PHASES)  # 4, 2, 2 corners
+        i_np, _ = grid_pass(sfm, geo, y, ra, dec, 5, compiled=False)
+        i_c, _ = grid_pass(sfm, geo, y, ra, dec, 5, compiled=True)
+        _check(i_c, i_np)
