@@ -17,7 +17,7 @@ contiguous window of the grid); what this module adds is how the work is laid ou
 
   - **compiled** (where numba is installed, :mod:`.spin_axis_window_sums`): one loop per
     axis reads each corner window from the table once and adds its products to the sums,
-    no intermediate arrays (2.3-2.7 times faster, BENCHMARKS.md);
+    no intermediate arrays (2.3-3.1 times less CPU time, BENCHMARKS.md);
   - **numpy blocks**: the grid ``values`` (rows, 2 n_phases, C) viewed as one row of
     ``n_phases x C`` contiguous floats per possible window start (:func:`window_view`, no
     copy), so a lookup gathers whole windows (one ``memcpy`` each); blocks of a few axes
