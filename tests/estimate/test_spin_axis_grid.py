@@ -212,8 +212,9 @@ def test_compiled_loop_equals_numpy_blocks_with_an_epoch_without_phase_vector() 
     """Both ways on one pass with an epoch without a phase vector (a zero observer
     direction, as :func:`speclight.maps.map_geometry.map_coordinates` marks it): the
     intensity misfit is infinite for every axis in both (a NaN window), the ranging term
-    counts that epoch's offset as 0 (the centre of mass) in both; elsewhere they agree to
-    float32 rounding of the sums (the bound of ``_check``), with the same best phases."""
+    counts that epoch's offset as 0 (the centre of mass) in both; elsewhere, and for maps of
+    4, 2 and 1 corners per lookup and an odd number of epochs, they agree to float32
+    rounding of the sums (the bound of ``_check``), with the same best phases."""
     rng = np.random.default_rng(13)
     geo = _geometry(rng)
     n_b = 2
@@ -237,3 +238,11 @@ def test_compiled_loop_equals_numpy_blocks_with_an_epoch_without_phase_vector() 
         i_np, _ = grid_pass(sfm, geo, y, ra, dec, 5, compiled=False)
         i_c, _ = grid_pass(sfm, geo, y, ra, dec, 5, compiled=True)
         _check(i_c, i_np)
+    # an odd number of epochs (the compiled loop takes them in pairs), with the ranging term
+    odd = EpochGeometry(geo.sun_gcrs[1:], geo.observer_gcrs[1:], geo.t_s[1:], geo.period_s)
+    term = RangingTerm(lmap, rsfm, meas[1:], 1.0, shares_rates=False)
+    i_np, r_np = grid_pass(sfm, odd, y[1:], ra, dec, 5, None, term, compiled=False)
+    i_c, r_c = grid_pass(sfm, odd, y[1:], ra, dec, 5, None, term, compiled=True)
+    assert r_np is not None and r_c is not None
+    _check(i_c, i_np)
+    _check(r_c, r_np)

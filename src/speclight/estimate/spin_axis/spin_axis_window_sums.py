@@ -43,16 +43,20 @@ def compiled_available() -> bool:
 def _epoch_sums_loop(
     flat: F32, width: int, rows: I64, weights: F32, n_t: int, y: F32, ok: F32, out: F32
 ) -> None:  # pragma: no cover - run compiled by numba (tests call it through the grid pass)
-    """Sums over the ``n_t`` epochs of each axis into ``out`` (S, A, J).
+    """Sums over the ``n_t`` epochs (even) of each axis into ``out`` (S, A, J).
 
     Lookup ``i = a n_t + t`` (axis ``a``, epoch ``t``) is the window ``p`` of ``J`` floats
     ``sum_c weights[i, c] flat[rows[i, c] width : rows[i, c] width + J]`` over its 4 corners
     (added in order; only the first where ``rows`` has one column). With ``S = 3``:
     ``out[:, a] = sum_t p, sum_t p^2, sum_t p y[t]``; with ``S = 1``: ``out[0, a] =
-    sum_t ((p - y[t]) ok[t])^2``.
+    sum_t ((p - y[t]) ok[t])^2``. Two epochs per pass over the window: each sum is loaded
+    and stored once per pair and added to in epoch order (``(s + v_t) + v_t+1``, as one
+    epoch at a time would).
     """
     n_sums, n_ax, n_j = out.shape
-    four = rows.shape[1] == 4
+    k = 3 if rows.shape[1] == 4 else 0  # one corner: q1..q3 are q0 and never read
+    k1, k2 = min(1, k), min(2, k)
+    last_ok = ok.shape[0] - 1
     s1 = np.empty(n_j, np.float32)
     s2 = np.empty(n_j, np.float32)
     sy = np.empty(n_j, np.float32)
@@ -60,35 +64,39 @@ def _epoch_sums_loop(
         s1[:] = 0.0
         s2[:] = 0.0
         sy[:] = 0.0
-        for t in range(n_t):
-            i = a * n_t + t
-            # slices: unit stride and no index wrap-around, so the loops below vectorise
-            k = 3 if four else 0  # one corner: q1..q3 are q0, never read
+        for t in range(0, n_t, 2):
+            i, h = a * n_t + t, a * n_t + t + 1  # the pair's lookups
+            # slices: unit stride and no index wrap-around, so the loop below vectorises
             q0 = flat[rows[i, 0] * width : rows[i, 0] * width + n_j]
-            q1 = flat[rows[i, min(1, k)] * width : rows[i, min(1, k)] * width + n_j]
-            q2 = flat[rows[i, min(2, k)] * width : rows[i, min(2, k)] * width + n_j]
+            q1 = flat[rows[i, k1] * width : rows[i, k1] * width + n_j]
+            q2 = flat[rows[i, k2] * width : rows[i, k2] * width + n_j]
             q3 = flat[rows[i, k] * width : rows[i, k] * width + n_j]
-            w0, w1, w2, w3 = (
-                weights[i, 0],
-                weights[i, min(1, k)],
-                weights[i, min(2, k)],
-                weights[i, k],
-            )
-            yt = y[t]
-            okt = ok[min(t, ok.shape[0] - 1)]
+            r0 = flat[rows[h, 0] * width : rows[h, 0] * width + n_j]
+            r1 = flat[rows[h, k1] * width : rows[h, k1] * width + n_j]
+            r2 = flat[rows[h, k2] * width : rows[h, k2] * width + n_j]
+            r3 = flat[rows[h, k] * width : rows[h, k] * width + n_j]
+            w0, w1, w2, w3 = weights[i, 0], weights[i, k1], weights[i, k2], weights[i, k]
+            u0, u1, u2, u3 = weights[h, 0], weights[h, k1], weights[h, k2], weights[h, k]
+            yt, yu = y[t], y[t + 1]
+            okt, oku = ok[min(t, last_ok)], ok[min(t + 1, last_ok)]
             for j in range(n_j):  # the branches are the same for every j: hoisted by LLVM
                 v = w0 * q0[j]
-                if four:
+                x = u0 * r0[j]
+                if k == 3:
                     v += w1 * q1[j]
+                    x += u1 * r1[j]
                     v += w2 * q2[j]
+                    x += u2 * r2[j]
                     v += w3 * q3[j]
+                    x += u3 * r3[j]
                 if n_sums == 3:
-                    s1[j] += v
-                    s2[j] += v * v
-                    sy[j] += v * yt[j]
+                    s1[j] = s1[j] + v + x
+                    s2[j] = s2[j] + v * v + x * x
+                    sy[j] = sy[j] + v * yt[j] + x * yu[j]
                 else:
                     d = (v - yt[j]) * okt[j]
-                    s2[j] += d * d
+                    e = (x - yu[j]) * oku[j]
+                    s2[j] = s2[j] + d * d + e * e
         if n_sums == 3:
             out[0, a] = s1
             out[1, a] = s2
@@ -121,9 +129,12 @@ def epoch_sums(
     """Sums over the epochs of interpolated windows of ``flat``, compiled (module docstring).
 
     The loop adds 1 or 4 corners: 2 are padded with the first corner at weight 0, and a bad
-    lookup has the weights (``fill``, 0, ...) for a NaN window or zeros for a zero one. On a
-    finite table both are exact (``v + 0 x = v``, ``0 x = 0``), so the windows are those of
-    :func:`.spin_axis_grid.gather`.
+    lookup has the weights (``fill``, 0, ...) for a NaN window or zeros for a zero one; it
+    takes the epochs in pairs: an odd ``T`` is padded with a copy of the last epoch's corners
+    at weight 0 (and ``y``, ``ok`` 0). All exact on a finite table (``v + 0 x = v``,
+    ``0 x = 0``; a padded window is one the lookup already reads, so a NaN cell there makes
+    the sums NaN either way): the windows and sums are those of :func:`.spin_axis_grid.gather`
+    and the numpy blocks, to float32 rounding.
 
     Parameters
     ----------
@@ -155,23 +166,32 @@ def epoch_sums(
     if not (np.isnan(fill) or fill == 0.0):
         raise ValueError(f"fill = {fill} must be NaN or 0 (the window of a bad lookup)")
     n_look, n_c = rows.shape
+    n_ax, n_even = n_look // n_t, n_t + n_t % 2
     n_pad = 1 if n_c == 1 else 4
-    rows4 = np.repeat(rows[:, :1], n_pad, axis=1)
-    rows4[:, :n_c] = rows
-    w4 = np.zeros((n_look, n_pad), np.float32)
-    w4[:, :n_c] = 1.0 if weights is None else weights
-    w4[bad] = 0.0
-    w4[bad, 0] = fill
-    out = np.empty((3 if ok is None else 1, n_look // n_t, y.shape[1]), np.float32)
-    ok_arr = np.ones((1, 1), np.float32) if ok is None else ok
+    rows4 = np.empty((n_ax, n_even, n_pad), np.int64)
+    rows4[:, :n_t] = rows[:, :1].reshape(n_ax, n_t, 1)
+    rows4[:, :n_t, :n_c] = rows.reshape(n_ax, n_t, n_c)
+    rows4[:, n_t:] = rows4[:, n_t - 1 : n_t]  # odd T: an epoch of weight 0 (adds 0)
+    w4 = np.zeros((n_ax, n_even, n_pad), np.float32)
+    w4[:, :n_t, :n_c] = 1.0 if weights is None else weights.reshape(n_ax, n_t, n_c)
+    w_bad = w4[:, :n_t].reshape(n_look, n_pad)  # a view
+    w_bad[bad] = 0.0
+    w_bad[bad, 0] = fill
+    y_even = np.zeros((n_even, y.shape[1]), np.float32)
+    y_even[:n_t] = y
+    ok_even = np.ones((1, 1), np.float32)
+    if ok is not None:
+        ok_even = np.zeros((n_even, ok.shape[1]), np.float32)
+        ok_even[:n_t] = ok
+    out = np.empty((3 if ok is None else 1, n_ax, y.shape[1]), np.float32)
     _compiled()(
         flat,
         int(width),
-        rows4,
-        w4,
-        int(n_t),
-        np.ascontiguousarray(y, dtype=np.float32),
-        np.ascontiguousarray(ok_arr, dtype=np.float32),
+        rows4.reshape(n_ax * n_even, n_pad),
+        w4.reshape(n_ax * n_even, n_pad),
+        n_even,
+        y_even,
+        ok_even,
         out,
     )
     return out
