@@ -275,8 +275,8 @@ def grid_pass(
 
 
 def _chunk_terms(ps: _Pass, frames: F64, turn: F64 | None) -> tuple[F64, F64 | None]:
-    """Both terms (A, K) of a chunk of axes, in blocks of ``ps.block_axes`` (``turn``: the
-    axes' own spin turns (A, T) [rad], or None)."""
+    """Both terms (A, K) of a chunk of axes, by the compiled loop or numpy blocks
+    (``turn``: the axes' own spin turns (A, T) [rad], or None)."""
     n_ax, n_t, n_b, n_k = frames.shape[0], ps.yn_tiled.shape[0], ps.n_b, ps.sfm.n_phases
     rg = ps.ranging
     if turn is not None:

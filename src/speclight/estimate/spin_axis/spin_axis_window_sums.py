@@ -5,16 +5,17 @@ windows of the spin-frame table. With numpy that takes a gathered copy of every 
 window (``table[rows]``), the corners weighed into a block of windows (``matmul``), then one
 pass over the block per sum: the 11.5 kB of corner windows of a passive lookup are written
 once and read twice more, and the block's windows three times. Here one loop per axis reads
-each corner window straight from the table into one window-sized buffer (the weighed sum of
-the corners) and adds its products to the axis's sums, which stay in the first-level cache:
-the table is read once per lookup corner and nothing else leaves the cache. The same
-arithmetic in the same order (the corners in order, then the epochs in order, float32):
-the sums equal numpy's to float32 rounding (fused multiply-adds may round differently).
+each corner window straight from the table, adds the corners with their weights in
+registers and adds the products to the axis's sums (3 windows, in the first-level cache),
+two epochs per pass over the window: the table is read once per lookup corner and nothing
+else leaves the cache. The same arithmetic in the same order (the corners in order, then
+the epochs in order, float32): the sums equal the numpy blocks' to float32 rounding (the
+weighing by ``matmul`` may round differently; with one corner they are bitwise the same).
 
 numba is an optional dependency (``pip install 'speclight[fast]'``); without it
 :func:`compiled_available` is False and the grid pass uses its numpy blocks. The loop is
-compiled on first use (about a second) and cached on disk by numba; it releases the GIL, so
-the grid pass's threads (``workers``) run it in parallel.
+compiled on first use (a few seconds) and then loaded from numba's cache on disk; it releases
+the GIL, so the grid pass's threads (``workers``) run it in parallel.
 """
 
 from __future__ import annotations
