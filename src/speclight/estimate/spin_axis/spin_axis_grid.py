@@ -1,4 +1,4 @@
-"""The misfit of every spin-axis candidate of a grid: lookups and sums in cache-sized blocks.
+"""The misfit of every spin-axis candidate of a grid: lookups and sums over the epochs.
 
 The lookup is that of :mod:`.spin_axis_lookup` (spin-frame grid, nearest polar and azimuth
 cell, linear in phase angle and roll, the ``n_phases`` phases of one axis and epoch one
@@ -6,30 +6,30 @@ contiguous window of the grid); what this module adds is how the work is laid ou
 
 * **Indices once per chunk of axes.** The spin-frame coordinates, grid rows and corner
   weights of a chunk of axes x all epochs are computed in one vectorised call
-  (:func:`lookup_corners`); the intensity and the ranging channels of a coaxial (laser) pass
-  share them.
-* **Windows as rows.** The grid ``values`` (rows, 2 n_phases, C) is viewed as one row of
-  ``n_phases x C`` contiguous floats per possible window start (:func:`window_view`, no
-  copy), so a lookup gathers whole windows (one ``memcpy`` each) in the order (phase, band)
-  the sums read.
-* **Blocks of a few axes** (:data:`BLOCK_BYTES` of gathered floats, about the size of the
-  second-level cache), so the gathered windows, their products and their sums stay in the
-  cache instead of streaming tens of MB through memory for every elementwise step.
-* **Sums over the epochs in one pass each** (float32 reductions and ``einsum`` over the
-  epoch axis of the block, the product fused with the sum): ``sum p``, ``sum p^2``,
-  ``sum p y`` of the intensity term (:func:`misfit_from_sums`) and, for the ranging term,
-  ``sum (o - o_meas)^2`` of the band offsets, whose table holds ``o = M / R`` per grid cell
-  (the ranging map is one geometry, phase angle 0, so its lookup is a single corner and the
-  offset of the looked-up cell is the ratio of the cell's channels, as a ratio after the
-  lookup would be; a ranging map of several geometries would interpolate the offsets
-  rather than the channels).
+  (:func:`.spin_axis_corners.lookup_corners`); the intensity and the ranging channels of a
+  coaxial (laser) pass share them.
+* **Sums over the epochs** ``sum p``, ``sum p^2``, ``sum p y`` of the intensity term
+  (:func:`misfit_from_sums`) and, for the ranging term, ``sum (o - o_meas)^2`` of the band
+  offsets, whose table holds ``o = M / R`` per grid cell (the ranging map is one geometry,
+  phase angle 0, so its lookup is a single corner and the offset of the looked-up cell is
+  the ratio of the cell's channels, as a ratio after the lookup would be; a ranging map of
+  several geometries would interpolate the offsets rather than the channels). Two ways:
+
+  - **compiled** (where numba is installed, :mod:`.spin_axis_window_sums`): one loop per
+    axis reads each corner window from the table once and adds its products to the sums,
+    no intermediate arrays (2.3-3.1 times less CPU time, BENCHMARKS.md);
+  - **numpy blocks**: the grid ``values`` (rows, 2 n_phases, C) viewed as one row of
+    ``n_phases x C`` contiguous floats per possible window start (:func:`window_view`, no
+    copy), so a lookup gathers whole windows (one ``memcpy`` each); blocks of a few axes
+    (:data:`BLOCK_BYTES` of gathered floats, about the second-level cache), so the gathered
+    windows, their products and their sums stay in the cache; each sum one float32 pass
+    (``add.reduce``, ``einsum`` with the product fused).
 * **Threads over the chunks** on request (``workers``).
 
 Accuracy: float32 from the table to the sums over the epochs, float64 from there (the misfit
 of :func:`misfit_from_sums`). tests/estimate/test_spin_axis_grid.py compares the whole misfit
-surface with a float64 computation one candidate at a time (largest difference 4e-7 against
-a float32 rounding bound of ``8 T eps32``); on the bench cases the intensity misfit is bitwise
-that of the previous per-chunk code (BENCHMARKS.md).
+surface of both ways with a float64 computation one candidate at a time (largest difference
+4e-7 against a float32 rounding bound of ``8 T eps32``) and the two ways with each other.
 """
 
 from __future__ import annotations
@@ -41,10 +41,15 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from speclight.estimate.spin_axis.spin_axis_corners import (
+    Corners,
+    EpochFrames,
+    epoch_frames,
+    lookup_corners,
+)
 from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, SpinFrameMap, axis_frames
 from speclight.estimate.spin_axis.spin_axis_ranging import RangingTerm, coaxial
-from speclight.maps.map_geometry import map_coordinates
-from speclight.maps.map_lookup import phase_angle_weights
+from speclight.estimate.spin_axis.spin_axis_window_sums import compiled_available, epoch_sums
 
 F64 = NDArray[np.float64]
 F32 = NDArray[np.float32]
@@ -87,110 +92,6 @@ def window_view(values: F32) -> F32:
     )
 
 
-@dataclass(frozen=True)
-class Corners:
-    """Window rows (for :func:`window_view`) and weights of the interpolation corners of
-    ``A x T`` lookups (axis slowest): ``rows`` (A T, corners), ``weights`` (A T, corners)
-    float32 or None for one corner of weight 1; ``bad`` (A T,) where the geometry has no
-    phase vector."""
-
-    rows: I64
-    weights: F32 | None
-    bad: NDArray[np.bool_]
-
-
-@dataclass(frozen=True)
-class EpochFrames:
-    """What the lookups need of the epochs, in GCRS (:func:`epoch_frames`): the phase vector
-    ``p`` (T, 3) (NaN rows where there is none), the unit vector ``u`` (T, 3) of the
-    Sun-observer plane on the Sun's side (0 at phase angle 0), the spin turn since the first
-    epoch [rad] (T,) and the phase-angle weights of the map."""
-
-    p: F64
-    u: F64
-    spin_turn_rad: F64
-    phase_weights: tuple
-
-
-def epoch_frames(geo: EpochGeometry, phase_angle_deg: F64) -> EpochFrames:
-    """:class:`EpochFrames` of ``geo`` for a map of the phase angles ``phase_angle_deg``.
-
-    A rotation keeps lengths and angles, so the phase vector, the plane's unit vector and the
-    phase angle are computed once per epoch in GCRS (as
-    :func:`speclight.maps.map_geometry.map_coordinates` does in the body frame) and only
-    turned into each candidate's spin frame.
-    """
-    p, a, _ = map_coordinates(geo.sun_gcrs, geo.observer_gcrs)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        s = geo.sun_gcrs / np.linalg.norm(geo.sun_gcrs, axis=1)[:, None]
-        o = geo.observer_gcrs / np.linalg.norm(geo.observer_gcrs, axis=1)[:, None]
-        d = s - o
-        nd = np.linalg.norm(d, axis=1)
-        u = np.where((nd > 1e-12)[:, None], d / np.where(nd > 1e-12, nd, 1.0)[:, None], 0.0)
-    a_deg = np.degrees(np.nan_to_num(a))
-    spin_turn = 2 * np.pi * np.mod(geo.t_s / geo.period_s, 1.0)
-    return EpochFrames(p, np.nan_to_num(u), spin_turn, phase_angle_weights(phase_angle_deg, a_deg))
-
-
-def _roll(p: F64, u: F64) -> F64:
-    """Roll [rad, 0..2 pi) of ``u`` about ``p`` (..., 3) in the spin frame (the convention of
-    :mod:`speclight.maps.map_geometry`: ``e_lon = normalize(z x p)``, ``e_lat = p x e_lon``,
-    ``e_lon = y`` within 1e-9 of the poles), from the components without normalising:
-    ``rho (u . e_lon) = u_y p_x - u_x p_y``, ``rho (u . e_lat) = u_z rho^2 - p_z (u_x p_x +
-    u_y p_y)`` with ``rho = |z x p|``."""
-    px, py, pz = p[..., 0], p[..., 1], p[..., 2]
-    ux, uy, uz = u[..., 0], u[..., 1], u[..., 2]
-    rho2 = px * px + py * py
-    lon_c = uy * px - ux * py
-    lat_c = uz * rho2 - pz * (ux * px + uy * py)
-    pole = rho2 < 1e-18
-    if np.any(pole):
-        lon_c = np.where(pole, uy, lon_c)
-        lat_c = np.where(pole, uz * px - ux * pz, lat_c)
-    return np.asarray(np.mod(np.arctan2(lat_c, lon_c), 2 * np.pi))
-
-
-def lookup_corners(
-    sfm: SpinFrameMap, ef: EpochFrames, frames: F64, spin_turn_rad: F64 | None = None
-) -> Corners:
-    """Corners of the lookups of ``frames`` (A, 3, 3) x the epochs of ``ef`` (phase ``k``:
-    ``360 k / K`` deg at ``t_s = 0``; the grid layout of :class:`.SpinFrameMap`);
-    ``spin_turn_rad`` (A, T): each axis's own spin turn (its own period), else ``ef``'s."""
-    n_ax = frames.shape[0]
-    p = np.matmul(ef.p[None], frames)  # (A, T, 3): frame^T p, the spin-frame phase vectors
-    n_k, m = sfm.n_phases, sfm.m
-    n_az = n_k * m
-    turn = ef.spin_turn_rad if spin_turn_rad is None else spin_turn_rad
-    az = np.arctan2(p[..., 1], p[..., 0]) - turn
-    c = np.rint(np.mod(az.ravel(), 2 * np.pi) / (2 * np.pi) * n_az).astype(np.int64) % n_az
-    pz = p[..., 2].ravel()
-    bad = ~np.isfinite(pz)
-    polar = np.arccos(np.clip(np.nan_to_num(pz), -1.0, 1.0))
-    i_polar = np.minimum((polar / np.pi * sfm.n_polar).astype(np.int64), sfm.n_polar - 1)
-    q, s_sub = c // m, c % m
-    n_p, n_r = sfm.phase_angle_deg.size, sfm.n_rolls
-    base = (i_polar * m + s_sub) * n_p * n_r
-    start = (n_k - 1 - q) % n_k  # element k of the window: azimuth cell q - k
-    j_idx, w_j = ef.phase_weights
-    if n_r > 1:
-        roll = _roll(p, np.matmul(ef.u[None], frames)).ravel()
-        f = np.nan_to_num(roll) / (2 * np.pi / n_r)
-        r_lo = np.floor(f).astype(np.int64) % n_r
-        w_r = f - np.floor(f)
-    rows: list[I64] = []
-    weights: list[F64] = []
-    for jj in range(2 if n_p > 1 else 1):
-        jt = np.tile(j_idx[jj], n_ax)
-        wj = np.tile(w_j[jj], n_ax)
-        for rr in range(2 if n_r > 1 else 1):
-            r_idx = (r_lo + rr) % n_r if n_r > 1 else 0
-            rows.append((base + jt * n_r + r_idx) * (2 * n_k) + start)
-            weights.append(wj * (w_r if rr else 1.0 - w_r) if n_r > 1 else wj)
-    # one corner: weight 1 (phase_angle_weights of one stored angle are ones)
-    w = None if len(rows) == 1 else np.stack(weights, axis=1).astype(np.float32)
-    return Corners(np.stack(rows, axis=1), w, bad)
-
-
 def gather(table: F32, corners: Corners, sl: slice, fill: float = np.nan) -> F32:
     """Interpolated windows (n, K C) of the lookups ``sl`` of ``corners`` (``fill`` where
     bad)."""
@@ -218,17 +119,35 @@ def _offset_table(sfm: SpinFrameMap, n_b: int) -> tuple[F32, F32]:
 
 
 @dataclass(frozen=True)
+class _Table:
+    """A spin-frame table (..., 2K, C) contiguous float32 as the two loops read it: ``flat``
+    (cell ``r`` at ``flat[r C : (r + 1) C]``) for the compiled loop, ``windows``
+    (:func:`window_view`, a view of the same memory) for numpy's gathers."""
+
+    flat: F32
+    width: int
+    windows: F32
+
+
+def _table(values: F32) -> _Table:
+    """:class:`_Table` of ``values`` (copied only if not contiguous float32)."""
+    v = np.ascontiguousarray(values, dtype=np.float32)
+    return _Table(v.reshape(-1), int(v.shape[-1]), window_view(v))
+
+
+@dataclass(frozen=True)
 class _Pass:
     """The per-search constants of :func:`grid_pass`."""
 
     sfm: SpinFrameMap
-    table: F32  # window_view of the intensity channels
+    table: _Table  # the intensity channels
     ef: EpochFrames
     yn_tiled: F32  # (T, K B) mean-normalised measured curves, tiled over the phases
     yy: F64  # (B,) sum over the epochs of their squares
     n_b: int
     block_axes: int
     ranging: _Ranging | None
+    compiled: bool  # sums by the compiled loop of :mod:`.spin_axis_window_sums`
 
 
 @dataclass(frozen=True)
@@ -237,7 +156,7 @@ class _Ranging:
 
     sfm: SpinFrameMap
     ef: EpochFrames  # coaxial: lit from the observer's direction
-    offsets: F32  # window_view of the offset table
+    offsets: _Table  # the offset table
     meas_tiled: F32  # (T, K B): measured offsets, 0 where unmeasured, tiled over the phases
     ok_tiled: F32 | None  # (T, K B) 1/0, or None where every offset is measured
     norm: float  # number measured x mean square of the measured offsets
@@ -256,14 +175,16 @@ def grid_pass(
     block_bytes: int = BLOCK_BYTES,
     workers: int = 1,
     period_s_axes: F64 | None = None,
+    compiled: bool | None = None,
 ) -> tuple[F64, F64 | None]:
     """Intensity term (A, K) and ranging term (A, K) or None of the axes ``ra_all, dec_all``.
 
     ``chunk``: axes whose lookup indices are computed in one call (blocks of about
-    ``block_bytes`` of gathered floats within it); ``workers``: threads over the chunks
-    (numpy's gathers, ufuncs and einsum release the GIL; default 1: on the shared 2-core
-    machine of BENCHMARKS.md two threads were not faster). The result does not depend on
-    ``chunk``, ``block_bytes`` or ``workers``.
+    ``block_bytes`` of gathered floats within it, numpy path); ``workers``: threads over the
+    chunks (the compiled loop, numpy's gathers, ufuncs and einsum release the GIL; default 1:
+    on the shared 2-core machine of BENCHMARKS.md two threads were not faster). The result
+    does not depend on ``chunk``, ``block_bytes`` or ``workers``, and on ``compiled`` only to
+    float32 rounding.
 
     Parameters
     ----------
@@ -289,6 +210,9 @@ def grid_pass(
         Each axis's own rotation period [s] (A,) (a synodic period turned sidereal,
         :mod:`.spin_axis_period`; NaN: no candidate, infinite misfit), or None for
         ``geo.period_s``.
+    compiled
+        Sums over the epochs by the compiled loop of :mod:`.spin_axis_window_sums` (True;
+        needs numba) or by numpy blocks (False); None: compiled where numba is installed.
     """
     n_t, n_b = y.shape
     n_k = sfm.n_phases
@@ -303,7 +227,7 @@ def grid_pass(
         rng = _Ranging(
             ranging.sfm,
             epoch_frames(coaxial(geo), ranging.sfm.phase_angle_deg),
-            window_view(o_tab),
+            _table(o_tab),
             np.tile(np.where(ok, meas, 0.0).astype(np.float32), (1, n_k)),
             None if ok.all() else np.tile(ok.astype(np.float32), (1, n_k)),
             norm,
@@ -311,13 +235,14 @@ def grid_pass(
         )
     ps = _Pass(
         sfm,
-        window_view(r_tab if shares else sfm.values),
+        _table(r_tab if shares else sfm.values),
         epoch_frames(geo, sfm.phase_angle_deg),
         np.tile(yn, (1, n_k)),
         np.sum(yn.astype(float) ** 2, axis=0),
         n_b,
         max(1, int(block_bytes // (n_t * n_k * n_b * 4))),
         rng,
+        compiled_available() if compiled is None else bool(compiled),
     )
     n_axes = ra_all.size
     e_i = np.empty((n_axes, n_k))
@@ -350,8 +275,8 @@ def grid_pass(
 
 
 def _chunk_terms(ps: _Pass, frames: F64, turn: F64 | None) -> tuple[F64, F64 | None]:
-    """Both terms (A, K) of a chunk of axes, in blocks of ``ps.block_axes`` (``turn``: the
-    axes' own spin turns (A, T) [rad], or None)."""
+    """Both terms (A, K) of a chunk of axes, by the compiled loop or numpy blocks
+    (``turn``: the axes' own spin turns (A, T) [rad], or None)."""
     n_ax, n_t, n_b, n_k = frames.shape[0], ps.yn_tiled.shape[0], ps.n_b, ps.sfm.n_phases
     rg = ps.ranging
     if turn is not None:
@@ -359,25 +284,41 @@ def _chunk_terms(ps: _Pass, frames: F64, turn: F64 | None) -> tuple[F64, F64 | N
     c_r = None if rg is None else lookup_corners(rg.sfm, rg.ef, frames, turn)
     c_i = c_r if rg is not None and rg.shares_rates else lookup_corners(ps.sfm, ps.ef, frames, turn)
     assert c_i is not None
+    if ps.compiled:
+        t = ps.table
+        sums = epoch_sums(t.flat, t.width, c_i.rows, c_i.weights, c_i.bad, n_t, ps.yn_tiled)
+        e_r = None
+        if rg is not None and c_r is not None:
+            e_r = _ranging_compiled(rg, c_r, n_t, n_k, n_b)
+    else:
+        sums, e_r = _numpy_sums(ps, c_i, c_r, n_ax)
+    s = sums.astype(float).reshape(3, n_ax, n_k, n_b).transpose(0, 1, 3, 2)
+    return misfit_from_sums(s[0], s[1], s[2], ps.yy, n_t), e_r
+
+
+def _numpy_sums(ps: _Pass, c_i: Corners, c_r: Corners | None, n_ax: int) -> tuple[F32, F64 | None]:
+    """``sum p``, ``sum p^2``, ``sum p y`` (3, A, K B) and the ranging term (A, K) or None of
+    a chunk, with numpy in blocks of ``ps.block_axes`` (module docstring)."""
+    n_t, n_b, n_k = ps.yn_tiled.shape[0], ps.n_b, ps.sfm.n_phases
+    rg = ps.ranging
     sums = np.empty((3, n_ax, n_k * n_b), dtype=np.float32)  # sum p, p^2, p y over epochs
     e_r = None if rg is None else np.empty((n_ax, n_k))
     for a0 in range(0, n_ax, ps.block_axes):
         a1 = min(a0 + ps.block_axes, n_ax)
         sl = slice(a0 * n_t, a1 * n_t)
-        p = gather(ps.table, c_i, sl).reshape(a1 - a0, n_t, n_k * n_b)
+        p = gather(ps.table.windows, c_i, sl).reshape(a1 - a0, n_t, n_k * n_b)
         np.add.reduce(p, axis=1, out=sums[0, a0:a1])
         np.einsum("ntj,ntj->nj", p, p, out=sums[1, a0:a1])
         np.einsum("ntj,tj->nj", p, ps.yn_tiled, out=sums[2, a0:a1])
         if rg is not None and e_r is not None and c_r is not None:
             e_r[a0:a1] = _ranging_block(rg, c_r, sl, n_t, n_k, n_b)
-    s = sums.astype(float).reshape(3, n_ax, n_k, n_b).transpose(0, 1, 3, 2)
-    return misfit_from_sums(s[0], s[1], s[2], ps.yy, n_t), e_r
+    return sums, e_r
 
 
 def _ranging_block(rg: _Ranging, corners: Corners, sl: slice, n_t: int, n_k: int, n_b: int) -> F64:
     """The ranging term (n, K) of a block: ``sum (o - o_meas)^2 / norm`` over the measured
     epochs and bands (offset 0, the centre of mass, where there is no phase vector)."""
-    d = gather(rg.offsets, corners, sl, fill=0.0).reshape(-1, n_t, n_k * n_b)
+    d = gather(rg.offsets.windows, corners, sl, fill=0.0).reshape(-1, n_t, n_k * n_b)
     n_ax = d.shape[0]
     if rg.norm <= 0:
         return np.zeros((n_ax, n_k))
@@ -386,3 +327,15 @@ def _ranging_block(rg: _Ranging, corners: Corners, sl: slice, n_t: int, n_k: int
         d *= rg.ok_tiled
     e = np.einsum("ntj,ntj->nj", d, d).reshape(n_ax, n_k, n_b)
     return np.asarray(e.sum(axis=-1), dtype=float) / rg.norm
+
+
+def _ranging_compiled(rg: _Ranging, corners: Corners, n_t: int, n_k: int, n_b: int) -> F64:
+    """The ranging term (A, K) of a chunk by the compiled loop (as :func:`_ranging_block`)."""
+    n_ax = corners.rows.shape[0] // n_t
+    if rg.norm <= 0:
+        return np.zeros((n_ax, n_k))
+    t = rg.offsets
+    ok = np.ones_like(rg.meas_tiled) if rg.ok_tiled is None else rg.ok_tiled
+    d2 = epoch_sums(t.flat, t.width, corners.rows, corners.weights, corners.bad, n_t,
+                    rg.meas_tiled, ok, fill=0.0)  # fmt: skip
+    return np.asarray(d2[0].reshape(n_ax, n_k, n_b).sum(axis=-1), dtype=float) / rg.norm
