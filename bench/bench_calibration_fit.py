@@ -22,8 +22,18 @@ them with the default method from the start:
 
 It prints, per kind, the fraction recovered (converged, and within 3 reported sigmas of the
 truth), the standard deviation and the median absolute value of the pulls ``(estimate -
-truth) / sigma`` (a calibrated sigma gives 1 and 0.67), and what the fit said where it did not
-converge.
+truth) / sigma`` (a calibrated sigma gives 1 and 0.67) with the 95 % range of the standard
+deviation of that many normal pulls, and what the fit said where it did not converge.
+
+For the roughness kinds every draw is also checked at the **truth**, without the fit
+(:func:`truth_check`): the deviance per measurement at the true model (is the noise model
+the simulation's?), the Fisher sigma there (is the reported sigma the Cramer-Rao one?), and
+with one roughness the linearised maximum-likelihood pull of the same measurements (does the
+fit reach the maximum?) and its standard deviation over :data:`GENERATOR_DRAWS` new draws of
+the simulation's noise generator (is the sigma calibrated at this geometry, from many more
+draws than the bench's one per geometry?). A standard deviation over 50 blind pulls
+scatters by about 0.1: these checks say whether a value at the edge of 0.8-1.25 is the
+sigma's or the draws' (BENCHMARKS.md, "Fit calibration").
 """
 
 from __future__ import annotations

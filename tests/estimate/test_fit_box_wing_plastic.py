@@ -51,7 +51,8 @@ def test_box_wing_plastic_roughness_per_part_from_far_starts():
     ds = simulate(parse_scenario(_scenario(TRUTH), source="truth")).dataset
     n = ds.sizes["time"]
     rate = ds["count_rate_measured"].transpose("time", "band").values
-    lc = MeasuredLightCurve(ds["time"].values, ["G-638/26"], rate, None, np.ones(n, np.int64), "sim")
+    ones = np.ones(n, np.int64)
+    lc = MeasuredLightCurve(ds["time"].values, ["G-638/26"], rate, None, ones, "sim")
     result = fit_scenario(
         parse_scenario(_scenario(START), source="start"), lc, free=("albedo", "roughness")
     )
