@@ -17,7 +17,9 @@ gradient method (:mod:`.gradient_fit`), which differs in the local stage only:
    smaller, SLSQP resumes with a step of one std. It is repeated without the measurements
    that lie more than ``clip_sigma`` robust sigmas from the fit (outliers,
    :mod:`.fit_quality`) while it finds new ones;
-3. the **uncertainties** and what cannot be claimed (:mod:`.roughness_uncertainty`).
+3. the **uncertainties** and what cannot be claimed (:mod:`.roughness_uncertainty`);
+4. with several materials, where the fit misfits the data, stages 1-3 once more from the
+   best point of the scan's common line, the fit of lower chi2 kept (:func:`solve`).
 """
 
 from __future__ import annotations
