@@ -17,7 +17,9 @@ gradient method (:mod:`.gradient_fit`), which differs in the local stage only:
    smaller, SLSQP resumes with a step of one std. It is repeated without the measurements
    that lie more than ``clip_sigma`` robust sigmas from the fit (outliers,
    :mod:`.fit_quality`) while it finds new ones;
-3. the **uncertainties** and what cannot be claimed (:mod:`.roughness_uncertainty`).
+3. the **uncertainties** and what cannot be claimed (:mod:`.roughness_uncertainty`);
+4. with several materials, where the fit misfits the data, stages 1-3 once more from the
+   best point of the scan's common line, the fit of lower chi2 kept (:func:`solve`).
 """
 
 from __future__ import annotations
@@ -29,10 +31,15 @@ from numpy.typing import NDArray
 from scipy.optimize import minimize
 
 from speclight.estimate.fitting.fit import F64, joint_std
-from speclight.estimate.fitting.fit_quality import CLIP_SIGMA, MAX_ROUNDS, outlier_mask
+from speclight.estimate.fitting.fit_quality import (
+    CLIP_SIGMA,
+    MAX_ROUNDS,
+    misfit_text,
+    outlier_mask,
+)
 from speclight.estimate.fitting.noise_model import PoissonNoise
 from speclight.estimate.fitting.roughness_problem import ROUGHNESS_RESOLUTION, RoughnessProblem
-from speclight.estimate.fitting.roughness_scan import SCAN_POINTS, coordinate_scan
+from speclight.estimate.fitting.roughness_scan import SCAN_POINTS, common_start, coordinate_scan
 from speclight.estimate.fitting.roughness_uncertainty import (
     PROFILE_SIGMAS,
     RoughnessFit,
@@ -125,7 +132,48 @@ def solve(
     clip_sigma: float | None = CLIP_SIGMA,
 ) -> RoughnessFit:
     """The stages of a roughness fit (module doc) with the local method ``refine``; the local
-    method is repeated without the outliers (:mod:`.fit_quality`) while it finds new ones."""
+    method is repeated without the outliers (:mod:`.fit_quality`) while it finds new ones.
+
+    With several materials, a fit that misfits the data (:func:`.fit_quality.misfit_text`)
+    is run once more from the best point of the scan's common line
+    (:func:`.roughness_scan.common_start`: every roughness at one grid value), and the fit
+    of lower chi2 is kept: a coordinate scan moves one material at a time and stays in a
+    basin that only a joint move leaves (a box-wing's two wings, whose light adds: from
+    0.5 and 0.8 it kept them at 0.54 and 0.99 for a truth of 0.05 and 0.08, chi2 per
+    degree of freedom 42).
+    """
+
+    def from_(x0: F64) -> RoughnessFit:
+        return _solve_from(problem, x0, refine, scan=scan, on_iteration=on_iteration,
+                           max_iterations=max_iterations, clip_sigma=clip_sigma)  # fmt: skip
+
+    fit = from_(start)
+    if not scan or fit.roughness.size < 2 or not _misfits(problem, fit.roughness):
+        return fit
+    other = common_start(problem, fit.roughness.size)
+    if np.allclose(other, fit.roughness):
+        return fit
+    again = from_(other)
+    better = problem.chi2(again.roughness) < problem.chi2(fit.roughness)
+    return again if better else fit
+
+
+def _misfits(problem: RoughnessProblem, x: F64) -> bool:
+    """The chi2 at ``x`` is far above its degrees of freedom (:mod:`.fit_quality`)."""
+    return bool(misfit_text(problem.chi2(x), problem.n_data, problem.n_par(x.size)))
+
+
+def _solve_from(
+    problem: RoughnessProblem,
+    start: F64,
+    refine: Refine,
+    *,
+    scan: bool,
+    on_iteration: Callable[[int, F64, float], None] | None,
+    max_iterations: int,
+    clip_sigma: float | None,
+) -> RoughnessFit:
+    """Scan, local method and outlier rounds, uncertainties: one start (:func:`solve`)."""
     x = np.clip(np.asarray(start, dtype=float), problem.lo, problem.hi)
     flat = np.zeros(x.size, dtype=bool)
     if scan:

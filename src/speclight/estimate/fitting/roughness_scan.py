@@ -103,6 +103,15 @@ def coordinate_scan(
     return Scan(x, grid, profile, flat, n_sweeps)
 
 
+def common_start(problem: RoughnessProblem, n: int, points: int = SCAN_POINTS) -> F64:
+    """The best point of the common line of ``n`` roughness values: all at one of the
+    ``points`` log-spaced grid values (:func:`coordinate_scan`'s grid); where a fit from
+    another start misfits, the fit starts again there (:func:`.roughness_fit.solve`)."""
+    grid = np.geomspace(problem.lo, problem.hi, points)
+    values = [problem.chi2(np.full(n, g)) for g in grid]
+    return np.full(n, grid[int(np.argmin(values))])
+
+
 def _along(problem: RoughnessProblem, x: F64, k: int, grid: F64) -> F64:
     """chi2 with roughness k at each grid value, the others at ``x``."""
     out = np.empty(grid.size)
@@ -113,4 +122,4 @@ def _along(problem: RoughnessProblem, x: F64, k: int, grid: F64) -> F64:
     return out
 
 
-__all__ = ["MAX_SWEEPS", "SCAN_POINTS", "Scan", "coordinate_scan"]
+__all__ = ["MAX_SWEEPS", "SCAN_POINTS", "Scan", "common_start", "coordinate_scan"]
