@@ -70,6 +70,8 @@ SECOND_REGION_DEG = 20.0
 JACKKNIFE_BLOCKS = 10
 #: Refined misfit over this times the noise floor: flagged.
 MAX_NOISE_RATIO = 10.0
+#: How the note of a flat surface starts.
+FLAT_NOTE = "the data do not constrain the axis"
 
 
 @dataclass
@@ -317,7 +319,7 @@ def _verdict(out: AxisConfidence) -> tuple[bool, str]:
     if not out.sigma_axis_deg <= MAX_SIGMA_DEG:
         flat.append(f"the axis sigma is {out.sigma_axis_deg:.3g} deg")
     if flat:
-        notes.append("the data do not constrain the axis: " + "; ".join(flat))
+        notes.append(f"{FLAT_NOTE}: " + "; ".join(flat))
     elif out.region95_max_sep_deg > SECOND_REGION_DEG:
         notes.append(
             "the 95 % region reaches "
