@@ -98,8 +98,10 @@ def block_jackknife_z(d: F64, n_blocks: int = JACKKNIFE_BLOCKS) -> float:
         return float("nan")
     edges = np.linspace(0, d.size, n_blocks + 1).astype(int)
     sums = np.add.reduceat(d, edges[:-1])
-    loo = d.sum() - sums  # the total without each block
-    se = float(np.sqrt((n_blocks - 1) / n_blocks * np.sum((loo - loo.mean()) ** 2)))
+    # the total without each block, rescaled to all blocks: G / (G - 1) (S - s_g); the
+    # jackknife variance (G - 1) / G sum (. - mean)^2 is then G / (G - 1) sum (s_g - s)^2
+    g = n_blocks
+    se = float(np.sqrt(g / (g - 1) * np.sum((sums - sums.mean()) ** 2)))
     return float(d.sum() / se) if se > 0 else float("inf") * np.sign(d.sum())
 
 
