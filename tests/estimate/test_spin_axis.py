@@ -228,3 +228,41 @@ def test_a_flat_surface_skips_the_period_check() -> None:
     )  # fmt: skip
     assert res.period_check is None
     assert res.confidence is not None and "period" not in res.confidence.note
+
+
+def test_map_error_variance_is_the_shift_on_the_half_resolution_map_over_three() -> None:
+    # reference: the answer refitted on the map at half its nside by Nelder-Mead on the spin
+    # model's own misfit (quaternions, not the tangent parametrisation); the variance on each
+    # axis component is (shift / 3)^2 (bilinear interpolation errs by k h^2: module doc)
+    from scipy.optimize import minimize
+
+    from speclight.estimate.spin_axis.spin_axis_confidence import map_error_covariance
+    from speclight.estimate.spin_axis.spin_axis_continuation import coarsen_map
+    from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
+    from speclight.estimate.spin_axis.spin_axis_misfit import exact_misfit
+
+    ra, dec, phase0, period = 40.0, 25.0, 50.0, 37.0
+    t, los = _sweeping_pass()
+    y = _rates(_body_directions(los, ra, dec, phase0, t, period))
+    geo = EpochGeometry(los, los, t, period)
+    bmap = _closed_form_map(16)
+    model = SpinMisfit.around(bmap, geo, y, None, ra, dec)
+    x0 = np.array([0.0, 0.0, np.radians(phase0)])
+    cov = map_error_covariance(model, x0)
+    coarse = coarsen_map(bmap, 8, None)
+    got = minimize(
+        lambda v: exact_misfit(coarse, geo, y, None, *v), [ra, dec, phase0],
+        method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-14, "maxiter": 4000},
+    )  # fmt: skip
+    shift_deg = angular_distance_deg(got.x[0], got.x[1], ra, dec)
+    assert shift_deg > 0.05  # the coarse map's error moves the answer
+    sigma_deg = np.degrees(np.sqrt(np.diag(cov)[:2]))
+    # both optimisers stop within ~1e-3 deg of their minimum
+    np.testing.assert_allclose(sigma_deg, shift_deg / 3, atol=2e-3)
+    assert np.all(cov[2:] == 0) and np.all(cov[:, 2:] == 0)
+    # nothing coarser than nside 1: no term
+    assert not np.any(
+        map_error_covariance(
+            SpinMisfit.around(coarsen_map(bmap, 1, None), geo, y, None, ra, dec), x0
+        )
+    )
