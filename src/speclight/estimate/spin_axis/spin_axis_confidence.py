@@ -20,6 +20,11 @@ to a lag chosen from the scores' lag-1 correlation (Andrews 1991, Econometrica 5
 doi:10.2307/2938229, eq. 6.4). No noise level is assumed; where the residuals are white
 this is the usual ``sigma^2 (J^T J)^-1``.
 
+**The map's own error** (``method="jackknife-map"``, not the default): the answer's shift
+on the map at half its resolution over 3 as an isotropic variance on the axis
+(:func:`map_error_covariance`). It removes the tail the map's error causes but widens the
+other sigmas (error / sigma standard deviations 0.70 / 0.60 over 50 blind draws).
+
 **Region**: with ``C_aa`` the axis block of ``C`` and ``(A^-1)_aa`` that of ``A^-1``, a
 misfit rise of ``Delta e`` over the grid (the phase minimised, as the surface is) is
 ``Delta chi^2 = Delta e / c`` with ``c = tr(C_aa (A^-1)_aa^-1) / 2`` (``c`` is the misfit
