@@ -1,6 +1,7 @@
 """Calibration of ``spin-axis`` on blind draws (issue 25): recovery, error / sigma, verdicts.
 
-Run: ``.venv/bin/python bench/bench_calibration_spin_axis.py [--draws 50] [--grid-deg 4]
+Run: ``.venv/bin/python bench/bench_calibration_spin_axis.py [--draws 50] [--wrong-draws 10]
+[--period-draws 10] [--sphere-draws 10] [--grid-deg 4]
 [--phases 36] [--folder DIR] [--seed 0]``
 
 Targets and maps (built once in ``--folder``, reused): the box-wing example at 100 nm bins;
@@ -15,8 +16,10 @@ Each draw, with its own random numbers: the spin axis uniform on the sphere, the
 uniform, the sidereal period uniform in 60-240 s, a window of 150-300 epochs (2 s) of the
 example's pass starting 0-100 epochs in (the geometry), relative noise per band and epoch
 of standard deviation 1-8 % (Gaussian), the spin body axis z. The search: grid ``--grid-deg``
-x ``--phases``, the Nelder-Mead refinement, the period fixed at the truth (first part) and,
-for the period part, given 1-4 % off and free (``period_bound`` 0.05).
+x ``--phases``, the Nelder-Mead refinement, the period fixed at the truth (first part; the
+period check of :mod:`speclight.estimate.spin_axis.spin_axis_period_check` runs, its false
+warnings are counted), given 2-6 % off and fixed (``--wrong-draws``: is it warned?) and
+given 1-4 % off and free (``period_bound`` 0.05).
 
 Reported: the fraction recovered (refined axis within 5 deg of the truth), the angular error,
 the error / sigma in the tangent plane (east, north; standard deviation to be 0.8-1.25), the
@@ -106,12 +109,16 @@ def _geometry(folder: Path) -> EpochGeometry:
 
 
 def _tangent_error(ra: float, dec: float, ra0: float, dec0: float) -> tuple[float, float]:
-    """(east, north) [deg] of (ra, dec) from (ra0, dec0), gnomonic about the truth."""
+    """(east, north) [deg] of (ra, dec) from (ra0, dec0): the azimuthal equidistant
+    projection about the truth (the angular distance along the bearing; the gnomonic one
+    used before flips the sign of answers more than 90 deg away)."""
     r, d, r0, d0 = np.radians([ra, dec, ra0, dec0])
     c = np.sin(d0) * np.sin(d) + np.cos(d0) * np.cos(d) * np.cos(r - r0)
-    x = np.cos(d) * np.sin(r - r0) / c
-    y = (np.cos(d0) * np.sin(d) - np.sin(d0) * np.cos(d) * np.cos(r - r0)) / c
-    return float(np.degrees(x)), float(np.degrees(y))
+    x = np.cos(d) * np.sin(r - r0)
+    y = np.cos(d0) * np.sin(d) - np.sin(d0) * np.cos(d) * np.cos(r - r0)
+    rho = np.arccos(np.clip(c, -1.0, 1.0))
+    scale = rho / np.hypot(x, y) if np.hypot(x, y) > 0 else 1.0
+    return float(np.degrees(x * scale)), float(np.degrees(y * scale))
 
 
 def _draw(rng: np.random.Generator, geo_all: EpochGeometry, truth_map, search, args, period_off):
@@ -131,9 +138,11 @@ def _draw(rng: np.random.Generator, geo_all: EpochGeometry, truth_map, search, a
     y = y * (1 + noise * rng.normal(size=y.shape))
     given = period
     bound = None
-    if period_off:
+    if period_off == "free":
         given = period * (1 + rng.choice([-1, 1]) * rng.uniform(0.01, 0.04))
         bound = 0.05
+    elif period_off == "fixed":
+        given = period * (1 + rng.choice([-1, 1]) * rng.uniform(0.02, 0.06))
     bmap, sfm = search
     res = spin_axis_search(
         bmap, sfm, dataclasses.replace(geo, period_s=given), y,
@@ -141,24 +150,58 @@ def _draw(rng: np.random.Generator, geo_all: EpochGeometry, truth_map, search, a
     )  # fmt: skip
     c = res.confidence
     g_ref = dataclasses.replace(geo, period_s=res.refined_period_s)
-    sand = axis_confidence(
-        bmap, g_ref, y, None, res.refined, res.error.T, res.dec_deg, res.ra_deg,
-        bound is not None, None, method="sandwich",
-    )  # fmt: skip
+    warned = res.period_check is not None and res.period_check.warn
+    sand, with_map = (
+        axis_confidence(
+            bmap,
+            g_ref,
+            y,
+            None,
+            res.refined,
+            res.error.T,
+            res.dec_deg,
+            res.ra_deg,
+            free_period=bound is not None,
+            method=m,
+        )
+        for m in ("sandwich", "jackknife-map")
+    )
+    for other in (sand, with_map):  # the period check's warning, as the default has it
+        other.constrained = other.constrained and not warned
     err = float(angular_distance_deg(res.refined[0], res.refined[1], ra, dec))
     east, north = _tangent_error(res.refined[0], res.refined[1], ra, dec)
+    print(
+        f"draw: error {err:.2f} deg (east {east:+.2f}, north {north:+.2f}), sigmas "
+        f"{c.sigma_east_deg:.2f}, {c.sigma_north_deg:.2f} (with the map's "
+        f"{with_map.sigma_east_deg:.2f}, {with_map.sigma_north_deg:.2f}), constrained "
+        f"{c.constrained}, warned {warned}",
+        flush=True,
+    )
     return dict(
-        err=err, east=east, north=north, noise=noise, c=c, sand=sand, period=period,
-        period_err=res.refined_period_s - period, y=y.shape,
+        err=err, east=east, north=north, noise=noise, c=c, sand=sand, map=with_map,
+        period=period, period_err=res.refined_period_s - period, y=y.shape, warned=warned,
+        checked=res.period_check is not None,
     )  # fmt: skip
 
 
 def _report(label: str, rows: list[dict]) -> None:
     if not rows:
         return
-    for key in ("c", "sand"):
-        print(f"\n### sigmas: {'jackknife (default)' if key == 'c' else 'sandwich (HAC)'}")
+    names = {
+        "c": "jackknife + sandwich (default)",
+        "map": "jackknife + sandwich + map error (jackknife-map)",
+        "sand": "sandwich (HAC)",
+    }
+    for key, name in names.items():
+        print(f"\n### sigmas: {name}")
         _report_one(label, [dict(r, c=r[key]) for r in rows])
+    warned = np.array([r["warned"] for r in rows])
+    got = np.array([r["err"] for r in rows]) < 5.0
+    print(
+        f"\nperiod check run in {sum(r['checked'] for r in rows)} of {len(rows)} draws; "
+        f"warned {int(warned.sum())} (of them recovered within 5 deg: "
+        f"{int(np.sum(warned & got))}); not warned and not recovered: {int(np.sum(~warned & ~got))}"
+    )
 
 
 def _z_scores(rows: list[dict]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -224,6 +267,7 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--draws", type=int, default=50)
     ap.add_argument("--period-draws", type=int, default=10)
+    ap.add_argument("--wrong-draws", type=int, default=10)
     ap.add_argument("--sphere-draws", type=int, default=10)
     ap.add_argument("--grid-deg", type=float, default=4.0)
     ap.add_argument("--phases", type=int, default=36)
@@ -242,15 +286,17 @@ def main() -> None:
     search = (b16, spin_frame_map(b16, None, args.phases))
     truth = load_band_map(truth_bw)
     t0 = time.perf_counter()
-    rows = [_draw(rng, geo, truth, search, args, False) for _ in range(args.draws)]
+    rows = [_draw(rng, geo, truth, search, args, "") for _ in range(args.draws)]
     _report("box-wing, period known", rows)
-    rows = [_draw(rng, geo, truth, search, args, True) for _ in range(args.period_draws)]
+    rows = [_draw(rng, geo, truth, search, args, "fixed") for _ in range(args.wrong_draws)]
+    _report("box-wing, period 2-6 % off and fixed (the period check)", rows)
+    rows = [_draw(rng, geo, truth, search, args, "free") for _ in range(args.period_draws)]
     _report("box-wing, period 1-4 % off and free", rows)
     search_s, truth_s = _maps(args.folder, True)
     s16 = load_band_map(search_s)
     sph = (s16, spin_frame_map(s16, None, args.phases))
     rows = [
-        _draw(rng, geo, load_band_map(truth_s), sph, args, False) for _ in range(args.sphere_draws)
+        _draw(rng, geo, load_band_map(truth_s), sph, args, "") for _ in range(args.sphere_draws)
     ]
     con = [r["c"].constrained for r in rows]
     print(f"\n## Lambertian sphere: {len(rows)} draws: said constrained {np.mean(con):.2f}")

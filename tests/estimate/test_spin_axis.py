@@ -184,3 +184,85 @@ def test_a_map_without_attitude_signal_is_said_not_to_constrain_the_axis() -> No
     )  # fmt: skip
     assert res.confidence is not None and not res.confidence.constrained
     assert res.confidence.note.startswith("the data do not constrain the axis")
+
+
+@pytest.mark.parametrize("wrong", [False, True])
+def test_a_wrong_fixed_period_is_warned_and_the_true_one_is_not(wrong) -> None:
+    # the pass made with P = 37 s and 1 % noise; searched with the period fixed at the truth
+    # and at 6 % off (a phase drift of 86 deg over the pass's four turns: the reference
+    # that decides is the period the data were made with)
+    ra, dec, phase0, p_true = 40.0, 25.0, 50.0, 37.0
+    t, los = _sweeping_pass()
+    rng = np.random.default_rng(4)
+    y = _rates(_body_directions(los, ra, dec, phase0, t, p_true))
+    y = y * (1 + 0.01 * rng.normal(size=y.shape))
+    given = p_true * 1.06 if wrong else p_true
+    bmap = _closed_form_map(16)
+    res = spin_axis_search(
+        bmap, spin_frame_map(bmap, None, 36), EpochGeometry(los, los, t, given), y,
+        ["b0", "b1"], 10.0, period_kind="sidereal",
+    )  # fmt: skip
+    check, conf = res.period_check, res.confidence
+    assert check is not None and conf is not None
+    assert check.warn is wrong
+    if wrong:
+        # the scan's step: two 10-deg phase steps of drift over the 150 s pass
+        step = 2 * given / (36 * 150.0)
+        assert check.preferred_period_s == pytest.approx(p_true, rel=step)
+        assert check.preferred_misfit < check.given_misfit
+        assert not conf.constrained and conf.note.startswith(check.note)
+        assert "the given period may be wrong" in conf.note
+    else:
+        assert conf.constrained and "period" not in conf.note
+
+
+def test_a_flat_surface_skips_the_period_check() -> None:
+    # the Lambertian case (above): the flat surface is said; no period check is run
+    bmap = _closed_form_map(8)
+    bmap = ReflectivityMap(bmap.header, bmap.direction_body, np.ones_like(bmap.intensity_W_sr_nm))
+    t, los = _sweeping_pass()
+    y = 1.0 + 0.01 * np.random.default_rng(2).normal(size=(t.size, 2))
+    res = spin_axis_search(
+        bmap, spin_frame_map(bmap, None, 12), EpochGeometry(los, los, t, 37.0), y,
+        ["b0", "b1"], 30.0,
+    )  # fmt: skip
+    assert res.period_check is None
+    assert res.confidence is not None and "period" not in res.confidence.note
+
+
+def test_map_error_variance_is_the_shift_on_the_half_resolution_map_over_three() -> None:
+    # reference: the answer refitted on the map at half its nside by Nelder-Mead on the spin
+    # model's own misfit (quaternions, not the tangent parametrisation); the variance on each
+    # axis component is (shift / 3)^2 (bilinear interpolation errs by k h^2: module doc)
+    from scipy.optimize import minimize
+
+    from speclight.estimate.spin_axis.spin_axis_confidence import map_error_covariance
+    from speclight.estimate.spin_axis.spin_axis_continuation import coarsen_map
+    from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
+    from speclight.estimate.spin_axis.spin_axis_misfit import exact_misfit
+
+    ra, dec, phase0, period = 40.0, 25.0, 50.0, 37.0
+    t, los = _sweeping_pass()
+    y = _rates(_body_directions(los, ra, dec, phase0, t, period))
+    geo = EpochGeometry(los, los, t, period)
+    bmap = _closed_form_map(16)
+    model = SpinMisfit.around(bmap, geo, y, None, ra, dec)
+    x0 = np.array([0.0, 0.0, np.radians(phase0)])
+    cov = map_error_covariance(model, x0)
+    coarse = coarsen_map(bmap, 8, None)
+    got = minimize(
+        lambda v: exact_misfit(coarse, geo, y, None, *v), [ra, dec, phase0],
+        method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-14, "maxiter": 4000},
+    )  # fmt: skip
+    shift_deg = angular_distance_deg(got.x[0], got.x[1], ra, dec)
+    assert shift_deg > 0.05  # the coarse map's error moves the answer
+    sigma_deg = np.degrees(np.sqrt(np.diag(cov)[:2]))
+    # both optimisers stop within ~1e-3 deg of their minimum
+    np.testing.assert_allclose(sigma_deg, shift_deg / 3, atol=2e-3)
+    assert np.all(cov[2:] == 0) and np.all(cov[:, 2:] == 0)
+    # nothing coarser than nside 1: no term
+    assert not np.any(
+        map_error_covariance(
+            SpinMisfit.around(coarsen_map(bmap, 1, None), geo, y, None, ra, dec), x0
+        )
+    )

@@ -131,8 +131,10 @@ def test_cli_run_and_bad_input(folder) -> None:
         assert a["refine_method"] == "gradient" and a["period_free"] == 1
         assert a["refine_gradient_evaluations"] > 0 and a["refine_misfit_evaluations"] == 0
         assert abs(a["refined_period_s"] / 120.0 - 1) <= a["period_bound"] == 0.05
+        assert a["period_check"] == "not run"  # a free period
     with xr.open_dataset(out, engine="h5netcdf") as ds:
         assert ds.attrs["refine_method"] == "none" and ds.attrs["period_free"] == 0
+        assert ds.attrs["period_check"] == "not run"  # no refinement
     cont = [*base, "-o", str(folder / "cont.nc"), *args[7:11]]
     run = runner.invoke(app, [*cont, "--refine", "gradient-continuation"])
     assert run.exit_code == 0, run.output
@@ -140,6 +142,9 @@ def test_cli_run_and_bad_input(folder) -> None:
     with xr.open_dataset(folder / "cont.nc", engine="h5netcdf") as ds:
         assert ds.attrs["refine_method"] == "gradient-continuation"
         assert ds.attrs["refine_gradient_evaluations"] > 0
+        # the scenario's (true) period, fixed: checked, and no other period preferred
+        assert ds.attrs["period_check"] == "passed", ds.attrs["axis_note"]
+        assert ds.attrs["period_check_n_periods"] > 3
     # the same noisy rates as a CSV (eq. 5 applied to them with the scenario's geometry, the
     # scenario run on the map): the same misfits, to the CSV's 7 significant digits
     with xr.open_dataset(measured, engine="h5netcdf") as sim:

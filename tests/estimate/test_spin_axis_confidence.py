@@ -123,3 +123,23 @@ def test_scan_steps_drift_two_phase_steps() -> None:
     p = scan_periods(120.0, 0.05, 72, 600.0)
     assert p[0] == pytest.approx(114.0) and p[-1] == pytest.approx(126.0)
     assert np.max(np.diff(p)) / 120.0 <= 1 / 180 + 1e-12
+
+
+@pytest.mark.parametrize("rho", [0.0, 0.8])
+def test_block_jackknife_z_is_students_t_under_the_null(rho) -> None:
+    # zero-mean AR(1) values, 10 blocks of 300: the blocks' sums are nearly independent, so
+    # z = sum / se is Student's t with 9 degrees of freedom, variance 9 / 7 (for rho = 0.8
+    # a white-noise standard error would give (1 + rho) / (1 - rho) = 9 times more)
+    from speclight.estimate.spin_axis.spin_axis_period_check import block_jackknife_z
+
+    rng = np.random.default_rng(11)
+    n_draws, n = 3000, 3000
+    e = rng.normal(size=(n_draws, n))
+    d = np.empty_like(e)
+    d[:, 0] = e[:, 0]
+    for i in range(1, n):
+        d[:, i] = rho * d[:, i - 1] + np.sqrt(1 - rho**2) * e[:, i]
+    z = np.array([block_jackknife_z(row, 10) for row in d])
+    # sampling error of a variance of t(9) values: sqrt((2 + 6 / 5) / n_draws) relative
+    assert np.var(z) == pytest.approx(9 / 7, rel=5 * np.sqrt(3.2 / n_draws))
+    assert np.isnan(block_jackknife_z(np.ones(5), 10))

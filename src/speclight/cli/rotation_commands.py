@@ -105,6 +105,15 @@ def spin_axis(
             "refined).",
         ),
     ] = 0.05,
+    no_period_check: Annotated[
+        bool,
+        typer.Option(
+            "--no-period-check",
+            help="With a fixed period, skip the check that scans the periods within 8 % and "
+            "warns where another fits better or moves the axis (about 30 passes of a coarse "
+            "axis grid).",
+        ),
+    ] = False,
     source: Annotated[
         str | None,
         source_option(
@@ -156,7 +165,7 @@ def spin_axis(
                 load_scenario(scenario), measured, map_file, period_s=period_s,
                 grid_deg=grid_deg, n_phases=phases, bands=names, refine=not no_refine,
                 light=source, ranging_weight=ranging_weight, refine_method=refine_method,
-                period_bound=bound, period_kind=period_kind,
+                period_bound=bound, period_kind=period_kind, period_check=not no_period_check,
             )  # fmt: skip
             return result, axis_dataset(result, str(map_file), str(scenario))
 

@@ -20,6 +20,11 @@ to a lag chosen from the scores' lag-1 correlation (Andrews 1991, Econometrica 5
 doi:10.2307/2938229, eq. 6.4). No noise level is assumed; where the residuals are white
 this is the usual ``sigma^2 (J^T J)^-1``.
 
+**The map's own error** (``method="jackknife-map"``, not the default): the answer's shift
+on the map at half its resolution over 3 as an isotropic variance on the axis
+(:func:`map_error_covariance`). It removes the tail the map's error causes but widens the
+other sigmas (error / sigma standard deviations 0.70 / 0.60 over 50 blind draws).
+
 **Region**: with ``C_aa`` the axis block of ``C`` and ``(A^-1)_aa`` that of ``A^-1``, a
 misfit rise of ``Delta e`` over the grid (the phase minimised, as the surface is) is
 ``Delta chi^2 = Delta e / c`` with ``c = tr(C_aa (A^-1)_aa^-1) / 2`` (``c`` is the misfit
@@ -70,6 +75,8 @@ SECOND_REGION_DEG = 20.0
 JACKKNIFE_BLOCKS = 10
 #: Refined misfit over this times the noise floor: flagged.
 MAX_NOISE_RATIO = 10.0
+#: How the note of a flat surface starts.
+FLAT_NOTE = "the data do not constrain the axis"
 
 
 @dataclass
@@ -176,6 +183,39 @@ def jackknife_covariance(model: SpinMisfit, x0: F64, ranged: bool) -> F64:
     return np.asarray((JACKKNIFE_BLOCKS - 1) / JACKKNIFE_BLOCKS * (d.T @ d))
 
 
+def map_error_covariance(model: SpinMisfit, x0: F64) -> F64:
+    """An isotropic variance (K, K) on the axis block for the map's own error, measured by
+    halving the map's resolution.
+
+    The map's HEALPix interpolation errs by ``k h^2`` (bilinear, ``h`` the pixel size), so
+    the answer refitted (L-BFGS-B, analytic gradient, from ``x0``) on the map coarsened to
+    half its ``nside`` (:func:`.spin_axis_continuation.coarsen_map`: ``2 h``, ``4 k h^2``)
+    moves by about 3 times what the map's error does to it: ``sigma_map = |shift| / 3`` on
+    each axis component (the shift's direction is that of the coarse map's error, not the
+    map's: only its size is used). Zero for a map of ``nside`` 1 (none coarser); the
+    ranging term (its own map) is kept as it is.
+    """
+    from scipy.optimize import minimize
+
+    from speclight.estimate.spin_axis.spin_axis_continuation import coarsen_map
+
+    k = x0.size
+    nside = model.bmap.header.nside
+    if nside < 2:
+        return np.zeros((k, k))
+    coarse = dataclasses.replace(model, bmap=coarsen_map(model.bmap, nside // 2, None))
+    res = minimize(
+        coarse.misfit_and_gradient, x0, jac=True, method="L-BFGS-B",
+        options={"maxiter": 100, "ftol": 1e-12, "gtol": 1e-9},
+    )  # fmt: skip
+    shift = np.asarray(res.x, dtype=float)[:2] - x0[:2]
+    if not np.all(np.isfinite(shift)):
+        return np.zeros((k, k))
+    out = np.zeros((k, k))
+    out[0, 0] = out[1, 1] = float(np.sum(shift**2)) / 9.0
+    return out
+
+
 def axis_confidence(
     bmap: ReflectivityMap,
     geo: EpochGeometry,
@@ -212,8 +252,9 @@ def axis_confidence(
     ranging
         The range-offset term (:class:`.spin_axis_ranging.RangingTerm`), or None.
     method
-        The covariance: ``jackknife`` (:func:`jackknife_covariance` plus the sandwich) or
-        ``sandwich`` (:func:`sandwich_covariance`).
+        The covariance: ``jackknife`` (:func:`jackknife_covariance` plus the sandwich),
+        ``jackknife-map`` (that plus :func:`map_error_covariance`) or ``sandwich``
+        (:func:`sandwich_covariance`).
     """
     out = AxisConfidence()
     finite = np.isfinite(error)
@@ -255,8 +296,10 @@ def _sigmas(
     if jac is None or not np.all(np.isfinite(r)) or not np.any(jac):
         return
     cov, a_inv, out.hac_lag = sandwich_covariance(r, jac, y.shape[0])
-    if method == "jackknife":  # plus the sandwich: never below the local noise's curvature
-        cov = cov + jackknife_covariance(model, x0, ranging is not None)
+    if method in ("jackknife", "jackknife-map"):  # plus the sandwich: never below the
+        cov = cov + jackknife_covariance(model, x0, ranging is not None)  # local curvature
+    if method == "jackknife-map":
+        cov = cov + map_error_covariance(model, x0)
     # x = (a, b): a tilts the axis towards -b_frame... (:mod:`.spin_axis_gradient`): the
     # tangent rotation (a, b) moves the axis by (b, -a) in the frame's (x, y); x is the
     # ascending node (east), y north of it
@@ -317,7 +360,7 @@ def _verdict(out: AxisConfidence) -> tuple[bool, str]:
     if not out.sigma_axis_deg <= MAX_SIGMA_DEG:
         flat.append(f"the axis sigma is {out.sigma_axis_deg:.3g} deg")
     if flat:
-        notes.append("the data do not constrain the axis: " + "; ".join(flat))
+        notes.append(f"{FLAT_NOTE}: " + "; ".join(flat))
     elif out.region95_max_sep_deg > SECOND_REGION_DEG:
         notes.append(
             "the 95 % region reaches "

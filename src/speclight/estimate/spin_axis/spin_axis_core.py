@@ -48,6 +48,7 @@ from speclight.maps.map_lookup import ReflectivityMap
 
 if TYPE_CHECKING:
     from speclight.estimate.spin_axis.spin_axis_confidence import AxisConfidence
+    from speclight.estimate.spin_axis.spin_axis_period_check import PeriodCheck
     from speclight.estimate.spin_axis.spin_axis_ranging import RangingTerm
 
 F64 = NDArray[np.float64]
@@ -92,6 +93,8 @@ class SpinAxisResult:
     #: with a free period: the periods scanned [s] and the best misfit of each
     scan_periods_s: F64 | None = None
     scan_errors: F64 | None = None
+    #: with a fixed period: whether another period fits better (:mod:`.spin_axis_period_check`)
+    period_check: PeriodCheck | None = None
 
 
 def check_search_options(grid_deg: float, n_phases: int) -> None:
@@ -254,6 +257,7 @@ def spin_axis_search(
     refine_method: str = "nelder-mead",
     period_bound: float | None = None,
     period_kind: str = "sidereal",
+    period_check: bool = True,
 ) -> SpinAxisResult:
     """Grid search, mirror and refinement (module docstring).
 
@@ -281,6 +285,9 @@ def spin_axis_search(
         What ``geo.period_s`` is (:mod:`.spin_axis_period`): ``sidereal`` (the body's),
         ``synodic`` (the light curve's: each axis gets its own sidereal period) or ``auto``
         (both tried, the better fit kept).
+    period_check
+        With a fixed period and a refinement: scan the periods around it and warn where the
+        data prefer another (:mod:`.spin_axis_period_check`).
     """
     from speclight.estimate.spin_axis.spin_axis_period import check_period_kind
     from speclight.estimate.spin_axis.spin_axis_refine import check_refine_options
@@ -352,6 +359,14 @@ def spin_axis_search(
             bmap, with_period(geo, period_s), y, spin_body_axis, refined, error, dec, ra,
             period_bound is not None, ranging,
         )  # fmt: skip
+    checked = None
+    if do_refine and period_check and period_bound is None:
+        from speclight.estimate.spin_axis.spin_axis_period_check import checked_answer
+
+        checked = checked_answer(
+            bmap, sfm, with_period(geo, period_s), y, spin_body_axis, refined, grid_deg,
+            chunk, ranging, confidence,
+        )  # fmt: skip
     return SpinAxisResult(
         ra,
         dec,
@@ -374,4 +389,5 @@ def spin_axis_search(
         confidence,
         scan.periods_s,
         scan.period_errors,
+        checked,
     )

@@ -67,6 +67,7 @@ def axis_dataset(run: SpinAxisRun, map_path: str, scenario_source: str) -> xr.Da
     if run.period_bound is not None:
         attrs["period_bound"] = run.period_bound
     ds = _with_confidence(ds, r)
+    _with_period_check(ds, r)
     attrs.update(
         period_s=run.period_s,
         spin_body_axis=np.asarray(run.spin_body_axis, dtype=float),
@@ -115,3 +116,24 @@ def _with_confidence(ds: xr.Dataset, r: SpinAxisResult) -> xr.Dataset:
         "95 % region",
     )
     return ds
+
+
+#: AXIS.nc attributes of :class:`.spin_axis_period_check.PeriodCheck`, each ``period_check_``
+#: and the field's name (docs/spin-axis.md).
+PERIOD_CHECK_ATTRS = (
+    "preferred_period_s", "preferred_misfit", "given_misfit", "preferred_ra_deg",
+    "preferred_dec_deg", "separation_deg", "z", "n_periods",
+)  # fmt: skip
+
+
+def _with_period_check(ds: xr.Dataset, r: SpinAxisResult) -> None:
+    """``period_check_*`` attributes: ``period_check`` is ``warned``, ``passed`` or ``not
+    run`` (a free period, no refinement, a flat surface or turned off)."""
+    c = r.period_check
+    if c is None:
+        ds.attrs["period_check"] = "not run"
+        return
+    ds.attrs["period_check"] = "warned" if c.warn else "passed"
+    ds.attrs["period_check_note"] = c.note
+    for name in PERIOD_CHECK_ATTRS:
+        ds.attrs[f"period_check_{name}"] = getattr(c, name)

@@ -172,6 +172,7 @@ def spin_axis_measured(
     refine_method: str = "nelder-mead",
     period_bound: float | None = None,
     period_kind: str | None = None,
+    period_check: bool = True,
 ) -> SpinAxisRun:
     """Search the spin axis of a measured pass against a reflectivity map (module doc).
 
@@ -210,6 +211,9 @@ def spin_axis_measured(
         What the period is (:mod:`.spin_axis_period`): ``sidereal``, ``synodic`` (a light
         curve's, e.g. from ``speclight period``) or ``auto``; default ``auto`` for a given
         ``period_s``, ``sidereal`` for the scenario's.
+    period_check
+        With a fixed period: warn where another period within 8 % fits better
+        (:mod:`.spin_axis_period_check`).
 
     Returns
     -------
@@ -321,6 +325,7 @@ def spin_axis_measured(
         refine_method,
         period_bound,
         period_kind,
+        period_check,
     )
     seconds = time.perf_counter() - t0
     refined_epochs = epochs
