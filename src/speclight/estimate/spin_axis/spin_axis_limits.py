@@ -17,8 +17,10 @@ What grows with the options (``grid_deg``, ``n_phases``) and the inputs (epochs 
 The ranging term (``ranging=True``) adds its own spin-frame map (one geometry, ``2 B``
 channels) and doubles the grid pass. Rates measured on the box-wing example (768-direction
 map, 4 phase angles x 8 rolls, 300 epochs, 10 bands; BENCHMARKS.md "Estimator limits",
-``bench/bench_estimator_limits.py``): 6-10.5 us per cell and geometry, 4.6-9 ns per lookup;
-the constants are about the upper ends.
+``bench/bench_estimator_limits.py``): 6-10.5 us per cell and geometry; the grid pass's
+lookups cost 1.1 ns of CPU each as numpy blocks and 0.36 ns in the compiled loop at load ~10
+(BENCHMARKS.md "Spin-axis grid pass", 2026-12-04; they were 4.6-9 ns before that loop and the
+matmul weighting). The constants are about the upper ends (the numpy fallback, loaded).
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ BYTES_PER_AXIS_EPOCH = 512
 #: Building the spin-frame map, per cell and map geometry (phase angle x roll) [s].
 SECONDS_PER_CELL_GEOMETRY = 10e-6
 #: The grid pass per axis, phase, epoch and band [s].
-SECONDS_PER_LOOKUP = 10e-9
+SECONDS_PER_LOOKUP = 2e-9
 #: The default ``n_phases`` (``--phases``), to tell which option made a search large.
 DEFAULT_PHASES = 72
 
