@@ -216,6 +216,35 @@ def test_a_wrong_fixed_period_is_warned_and_the_true_one_is_not(wrong) -> None:
         assert conf.constrained and "period" not in conf.note
 
 
+@pytest.mark.parametrize("bound", [0.03, 0.10])
+def test_a_free_period_stopped_by_its_bound_is_said(bound) -> None:
+    # the pass of the test above made with P = 37 s, the search started 6 % off with the
+    # period free within `bound`: within 3 % the truth is out of reach and the answer sits
+    # on the bound's edge (said, axis not called constrained); within 10 % the truth is
+    # inside and found (no edge note)
+    ra, dec, phase0, p_true = 40.0, 25.0, 50.0, 37.0
+    t, los = _sweeping_pass()
+    rng = np.random.default_rng(4)
+    y = _rates(_body_directions(los, ra, dec, phase0, t, p_true))
+    y = y * (1 + 0.01 * rng.normal(size=y.shape))
+    given = p_true * 1.06
+    bmap = _closed_form_map(16)
+    res = spin_axis_search(
+        bmap, spin_frame_map(bmap, None, 36), EpochGeometry(los, los, t, given), y,
+        ["b0", "b1"], 10.0, period_kind="sidereal", period_bound=bound,
+    )  # fmt: skip
+    conf = res.confidence
+    assert conf is not None
+    if bound < 0.06:
+        assert res.refined_period_s == pytest.approx(given * (1 - bound), rel=0.02 * bound)
+        assert not conf.constrained
+        assert conf.note.startswith("the free period ended at the lower edge")
+    else:
+        # the period to the scan's step (two 10-deg phase steps of drift over the pass)
+        assert res.refined_period_s == pytest.approx(p_true, rel=2 * given / (36 * 150.0))
+        assert "edge" not in conf.note
+
+
 def test_a_flat_surface_skips_the_period_check() -> None:
     # the Lambertian case (above): the flat surface is said; no period check is run
     bmap = _closed_form_map(8)

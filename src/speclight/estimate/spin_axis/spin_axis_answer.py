@@ -161,3 +161,37 @@ def refine_answer(
         sum(t.n_misfit for t in tries),
         sum(t.n_gradient for t in tries),
     )
+
+
+#: A free period within this fraction of ``period_bound`` from its edge is "at the edge".
+EDGE_FRACTION = 0.02
+
+
+def period_edge_note(
+    geo: EpochGeometry,
+    synodic_s: float | None,
+    answer: Answer,
+    period_s: float,
+    period_bound: float | None,
+) -> str:
+    """A note where a free period ended at the edge of ``[P0 (1 - b), P0 (1 + b)]`` (the
+    truth may lie beyond it: the answer is then the bound's, not the data's), else ``""``.
+
+    ``P0`` is the sidereal period the refinement started from at the answer's axis
+    (:func:`axis_geometry`), ``b`` is ``period_bound``.
+    """
+    if period_bound is None or not np.isfinite(period_s) or not np.isfinite(answer[0]):
+        return ""
+    p0 = axis_geometry(geo, synodic_s, answer[0], answer[1]).period_s
+    if not np.isfinite(p0) or p0 <= 0:
+        return ""
+    rel = period_s / p0 - 1.0
+    if abs(rel) < period_bound * (1.0 - EDGE_FRACTION):
+        return ""
+    side = "upper" if rel > 0 else "lower"
+    return (
+        f"the free period ended at the {side} edge of its range ({period_s:.6g} s, "
+        f"{100 * rel:+.2f} % of {p0:.6g} s; period_bound {period_bound:g}): the data may "
+        "prefer a period beyond it, so the axis and the period are the bound's answer; "
+        "widen the bound or give a better period"
+    )

@@ -346,7 +346,7 @@ def spin_axis_search(
     period_s = float("nan")
     confidence = None
     if do_refine:
-        from speclight.estimate.spin_axis.spin_axis_answer import refine_answer
+        from speclight.estimate.spin_axis.spin_axis_answer import period_edge_note, refine_answer
         from speclight.estimate.spin_axis.spin_axis_confidence import axis_confidence, with_period
 
         step = max(grid_deg, 360.0 / sfm.n_phases) / 2
@@ -359,6 +359,10 @@ def spin_axis_search(
             bmap, with_period(geo, period_s), y, spin_body_axis, refined, error, dec, ra,
             period_bound is not None, ranging,
         )  # fmt: skip
+        edge = period_edge_note(geo, synodic_s, refined, period_s, period_bound)
+        if edge and confidence is not None:
+            confidence.constrained = False
+            confidence.note = f"{edge}; {confidence.note}"
     checked = None
     if do_refine and period_check and period_bound is None:
         from speclight.estimate.spin_axis.spin_axis_period_check import checked_answer
