@@ -25,7 +25,7 @@ moment ratios (within :data:`FAMILY_RELATIVE`); every family is reported.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -39,14 +39,16 @@ from speclight.estimate.shape.convex_model import facet_brightness, relative_res
 from speclight.estimate.shape.ecliptic import angular_distance_deg
 from speclight.estimate.shape.inversion_data import InversionData
 from speclight.estimate.shape.scattering import ScatteringLaw
+from speclight.estimate.shape.tumbling_mirror import mirror_plane, mirror_state
 from speclight.estimate.shape.tumbling_principal import ALPHA as PRINCIPAL_ALPHA
-from speclight.estimate.shape.tumbling_principal import principal_axis_test
+from speclight.estimate.shape.tumbling_principal import lag1_correlation, principal_axis_test
 from speclight.estimate.shape.tumbling_search import (
     N_CARRY,
     grid_starts,
     moments_from_u,
     window_schedule,
 )
+from speclight.estimate.shape.tumbling_uncertainty import rate_and_ratio_std
 
 F64 = NDArray[np.float64]
 N_STARTS = 32
@@ -78,6 +80,9 @@ class TumblingState:
         Sum of squared residuals.
     scale
         Factor on the areas (calibrated data; 1 for relative).
+    std
+        (3,) standard deviations of the rate [rad/s] and of the two moment ratios
+        (:mod:`.tumbling_uncertainty`); NaN where not fitted.
     """
 
     q0: F64
@@ -85,6 +90,7 @@ class TumblingState:
     moments: F64
     chi2: float
     scale: float = 1.0
+    std: F64 = field(default_factory=lambda: np.full(3, np.nan))
 
     @property
     def momentum_direction(self) -> F64:
@@ -232,12 +238,14 @@ def _fit_tumbling(
         final = first
     else:
         gap_s = float(np.ptp(data.time_jd)) * SECONDS_PER_DAY
+        normal, _ = mirror_plane(data.sun_ecliptic, data.observer_ecliptic)
         x_next = []
         for sol in seeds:
             period_s = 2 * np.pi / sol.rate_rad_s
             dc = PHASE_DRIFT * period_s / gap_s
             for j in np.arange(-np.floor(rate_span / dc), np.floor(rate_span / dc) + 1):
-                x_next.append(_state_vector(sol, 1.0 + j * dc))
+                for s in (sol, mirror_state(sol, normal)):
+                    x_next.append(_state_vector(s, 1.0 + j * dc))
         final = _fit_all(prob, x_next)
     kept = _within(final, prob)
     n_par = 9 if prob.calibrated else 8
@@ -324,15 +332,19 @@ def _fit_all(
             max_nfev=max_evaluations,
         )
         q0, w0, moments, scale = prob.state(np.append(res.x, 0.0)[:9])
-        out.append(TumblingState(q0, w0, moments, float(2.0 * res.cost), scale))
+        std = rate_and_ratio_std(res.x, res.jac, res.fun)
+        out.append(TumblingState(q0, w0, moments, float(2.0 * res.cost), scale, std))
     out.sort(key=lambda s: s.chi2)
     return out
 
 
 def _within(states: list[TumblingState], prob: _Problem) -> list[TumblingState]:
-    """The states within ``chi2_min + delta s^2`` (module doc)."""
+    """The states within ``chi2_min + delta s^2`` (module doc), ``s^2`` the best's
+    residual variance times ``(1 + rho) / (1 - rho)``, ``rho`` its residuals' lag-1
+    correlation (model error: fewer independent points, as in :mod:`.tumbling_principal`)."""
     n_par = 9 if prob.calibrated else 8
-    s2 = states[0].chi2 / max(prob.data.n_points - n_par, 1)
+    rho = max(lag1_correlation(prob.residuals(_state_vector(states[0], 1.0)[:n_par])), 0.0)
+    s2 = states[0].chi2 / max(prob.data.n_points - n_par, 1) * (1 + rho) / (1 - rho)
     threshold = states[0].chi2 + float(stats.chi2.ppf(0.99, n_par)) * s2
     return [s for s in states if s.chi2 <= threshold]
 
