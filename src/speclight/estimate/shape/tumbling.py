@@ -181,7 +181,9 @@ def fit_tumbling(
     rotation phase drifts by ``T / P`` turns per unit of relative rate error, so each starts
     at rate scales ``1 + j dc``, ``dc =`` :data:`PHASE_DRIFT` ``P / T``, ``|j dc| <=``
     :data:`RATE_SPAN` (a torque-free motion with its rates scaled by ``c`` is the same
-    motion ``c`` times faster), and the lowest of all is kept as in stage 1.
+    motion ``c`` times faster), and the lowest of all is kept as in stage 1. Last, the
+    mirror image of each kept family's best (at most :data:`N_SEEDS`;
+    :mod:`.tumbling_mirror`) is fitted to all curves and joins the solutions.
 
     ``rate_span``: the relative rate error covered in stage 2 (default :data:`RATE_SPAN`).
     ``initial_states`` (at ``t0_jd``, default the seed curve's middle) are tried before the
@@ -238,15 +240,21 @@ def _fit_tumbling(
         final = first
     else:
         gap_s = float(np.ptp(data.time_jd)) * SECONDS_PER_DAY
-        normal, _ = mirror_plane(data.sun_ecliptic, data.observer_ecliptic)
         x_next = []
         for sol in seeds:
             period_s = 2 * np.pi / sol.rate_rad_s
             dc = PHASE_DRIFT * period_s / gap_s
             for j in np.arange(-np.floor(rate_span / dc), np.floor(rate_span / dc) + 1):
-                for s in (sol, mirror_state(sol, normal)):
-                    x_next.append(_state_vector(s, 1.0 + j * dc))
+                x_next.append(_state_vector(sol, 1.0 + j * dc))
         final = _fit_all(prob, x_next)
+    # each family's mirror image (tumbling_mirror.py) fitted too: a start the search
+    # rarely reaches, as good as the family where the geometry is nearly coplanar
+    normal, _ = mirror_plane(data.sun_ecliptic, data.observer_ecliptic)
+    mirrors = [mirror_state(f[0], normal) for f in _families(_within(final, prob))]
+    final = sorted(
+        final + _fit_all(prob, [_state_vector(m, 1.0) for m in mirrors[:N_SEEDS]]),
+        key=lambda s: s.chi2,
+    )
     kept = _within(final, prob)
     n_par = 9 if prob.calibrated else 8
     chi_pa, p = principal_axis_test(prob.residuals, _state_vector(kept[0], 1.0)[:n_par], n_par)
