@@ -7,6 +7,7 @@ import os
 
 import numpy as np
 import pytest
+import xarray as xr
 from scipy.spatial.transform import Rotation
 
 from conftest import WHITE, render_mesh
@@ -16,8 +17,15 @@ from speclight.estimate.shape.convex_model import facet_brightness
 from speclight.estimate.shape.egi import mesh_facets
 from speclight.estimate.shape.inversion_data import build_inversion_data
 from speclight.estimate.shape.scattering import scattering_law
-from speclight.estimate.shape.tumbling import TumblingState, fit_tumbling, same_family
+from speclight.estimate.shape.tumbling import (
+    FAMILY_ANGLE_DEG,
+    FAMILY_RELATIVE,
+    TumblingState,
+    fit_tumbling,
+    same_family,
+)
 from speclight.estimate.shape.tumbling_mirror import mirror_plane, mirror_state
+from speclight.estimate.shape.tumbling_run import add_tumbling
 from speclight.target import shapes
 
 MOMENTS = np.array([0.45, 0.8, 1.0])  # principal moments / the largest
@@ -48,13 +56,14 @@ LONG = pytest.mark.skipif(
 )
 
 
-@LONG
-@pytest.mark.xfail(
-    strict=True,
-    reason="issue 27 item 3 open: the grid + continuation does not yet reach the truth's "
-    "family from this far start (BENCHMARKS.md, 'Tumbling from far starts')",
-)
-def test_torque_free_box_wing_state_recovered():
+def _angle_deg(a, b):
+    return np.degrees(np.arccos(np.clip(a @ b, -1.0, 1.0)))
+
+
+@pytest.fixture(scope="module")
+def rendered_far_fit():
+    """The torque-free box-wing rendered by speclight (shadows included), fitted with no
+    prior but a far start; the truth's own best fit; the truth and its mirror state."""
     tgt = shapes.box_wing(WHITE, dish=False)
     parts = [(p.vertices_m, p.faces) for p in tgt.parts]
     t_s, sun, obs = _two_passes()
@@ -68,15 +77,9 @@ def test_torque_free_box_wing_state_recovered():
     sigma = 0.01 * np.mean(y)
     t_jd = 2459000.5 + t_s / 86400.0
     data = build_inversion_data(
-        t_jd,
-        y + sigma * rng.normal(size=y.size),
-        np.full(y.size, sigma),
-        sun,
-        obs,
-        np.repeat([0, 1], 60),
-        np.array([False, False]),
-        "tf",
-    )
+        t_jd, y + sigma * rng.normal(size=y.size), np.full(y.size, sigma), sun, obs,
+        np.repeat([0, 1], 60), np.array([False, False]), "tf",
+    )  # fmt: skip
     truth = TumblingState(Q0, W0, MOMENTS, 0.0)
     # a start far from the truth: the attitude turned by 120 deg, the rates 60 deg off and
     # 30 % slower, moments (0.3, 0.9, 1): the fit's grid and continuation must find the way
@@ -90,20 +93,44 @@ def test_torque_free_box_wing_state_recovered():
     )
     assert not same_family(far, truth)
     normals, areas = mesh_facets(parts)
-    fit = fit_tumbling(
-        data,
-        normals,
-        areas,
-        scattering_law("lambert"),
-        min_period_h=0.03,
-        max_period_h=0.1,
-        n_starts=0,
-        initial_states=[far],
-        t0_jd=t_jd[0],
-        rate_span=0.015,
+    law = scattering_law("lambert")
+    common = dict(min_period_h=0.03, max_period_h=0.1, n_starts=0, t0_jd=t_jd[0])
+    fit = fit_tumbling(data, normals, areas, law, initial_states=[far], rate_span=0.015, **common)
+    at_truth = fit_tumbling(
+        data, normals, areas, law, initial_states=[truth], rate_span=0.0, grid=False, **common
     )
-    assert any(same_family(fam[0], truth) for fam in fit.families)
+    mirror = mirror_state(truth, mirror_plane(sun, obs)[0])
+    return fit, at_truth, truth, mirror
+
+
+@LONG
+def test_far_start_reaches_the_truths_momentum_and_rate(rendered_far_fit):
+    """From the far start the search ends at least as low as the truth's own best fit
+    (chi-square; the convex model lacks the shadows, so that is not the truth's state), and
+    a reported family has the truth's momentum direction (or its mirror's: the passes' Sun
+    and observer directions lie within 0.6 deg rms of one plane, tumbling_mirror.py) within
+    the families' 10 deg and the rate within their 5 %; it beats a principal-axis rotation."""
+    fit, at_truth, truth, mirror = rendered_far_fit
+    assert fit.families[0][0].chi2 <= at_truth.families[0][0].chi2
+    assert any(
+        _angle_deg(f[0].momentum_direction, ref.momentum_direction) <= FAMILY_ANGLE_DEG
+        and abs(f[0].rate_rad_s / ref.rate_rad_s - 1.0) <= FAMILY_RELATIVE
+        for f in fit.families
+        for ref in (truth, mirror)
+    )
     assert fit.detected  # better than any rotation about a principal axis (F-test)
+
+
+@LONG
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 27 item 3 open: the convex model lacks the shadows of the rendered "
+    "box-wing, and its best fit (chi2 3803 against 7497 for the truth's own) has the "
+    "smaller moment ratio 0.53 where the truth has 0.45 (3.9 sigma); BENCHMARKS.md",
+)
+def test_torque_free_box_wing_state_recovered(rendered_far_fit):
+    fit, _, truth, mirror = rendered_far_fit
+    assert any(same_family(f[0], truth) or same_family(f[0], mirror) for f in fit.families)
 
 
 @LONG
@@ -165,6 +192,10 @@ def test_principal_axis_rotation_is_not_tumbling_fast():
         initial_states=[start], t0_jd=t_jd[0], rate_span=0.0, grid=False,
     )  # fmt: skip
     assert not fit.detected
+    ds = add_tumbling(xr.Dataset(), fit)  # SHAPE.nc's variables, the std ones finite
+    assert ds.attrs["tumbling_detected"] == 0
+    assert np.all(np.isfinite(ds.tumbling_rate_std)) and np.all(ds.tumbling_rate_std > 0)
+    assert np.all(np.isfinite(ds.tumbling_moment_ratio_std))
 
 
 def test_body_symmetry_keeps_the_family():
