@@ -7,15 +7,25 @@ import os
 
 import numpy as np
 import pytest
+import xarray as xr
 from scipy.spatial.transform import Rotation
 
 from conftest import WHITE, render_mesh
 from speclight.attitude import torque_free_attitude
 from speclight.attitude.quaternion import quat_conjugate, quat_rotate
+from speclight.estimate.shape.convex_model import facet_brightness
 from speclight.estimate.shape.egi import mesh_facets
 from speclight.estimate.shape.inversion_data import build_inversion_data
 from speclight.estimate.shape.scattering import scattering_law
-from speclight.estimate.shape.tumbling import TumblingState, fit_tumbling, same_family
+from speclight.estimate.shape.tumbling import (
+    FAMILY_ANGLE_DEG,
+    FAMILY_RELATIVE,
+    TumblingState,
+    fit_tumbling,
+    same_family,
+)
+from speclight.estimate.shape.tumbling_mirror import mirror_plane, mirror_state
+from speclight.estimate.shape.tumbling_run import add_tumbling
 from speclight.target import shapes
 
 MOMENTS = np.array([0.45, 0.8, 1.0])  # principal moments / the largest
@@ -37,22 +47,37 @@ def _two_passes():
     return t_s, sun, obs
 
 
-#: The far-start recovery and the principal-axis check run the full grid search (~1 and ~4
-#: minutes on 2 cores): too long for the suite's 12-minute budget. They run where
-#: SPECLIGHT_LONG_TESTS=1 is set; bench/bench_tumbling_far.py measures the same over draws.
+#: The far-start searches and the full principal-axis check run the grid search (about a
+#: CPU minute each, ~4 for the null case): too long for the suite's 12-minute budget. They
+#: run where SPECLIGHT_LONG_TESTS=1 is set (a fast null test runs always);
+#: bench/bench_tumbling_far.py measures the search over random draws.
 LONG = pytest.mark.skipif(
     not os.environ.get("SPECLIGHT_LONG_TESTS"),
     reason="the tumbling grid search takes minutes: set SPECLIGHT_LONG_TESTS=1",
 )
 
 
-@LONG
-@pytest.mark.xfail(
-    strict=True,
-    reason="issue 27 item 3 open: the grid + continuation does not yet reach the truth's "
-    "family from this far start (BENCHMARKS.md, 'Tumbling from far starts')",
-)
-def test_torque_free_box_wing_state_recovered():
+def _angle_deg(a, b):
+    return np.degrees(np.arccos(np.clip(a @ b, -1.0, 1.0)))
+
+
+def _far_start():
+    """A start far from the truth: the attitude turned by 120 deg, the rates 60 deg off and
+    30 % slower, moments (0.3, 0.9, 1): the fit's grid and continuation must find the way."""
+    off = Rotation.from_rotvec(np.deg2rad(120.0) * _unit(np.array([1.0, -1.0, 0.5])))
+    w_off = Rotation.from_rotvec(np.deg2rad(60.0) * _unit(np.array([0.0, 1.0, 1.0]))).apply(W0)
+    return TumblingState(
+        (Rotation.from_quat(Q0, scalar_first=True) * off).as_quat(scalar_first=True),
+        0.7 * w_off,
+        np.array([0.3, 0.9, 1.0]),
+        0.0,
+    )
+
+
+@pytest.fixture(scope="module")
+def rendered_far_fit():
+    """The torque-free box-wing rendered by speclight (shadows included), fitted with no
+    prior but a far start; the truth's own best fit; the truth and its mirror state."""
     tgt = shapes.box_wing(WHITE, dish=False)
     parts = [(p.vertices_m, p.faces) for p in tgt.parts]
     t_s, sun, obs = _two_passes()
@@ -66,42 +91,80 @@ def test_torque_free_box_wing_state_recovered():
     sigma = 0.01 * np.mean(y)
     t_jd = 2459000.5 + t_s / 86400.0
     data = build_inversion_data(
-        t_jd,
-        y + sigma * rng.normal(size=y.size),
-        np.full(y.size, sigma),
-        sun,
-        obs,
-        np.repeat([0, 1], 60),
-        np.array([False, False]),
-        "tf",
-    )
+        t_jd, y + sigma * rng.normal(size=y.size), np.full(y.size, sigma), sun, obs,
+        np.repeat([0, 1], 60), np.array([False, False]), "tf",
+    )  # fmt: skip
     truth = TumblingState(Q0, W0, MOMENTS, 0.0)
-    # a start far from the truth: the attitude turned by 120 deg, the rates 60 deg off and
-    # 30 % slower, moments (0.3, 0.9, 1): the fit's grid and continuation must find the way
-    off = Rotation.from_rotvec(np.deg2rad(120.0) * _unit(np.array([1.0, -1.0, 0.5])))
-    w_off = Rotation.from_rotvec(np.deg2rad(60.0) * _unit(np.array([0.0, 1.0, 1.0]))).apply(W0)
-    far = TumblingState(
-        (Rotation.from_quat(Q0, scalar_first=True) * off).as_quat(scalar_first=True),
-        0.7 * w_off,
-        np.array([0.3, 0.9, 1.0]),
-        0.0,
-    )
+    far = _far_start()
     assert not same_family(far, truth)
     normals, areas = mesh_facets(parts)
-    fit = fit_tumbling(
-        data,
-        normals,
-        areas,
-        scattering_law("lambert"),
-        min_period_h=0.03,
-        max_period_h=0.1,
-        n_starts=0,
-        initial_states=[far],
-        t0_jd=t_jd[0],
-        rate_span=0.015,
+    law = scattering_law("lambert")
+    common = dict(min_period_h=0.03, max_period_h=0.1, n_starts=0, t0_jd=t_jd[0])
+    fit = fit_tumbling(data, normals, areas, law, initial_states=[far], rate_span=0.015, **common)
+    at_truth = fit_tumbling(
+        data, normals, areas, law, initial_states=[truth], rate_span=0.0, grid=False, **common
     )
-    assert any(same_family(fam[0], truth) for fam in fit.families)
+    mirror = mirror_state(truth, mirror_plane(sun, obs)[0])
+    return fit, at_truth, truth, mirror
+
+
+@LONG
+def test_far_start_reaches_the_truths_momentum_and_rate(rendered_far_fit):
+    """From the far start the search ends at least as low as the truth's own best fit
+    (chi-square; the convex model lacks the shadows, so that is not the truth's state), and
+    a reported family has the truth's momentum direction (or its mirror's: the passes' Sun
+    and observer directions lie within 0.6 deg rms of one plane, tumbling_mirror.py) within
+    the families' 10 deg and the rate within their 5 %; it beats a principal-axis rotation."""
+    fit, at_truth, truth, mirror = rendered_far_fit
+    assert fit.families[0][0].chi2 <= at_truth.families[0][0].chi2
+    assert any(
+        _angle_deg(f[0].momentum_direction, ref.momentum_direction) <= FAMILY_ANGLE_DEG
+        and abs(f[0].rate_rad_s / ref.rate_rad_s - 1.0) <= FAMILY_RELATIVE
+        for f in fit.families
+        for ref in (truth, mirror)
+    )
     assert fit.detected  # better than any rotation about a principal axis (F-test)
+
+
+@LONG
+def test_far_start_recovers_the_state_when_the_model_is_right():
+    """The same case and far start with light curves from the convex model itself (the
+    fitted model, no shadows; 1 % noise): the truth's family is reported and tumbling is
+    detected. Where the model is right the search reaches the state; on the rendered
+    light curves the model error moves the best fit (the xfail below)."""
+    tgt = shapes.box_wing(WHITE, dish=False)
+    normals, areas = mesh_facets([(p.vertices_m, p.faces) for p in tgt.parts])
+    t_s, sun, obs = _two_passes()
+    q, _ = torque_free_attitude(t_s, MOMENTS, Q0, W0)
+    qc = quat_conjugate(q)
+    law = scattering_law("lambert")
+    chp = np.sqrt(0.5 * (1 + np.sum(sun * obs, axis=1)))
+    y = facet_brightness(quat_rotate(qc, sun), quat_rotate(qc, obs), normals, areas, law, chp)
+    rng = np.random.default_rng(0)
+    sigma = 0.01 * np.mean(y)
+    t_jd = 2459000.5 + t_s / 86400.0
+    data = build_inversion_data(
+        t_jd, y + sigma * rng.normal(size=y.size), np.full(y.size, sigma), sun, obs,
+        np.repeat([0, 1], 60), np.array([False, False]), "tf",
+    )  # fmt: skip
+    fit = fit_tumbling(
+        data, normals, areas, law, min_period_h=0.03, max_period_h=0.1, n_starts=0,
+        initial_states=[_far_start()], t0_jd=t_jd[0], rate_span=0.015,
+    )  # fmt: skip
+    assert any(same_family(f[0], TumblingState(Q0, W0, MOMENTS, 0.0)) for f in fit.families)
+    assert fit.detected
+
+
+@LONG
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 27 item 3 open: the convex model lacks the shadows of the rendered "
+    "box-wing, and its best fit (chi2 3803 against 7497 for the truth's own) has the "
+    "smaller moment ratio 0.53 where the truth has 0.45 (3.9 sigma); BENCHMARKS.md",
+)
+def test_torque_free_box_wing_state_recovered(rendered_far_fit):
+    fit, _, truth, mirror = rendered_far_fit
+    assert any(same_family(f[0], truth) or same_family(f[0], mirror) for f in fit.families)
 
 
 @LONG
@@ -133,6 +196,42 @@ def test_principal_axis_rotation_is_not_tumbling():
     assert not fit.detected
 
 
+def test_principal_axis_rotation_is_not_tumbling_fast():
+    """The null case in seconds: a convex-model light curve of a box-wing spinning about its
+    axis of largest moment, fitted from a tumbling start near it (rates 20 deg off the axis,
+    other moments) without the grid. The torque-free fit's 4 extra parameters fit the noise
+    a little better (chi-square lower by about chi2(4)); the F-test against the best
+    principal-axis rotation must not call that tumbling (p >= 0.001)."""
+    tgt = shapes.box_wing(WHITE, dish=False)
+    normals, areas = mesh_facets([(p.vertices_m, p.faces) for p in tgt.parts])
+    t_s, sun, obs = (a[::2] for a in _two_passes())  # a point every 20 s
+    moments = MOMENTS[[1, 0, 2]]
+    w0 = np.array([0.0, 0.0, 0.035])  # about body z, the largest moment
+    q, _ = torque_free_attitude(t_s, moments, Q0, w0)
+    qc = quat_conjugate(q)
+    law = scattering_law("lambert")
+    chp = np.sqrt(0.5 * (1 + np.sum(sun * obs, axis=1)))
+    y = facet_brightness(quat_rotate(qc, sun), quat_rotate(qc, obs), normals, areas, law, chp)
+    rng = np.random.default_rng(2)
+    sigma = 0.01 * np.mean(y)
+    t_jd = 2459000.5 + t_s / 86400.0
+    data = build_inversion_data(
+        t_jd, y + sigma * rng.normal(size=y.size), np.full(y.size, sigma), sun, obs,
+        np.repeat([0, 1], 30), np.array([False, False]), "pa",
+    )  # fmt: skip
+    tilt = Rotation.from_rotvec(np.deg2rad(20.0) * np.array([1.0, 0.0, 0.0]))
+    start = TumblingState(Q0, tilt.apply(w0), np.array([0.6, 0.9, 1.0]), 0.0)
+    fit = fit_tumbling(
+        data, normals, areas, law, min_period_h=0.03, max_period_h=0.1, n_starts=0,
+        initial_states=[start], t0_jd=t_jd[0], rate_span=0.0, grid=False,
+    )  # fmt: skip
+    assert not fit.detected
+    ds = add_tumbling(xr.Dataset(), fit)  # SHAPE.nc's variables, the std ones finite
+    assert ds.attrs["tumbling_detected"] == 0
+    assert np.all(np.isfinite(ds.tumbling_rate_std)) and np.all(ds.tumbling_rate_std > 0)
+    assert np.all(np.isfinite(ds.tumbling_moment_ratio_std))
+
+
 def test_body_symmetry_keeps_the_family():
     """A box-wing without its dish is symmetric under a half turn about its x axis: the
     states q0 and q0 R_x(180 deg) (rates turned with it) give the same light curve and are
@@ -161,3 +260,35 @@ def test_body_symmetry_keeps_the_family():
             facet_brightness(quat_rotate(qc, sun), quat_rotate(qc, obs), normals, areas, law, chp)
         )
     assert np.allclose(curves[0], curves[1], rtol=1e-9, atol=1e-12 * np.max(curves[0]))
+
+
+def test_mirror_state_gives_the_same_light_curve_in_a_plane():
+    """The mirror ambiguity (tumbling_mirror.py): with every Sun and observer direction in
+    one plane, the state reflected through it (attitude -M R, the same body rates and
+    moments) shows the centrally symmetric box-wing's facets to antipodal directions, which
+    a Lambert law lights alike: the same light curve to round-off, and the momentum -M H
+    (an axial vector under a reflection)."""
+    tgt = shapes.box_wing(WHITE, dish=False)
+    normals, areas = mesh_facets([(p.vertices_m, p.faces) for p in tgt.parts])
+    t_s, sun, obs = _two_passes()
+    tilt = Rotation.from_rotvec([0.3, -0.2, 0.1])  # the plane: not a coordinate plane
+    sun, obs = tilt.apply(sun * [1, 1, 0]), tilt.apply(obs * [1, 1, 0])
+    sun, obs = _unit(sun), _unit(obs)
+    normal, rms_sine = mirror_plane(sun, obs)
+    assert rms_sine < 1e-12
+    assert abs(abs(normal @ tilt.apply([0.0, 0.0, 1.0])) - 1.0) < 1e-12
+    truth = TumblingState(Q0, W0, MOMENTS, 0.0)
+    mirror = mirror_state(truth, normal)
+    reflect = np.eye(3) - 2 * np.outer(normal, normal)
+    assert np.allclose(mirror.momentum_direction, -reflect @ truth.momentum_direction, atol=1e-12)
+    law = scattering_law("lambert")
+    chp = np.sqrt(0.5 * (1 + np.sum(sun * obs, axis=1)))
+    curves = []
+    for s in (truth, mirror):
+        q, _ = torque_free_attitude(t_s, s.moments, s.q0, s.omega0_body_rad_s)
+        qc = quat_conjugate(q)
+        curves.append(
+            facet_brightness(quat_rotate(qc, sun), quat_rotate(qc, obs), normals, areas, law, chp)
+        )
+    assert np.allclose(curves[0], curves[1], rtol=1e-9, atol=1e-12 * np.max(curves[0]))
+    assert not same_family(truth, mirror)  # a different state, not a body symmetry

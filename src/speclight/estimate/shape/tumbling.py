@@ -25,7 +25,7 @@ moment ratios (within :data:`FAMILY_RELATIVE`); every family is reported.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -39,14 +39,16 @@ from speclight.estimate.shape.convex_model import facet_brightness, relative_res
 from speclight.estimate.shape.ecliptic import angular_distance_deg
 from speclight.estimate.shape.inversion_data import InversionData
 from speclight.estimate.shape.scattering import ScatteringLaw
+from speclight.estimate.shape.tumbling_mirror import mirror_plane, mirror_state
 from speclight.estimate.shape.tumbling_principal import ALPHA as PRINCIPAL_ALPHA
-from speclight.estimate.shape.tumbling_principal import principal_axis_test
+from speclight.estimate.shape.tumbling_principal import lag1_correlation, principal_axis_test
 from speclight.estimate.shape.tumbling_search import (
     N_CARRY,
     grid_starts,
     moments_from_u,
     window_schedule,
 )
+from speclight.estimate.shape.tumbling_uncertainty import rate_and_ratio_std
 
 F64 = NDArray[np.float64]
 N_STARTS = 32
@@ -78,6 +80,9 @@ class TumblingState:
         Sum of squared residuals.
     scale
         Factor on the areas (calibrated data; 1 for relative).
+    std
+        (3,) standard deviations of the rate [rad/s] and of the two moment ratios
+        (:mod:`.tumbling_uncertainty`); NaN where not fitted.
     """
 
     q0: F64
@@ -85,6 +90,7 @@ class TumblingState:
     moments: F64
     chi2: float
     scale: float = 1.0
+    std: F64 = field(default_factory=lambda: np.full(3, np.nan))
 
     @property
     def momentum_direction(self) -> F64:
@@ -175,7 +181,9 @@ def fit_tumbling(
     rotation phase drifts by ``T / P`` turns per unit of relative rate error, so each starts
     at rate scales ``1 + j dc``, ``dc =`` :data:`PHASE_DRIFT` ``P / T``, ``|j dc| <=``
     :data:`RATE_SPAN` (a torque-free motion with its rates scaled by ``c`` is the same
-    motion ``c`` times faster), and the lowest of all is kept as in stage 1.
+    motion ``c`` times faster), and the lowest of all is kept as in stage 1. Last, the
+    mirror image of each kept family's best (at most :data:`N_SEEDS`;
+    :mod:`.tumbling_mirror`) is fitted to all curves and joins the solutions.
 
     ``rate_span``: the relative rate error covered in stage 2 (default :data:`RATE_SPAN`).
     ``initial_states`` (at ``t0_jd``, default the seed curve's middle) are tried before the
@@ -239,6 +247,14 @@ def _fit_tumbling(
             for j in np.arange(-np.floor(rate_span / dc), np.floor(rate_span / dc) + 1):
                 x_next.append(_state_vector(sol, 1.0 + j * dc))
         final = _fit_all(prob, x_next)
+    # each family's mirror image (tumbling_mirror.py) fitted too: a start the search
+    # rarely reaches, as good as the family where the geometry is nearly coplanar
+    normal, _ = mirror_plane(data.sun_ecliptic, data.observer_ecliptic)
+    mirrors = [mirror_state(f[0], normal) for f in _families(_within(final, prob))]
+    final = sorted(
+        final + _fit_all(prob, [_state_vector(m, 1.0) for m in mirrors[:N_SEEDS]]),
+        key=lambda s: s.chi2,
+    )
     kept = _within(final, prob)
     n_par = 9 if prob.calibrated else 8
     chi_pa, p = principal_axis_test(prob.residuals, _state_vector(kept[0], 1.0)[:n_par], n_par)
@@ -324,15 +340,19 @@ def _fit_all(
             max_nfev=max_evaluations,
         )
         q0, w0, moments, scale = prob.state(np.append(res.x, 0.0)[:9])
-        out.append(TumblingState(q0, w0, moments, float(2.0 * res.cost), scale))
+        std = rate_and_ratio_std(res.x, res.jac, res.fun)
+        out.append(TumblingState(q0, w0, moments, float(2.0 * res.cost), scale, std))
     out.sort(key=lambda s: s.chi2)
     return out
 
 
 def _within(states: list[TumblingState], prob: _Problem) -> list[TumblingState]:
-    """The states within ``chi2_min + delta s^2`` (module doc)."""
+    """The states within ``chi2_min + delta s^2`` (module doc), ``s^2`` the best's
+    residual variance times ``(1 + rho) / (1 - rho)``, ``rho`` its residuals' lag-1
+    correlation (model error: fewer independent points, as in :mod:`.tumbling_principal`)."""
     n_par = 9 if prob.calibrated else 8
-    s2 = states[0].chi2 / max(prob.data.n_points - n_par, 1)
+    rho = max(lag1_correlation(prob.residuals(_state_vector(states[0], 1.0)[:n_par])), 0.0)
+    s2 = states[0].chi2 / max(prob.data.n_points - n_par, 1) * (1 + rho) / (1 - rho)
     threshold = states[0].chi2 + float(stats.chi2.ppf(0.99, n_par)) * s2
     return [s for s in states if s.chi2 <= threshold]
 

@@ -27,7 +27,8 @@ F64 = NDArray[np.float64]
 ALPHA = 1e-3
 
 
-def _lag1(r: F64) -> float:
+def lag1_correlation(r: F64) -> float:
+    """Lag-1 correlation of residuals ``r`` (0 when all vanish; at most 0.99)."""
     den = float(np.sum(r**2))
     return min(float(np.sum(r[1:] * r[:-1])) / den, 0.99) if den > 0 else 0.0
 
@@ -66,5 +67,5 @@ def principal_axis_test(
         fit = least_squares(pa, x0, method="trf", x_scale="jac", max_nfev=200)
         chi_pa = min(chi_pa, float(2.0 * fit.cost))
     p_pa = 4 + n_par - 8
-    _, p = nested_f_test(chi_pa, p_pa, chi_best, n_par, r_best.size, _lag1(r_best))
+    _, p = nested_f_test(chi_pa, p_pa, chi_best, n_par, r_best.size, lag1_correlation(r_best))
     return chi_pa, 1.0 if np.isnan(p) else p

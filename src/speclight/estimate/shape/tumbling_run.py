@@ -5,7 +5,9 @@ The EGI is the scenario's target mesh (:func:`.egi.mesh_facets`: faces as the re
 them, without the shadows parts cast on each other); the law is the run's. Variables added
 to SHAPE.nc along ``family`` (lowest chi-square first): ``tumbling_chi2``,
 ``tumbling_momentum_direction(family, xyz)`` (ecliptic J2000), ``tumbling_rate`` [rad s-1],
-``tumbling_moment_ratio(family, ratio)``, ``tumbling_members``, the best state's
+``tumbling_moment_ratio(family, ratio)``, their standard deviations ``tumbling_rate_std``
+and ``tumbling_moment_ratio_std`` (:mod:`.tumbling_uncertainty`: linearised, residual
+correlation counted), ``tumbling_members``, the best state's
 ``tumbling_q0(family, quaternion)`` and ``tumbling_omega0(family, xyz)`` [rad s-1] at
 ``tumbling_t0_jd``.
 """
@@ -116,6 +118,16 @@ def add_tumbling(ds: xr.Dataset, fit: TumblingFit) -> xr.Dataset:
             ("family", "ratio"),
             [s.moment_ratios for s in best],
             {"units": "1", "long_name": "smaller principal moments over the largest, sorted"},
+        ),
+        "tumbling_rate_std": (
+            ("family",),
+            [s.std[0] for s in best],
+            {"units": "rad s-1", "long_name": "standard deviation of tumbling_rate"},
+        ),
+        "tumbling_moment_ratio_std": (
+            ("family", "ratio"),
+            [s.std[1:] for s in best],
+            {"units": "1", "long_name": "standard deviation of tumbling_moment_ratio"},
         ),
         "tumbling_q0": (
             ("family", "quaternion"),
