@@ -43,7 +43,11 @@ def draw(rng: np.random.Generator) -> dict:
     return case
 
 
-def light_curve(case: dict, rng: np.random.Generator, path: Path) -> None:
+def light_curve(
+    case: dict, rng: np.random.Generator, path: Path, noise: np.random.Generator | None = None
+) -> None:
+    """Write the CSV of ``case``: its trend, light curve and band factors from ``rng``,
+    the noise from ``noise`` (default ``rng``, drawn last)."""
     t = np.arange(0.0, case["span"], case["dt"])
     x = t / t[-1]
     c = rng.normal(0, 1, 3)
@@ -61,7 +65,7 @@ def light_curve(case: dict, rng: np.random.Generator, path: Path) -> None:
     mag = (trend + signal)[:, None] * rng.uniform(0.8, 1.2, nb) + rng.uniform(0, 0.5, nb)
     rate = 1e4 * 10 ** (-0.4 * mag)
     sigma = rate / case["snr"]
-    rate = rate + rng.normal(0, sigma)
+    rate = rate + (rng if noise is None else noise).normal(0, sigma)
     names = ["B", "G", "R"][:nb]
     start = np.datetime64("2021-03-01T20:00:00", "ms")
     lines = ["time," + ",".join(names) + "," + ",".join(f"{n}_sigma" for n in names)]
@@ -87,7 +91,8 @@ def main() -> None:
             path = Path(tmp) / f"d{i}.csv"
             light_curve(case, rng, path)
             t0 = time.perf_counter()
-            out = estimate_period(path, if_symmetric="keep").to_json()
+            result = estimate_period(path, if_symmetric="keep")
+            out = result.to_json()
             seconds.append(time.perf_counter() - t0)
             truth = case["period"]
             if case["null"]:
@@ -102,8 +107,11 @@ def main() -> None:
                 recovered += ok
                 if ok:
                     pulls.append((p - truth) / s)
+                pull = f"pull {(p - truth) / s:+6.2f}" if ok else "MISS"
                 what = (f"P {truth:8.3f} -> {p if p is None else round(p, 4)} +- "
-                        f"{s if s is None else round(s, 4)} {'ok' if ok else 'MISS'}")  # fmt: skip
+                        f"{s if s is None else round(s, 4)} {pull} (factor "
+                        f"{result.peak.noise_factor:.2f}, harmonics {len(result.peak.orders)}, "
+                        f"trend degree {result.peak.trend_degree})")  # fmt: skip
             print(f"{i:3d} span {case['span']:5.0f} dt {case['dt']:.2f} B {case['bands']} "
                   f"SNR {case['snr']:5.0f} trend {case['trend']:.2f} K {case['harmonics']} {what}",
                   flush=True)  # fmt: skip

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from speclight.estimate.period.peak_refinement import refine_peak
 from speclight.estimate.period.period_decision import rotation_period
 from speclight.estimate.period.period_fap import bootstrap_maxima
 from speclight.estimate.period.periodogram import (
@@ -14,7 +15,6 @@ from speclight.estimate.period.periodogram import (
     harmonic_chi2,
     local_maxima,
     multiband_power,
-    refine_peak,
 )
 from speclight.estimate.period.synodic import sidereal_period
 
