@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from speclight.estimate.period.peak_refinement import refine_peak
+from speclight.estimate.period.peak_refinement import refine_peak, refine_with_model
 from speclight.estimate.period.period_decision import rotation_period
 from speclight.estimate.period.period_fap import bootstrap_maxima
 from speclight.estimate.period.periodogram import (
@@ -82,6 +82,33 @@ def test_frequency_std_matches_the_cramer_rao_bound_of_a_sinusoid():
     expected = np.sqrt(6 / n) * sigma / (np.pi * amp * span)
     assert peak.frequency_std_hz == pytest.approx(expected, rel=0.1)
     assert abs(peak.frequency_hz - 1 / 23.0) < 4 * expected
+
+
+def test_refined_model_gives_the_cramer_rao_bound_with_harmonics_and_a_bump():
+    # Four harmonics A_k = 0.3/k and a slow change no cubic removes (a Gaussian bump of 0.5
+    # mag, a tenth of the pass wide) in white noise sigma: the bound of the test above summed
+    # over the harmonics' information, sigma_f = sqrt(6 / N) sigma / (pi T sqrt(sum k^2
+    # A_k^2)) (Kay 1993, Fundamentals of Statistical Signal Processing I, ch. 3: the Fisher
+    # information of independent harmonics adds). The periodogram's K = 2 harmonics and cubic
+    # leave the higher harmonics and the bump in the residuals (reduced chi2 in the hundreds):
+    # their std is many times the bound. The model the light curve needs must reach the
+    # bound to the noise of its own estimate (~3 %) plus the trend's few columns' coupling.
+    rng = np.random.default_rng(11)
+    n, span, period, sigma = 1000, 600.0, 23.0, 0.01
+    t = np.linspace(0, span, n)
+    amp = 0.3 / np.arange(1, 5)
+    x = 2 * np.pi * t / period
+    y = sum(a * np.cos(k * x + rng.uniform(0, 2 * np.pi)) for k, a in enumerate(amp, 1))
+    y = y + 0.5 * np.exp(-(((t / span - 0.4) / 0.1) ** 2)) + 0.2 * (t / span) ** 3
+    s = _series(t, (y + rng.normal(0, sigma, n))[:, None], sigma)
+    bound = np.sqrt(6 / n) * sigma / (np.pi * span * np.sqrt(np.sum((np.arange(1, 5) * amp) ** 2)))
+    start = 1 / period + 0.07 / span  # within the periodogram grid's step 1/(5 span)
+    plain = refine_peak(s, start, [1, 2])
+    assert plain.frequency_std_hz > 5 * bound  # the misfit the test is about
+    peak = refine_with_model(s, start, 2)
+    assert peak.orders == [1, 2, 3, 4] and peak.trend_degree > 3
+    assert peak.frequency_std_hz == pytest.approx(bound, rel=0.15)
+    assert abs(peak.frequency_hz - 1 / period) < 4 * bound
 
 
 def _two_fold(odd_amplitude, seed=2):
