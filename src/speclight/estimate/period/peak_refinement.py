@@ -30,11 +30,14 @@ from speclight.estimate.period.periodogram import (
 
 #: Most harmonics of a refinement's model: a light curve with glints has many.
 MAX_HARMONICS = 24
-#: Highest degree of the trend of a refinement's model. The trend's degree is also kept
-#: below the number of cycles in the span: a Legendre polynomial of degree ``d`` oscillates
-#: about ``d / pi`` times per span at mid-pass, so it stays below a third of the rotation
-#: frequency and does not fit the light curve itself.
+#: Highest degree of the trend of a refinement's model. The degree is also kept below
+#: ``pi`` times the cycles in the span: a Legendre polynomial of degree ``d`` oscillates about
+#: ``d / pi`` times per span at mid-pass, so the trend stays slower than the rotation. Where
+#: the trend and the harmonics are alike all the same, the curvature of the profile
+#: chi-square (all linear terms refitted at each frequency) widens the standard deviation.
 MAX_TREND_DEGREE = 20
+#: Passes of model choice and refinement in :func:`refine_with_model`.
+MODEL_PASSES = 3
 
 
 @dataclass
@@ -262,17 +265,23 @@ def trend_degree_needed(
     series: BandSeries, frequency_hz: float, orders: list[int], alpha: float = ALPHA
 ) -> int:
     """Degree of the trend per band beside the harmonics ``orders``: from
-    :data:`.periodogram.TREND_DEGREE`, grown while the next degree is significant (F-test at
-    ``alpha``), at most :data:`MAX_TREND_DEGREE` and below the cycles in the span."""
-    cap = min(int(series.span_s * frequency_hz) - 1, MAX_TREND_DEGREE)
+    :data:`.periodogram.TREND_DEGREE`, grown while the next degree, or the next two together
+    (a slow change symmetric about mid-pass has only even Legendre terms), is significant
+    (F-test at ``alpha``), at most :data:`MAX_TREND_DEGREE` and below ``pi`` times the
+    cycles in the span."""
+    cap = min(int(np.ceil(np.pi * series.span_s * frequency_hz)) - 1, MAX_TREND_DEGREE)
     d = TREND_DEGREE
     chi, npar, _ = harmonic_chi2(series, frequency_hz, orders, None, d)
-    while d < cap:
-        chi2, npar2, _ = harmonic_chi2(series, frequency_hz, orders, None, d + 1)
-        if not nested_f_test(chi, npar, chi2, npar2, series.t_s.size)[1] < alpha:
-            break
-        d, chi, npar = d + 1, chi2, npar2
-    return d
+    while True:
+        for step in (1, 2):  # a change symmetric about mid-pass needs only even degrees
+            if d + step > cap:
+                return d
+            chi2, npar2, _ = harmonic_chi2(series, frequency_hz, orders, None, d + step)
+            if nested_f_test(chi, npar, chi2, npar2, series.t_s.size)[1] < alpha:
+                d, chi, npar = d + step, chi2, npar2
+                break
+        else:
+            return d
 
 
 def refine_with_model(
@@ -283,7 +292,9 @@ def refine_with_model(
 ) -> Peak:
     """The peak near ``frequency_hz`` refined (:func:`refine_peak`) with the ``harmonics``
     of the periodogram and a cubic trend, then again with the model the light curve needs
-    at that frequency (:func:`harmonics_needed`, :func:`trend_degree_needed`).
+    at that frequency (:func:`harmonics_needed`, :func:`trend_degree_needed`), up to
+    :data:`MODEL_PASSES` times while the model changes (a better model moves the frequency,
+    and the model's terms are tested at the frequency found).
 
     Parameters
     ----------
@@ -296,10 +307,13 @@ def refine_with_model(
     within
         The searched frequency range (low, high) [Hz], or None.
     """
-    orders = list(range(1, harmonics + 1))
+    orders, degree = list(range(1, harmonics + 1)), TREND_DEGREE
     peak = refine_peak(series, frequency_hz, orders, within=within)
-    more = harmonics_needed(series, peak.frequency_hz, harmonics)
-    degree = trend_degree_needed(series, peak.frequency_hz, more)
-    if len(more) == len(orders) and degree == TREND_DEGREE:
-        return peak
-    return refine_peak(series, peak.frequency_hz, more, trend_degree=degree, within=within)
+    for _ in range(MODEL_PASSES):
+        more = harmonics_needed(series, peak.frequency_hz, harmonics)
+        more_degree = trend_degree_needed(series, peak.frequency_hz, more)
+        if more == orders and more_degree == degree:
+            break
+        orders, degree = more, more_degree
+        peak = refine_peak(series, peak.frequency_hz, orders, trend_degree=degree, within=within)
+    return peak
