@@ -23,8 +23,7 @@ from speclight.estimate.period.periodogram import (
     F64,
     TREND_DEGREE,
     BandSeries,
-    _with_trend,
-    design_matrix,
+    band_design,
     harmonic_chi2,
 )
 
@@ -57,8 +56,10 @@ class Peak:
     noise_factor
         ``frequency_std_hz / white_std_hz``: the square root of the reduced chi-square
         times the coloured-noise factor (:func:`refine_peak`).
-    orders, trend_degree
-        The model: its harmonics and the degree of its trend per band.
+    orders, trend_degree, amplitude_change
+        The model: its harmonics, the degree of its trend per band, and whether the
+        harmonics' amplitude changes linearly over the pass
+        (:func:`.periodogram.band_design`).
     """
 
     frequency_hz: float
@@ -70,6 +71,7 @@ class Peak:
     noise_factor: float = 1.0
     orders: list[int] = field(default_factory=lambda: [1])
     trend_degree: int = TREND_DEGREE
+    amplitude_change: bool = False
 
 
 def refine_peak(
@@ -79,6 +81,7 @@ def refine_peak(
     phase_rad: F64 | None = None,
     trend_degree: int = TREND_DEGREE,
     within: tuple[float, float] | None = None,
+    amplitude_change: bool = False,
 ) -> Peak:
     """Best frequency near ``frequency_hz`` and its standard deviation.
 
@@ -113,7 +116,7 @@ def refine_peak(
     from scipy.optimize import minimize_scalar
 
     def chi(f: float) -> float:
-        return harmonic_chi2(series, f, orders, phase_rad, trend_degree)[0]
+        return harmonic_chi2(series, f, orders, phase_rad, trend_degree, amplitude_change)[0]
 
     half = 0.1 / series.span_s
     lo, hi = frequency_hz - half, frequency_hz + half
@@ -121,7 +124,9 @@ def refine_peak(
         lo, hi = max(lo, float(within[0])), min(hi, float(within[1]))
     found = minimize_scalar(chi, bounds=(lo, hi), method="bounded", options={"xatol": 1e-6 * half})
     best = float(found.x)
-    chi2, npar, coefs = harmonic_chi2(series, best, orders, phase_rad, trend_degree)
+    chi2, npar, coefs = harmonic_chi2(
+        series, best, orders, phase_rad, trend_degree, amplitude_change
+    )
     dof = max(series.t_s.size - npar - 1, 1)
     step, std = half / 10, float("nan")
     for _ in range(2):
@@ -130,11 +135,16 @@ def refine_peak(
             break
         std = float(np.sqrt((chi2 / dof) / c2))
         step = min(2 * std, half)
-    rho, residuals = residual_lag1_correlation(series, best, orders, coefs, phase_rad, trend_degree)
+    rho, residuals = residual_lag1_correlation(
+        series, best, orders, coefs, phase_rad, trend_degree, amplitude_change
+    )
     inflation = red_noise_inflation(series, best, orders, coefs, residuals)
     white = std / np.sqrt(chi2 / dof)
     factor = float(np.sqrt(chi2 / dof) * inflation)
-    return Peak(best, std * inflation, chi2, dof, rho, white, factor, list(orders), trend_degree)
+    return Peak(
+        best, std * inflation, chi2, dof, rho, white, factor, list(orders), trend_degree,
+        amplitude_change,
+    )  # fmt: skip
 
 
 def red_noise_inflation(
@@ -205,6 +215,7 @@ def residual_lag1_correlation(
     coefs: list[F64],
     phase_rad: F64 | None = None,
     trend_degree: int = 0,
+    amplitude_change: bool = False,
 ) -> tuple[float, F64]:
     """Lag-1 autocorrelation of the normalised residuals, consecutive points of each band
     pooled (``sum r_i r_(i+1) / sum r_i^2``, capped at 0.99), and the normalised residuals
@@ -224,15 +235,14 @@ def residual_lag1_correlation(
         A phase per point added to the harmonics' argument [rad], or None.
     trend_degree
         Degree of the polynomial trend in time per band.
+    amplitude_change
+        Whether the model has the amplitude-change column (:func:`.periodogram.band_design`).
     """
     num = den = 0.0
     out = np.zeros(series.y.size)
     for b, beta in enumerate(coefs):
         m = series.band == b
-        ph = None if phase_rad is None else phase_rad[m]
-        x = _with_trend(
-            series, m, design_matrix(series.t_s[m], frequency_hz, orders, ph), trend_degree
-        )
+        x = band_design(series, m, frequency_hz, orders, phase_rad, trend_degree, amplitude_change)
         order = np.argsort(series.t_s[m])
         res = (series.y[m] - x @ beta) / series.dy[m]
         out[m] = res
@@ -294,7 +304,10 @@ def refine_with_model(
     of the periodogram and a cubic trend, then again with the model the light curve needs
     at that frequency (:func:`harmonics_needed`, :func:`trend_degree_needed`), up to
     :data:`MODEL_PASSES` times while the model changes (a better model moves the frequency,
-    and the model's terms are tested at the frequency found).
+    and the model's terms are tested at the frequency found), all within the periodogram's
+    peak, ``+-0.5 / span`` of ``frequency_hz``. A model whose chi-square has no minimum of
+    positive curvature there
+    is not taken (the last pass's peak is kept).
 
     Parameters
     ----------
@@ -307,13 +320,37 @@ def refine_with_model(
     within
         The searched frequency range (low, high) [Hz], or None.
     """
-    orders, degree = list(range(1, harmonics + 1)), TREND_DEGREE
-    peak = refine_peak(series, frequency_hz, orders, within=within)
+    half = 0.5 / series.span_s  # the passes stay within the periodogram's peak
+    lo, hi = frequency_hz - half, frequency_hz + half
+    if within is not None:
+        lo, hi = max(lo, float(within[0])), min(hi, float(within[1]))
+    within = (lo, hi)
+    model: tuple[list[int], int, bool] = (list(range(1, harmonics + 1)), TREND_DEGREE, False)
+    peak = refine_peak(series, frequency_hz, model[0], within=within)
     for _ in range(MODEL_PASSES):
-        more = harmonics_needed(series, peak.frequency_hz, harmonics)
-        more_degree = trend_degree_needed(series, peak.frequency_hz, more)
-        if more == orders and more_degree == degree:
+        f = peak.frequency_hz
+        orders = harmonics_needed(series, f, harmonics)
+        degree = trend_degree_needed(series, f, orders)
+        chosen = (orders, degree, amplitude_change_needed(series, f, orders, degree))
+        if chosen == model:
             break
-        orders, degree = more, more_degree
-        peak = refine_peak(series, peak.frequency_hz, orders, trend_degree=degree, within=within)
+        model = chosen
+        better = refine_peak(
+            series, f, orders, trend_degree=degree, within=within, amplitude_change=chosen[2]
+        )
+        if not np.isfinite(better.frequency_std_hz):  # no minimum with a positive curvature
+            break
+        peak = better
     return peak
+
+
+def amplitude_change_needed(
+    series: BandSeries, frequency_hz: float, orders: list[int], trend_degree: int,
+    alpha: float = ALPHA,
+) -> bool:  # fmt: skip
+    """Whether the harmonics' amplitude changing linearly over the pass
+    (:func:`.periodogram.band_design`, one parameter per band) is significant beside the
+    harmonics ``orders`` and the trend (F-test at ``alpha``)."""
+    chi, npar, _ = harmonic_chi2(series, frequency_hz, orders, None, trend_degree)
+    chi2, npar2, _ = harmonic_chi2(series, frequency_hz, orders, None, trend_degree, True)
+    return bool(nested_f_test(chi, npar, chi2, npar2, series.t_s.size)[1] < alpha)

@@ -157,12 +157,40 @@ def weighted_lstsq(x: F64, y: F64, w: F64) -> F64:
     return np.asarray(beta, dtype=np.float64)
 
 
+def band_design(
+    series: BandSeries,
+    m: NDArray[np.bool_],
+    frequency_hz: float,
+    orders: list[int],
+    phase_rad: F64 | None = None,
+    trend_degree: int = 0,
+    amplitude_change: bool = False,
+) -> F64:
+    """Design matrix of the points ``m`` (one band): :func:`design_matrix` with the trend
+    (:func:`_with_trend`) and, with ``amplitude_change``, one more column ``u h(t)``: the
+    band's fitted harmonic curve ``h`` (a first fit without it) times the time ``u`` scaled
+    to -1..1, a light curve whose amplitude changes linearly over the pass (as with the
+    phase angle, Zappala et al. 1990, A&A 231, 548). It is orthogonal to a shift of the
+    frequency (which moves ``h`` by its quadrature ``t h'``), so it takes no information from
+    the frequency."""
+    ph = None if phase_rad is None else phase_rad[m]
+    x = _with_trend(series, m, design_matrix(series.t_s[m], frequency_hz, orders, ph), trend_degree)
+    if not amplitude_change:
+        return x
+    beta = weighted_lstsq(x, series.y[m], 1.0 / series.dy[m])
+    k2 = 2 * len(orders)
+    h = x[:, 1 : 1 + k2] @ beta[1 : 1 + k2]
+    u = 2 * (series.t_s[m] - series.t_s.min()) / max(series.span_s, 1e-12) - 1
+    return np.hstack([x, (u * h)[:, None]])
+
+
 def harmonic_chi2(
     series: BandSeries,
     frequency_hz: float,
     orders: list[int],
     phase_rad: F64 | None = None,
     trend_degree: int = 0,
+    amplitude_change: bool = False,
 ) -> tuple[float, int, list[F64]]:
     """Weighted least-squares fit of the harmonics ``orders`` of ``frequency_hz`` per band,
     with a polynomial in time per band beside the constant (the coefficients of the
@@ -181,6 +209,8 @@ def harmonic_chi2(
         :func:`design_matrix`), or None.
     trend_degree
         Degree of the polynomial trend in time per band (0: the constant alone).
+    amplitude_change
+        Let the harmonics' amplitude change linearly over the pass (:func:`band_design`).
 
     Returns
     -------
@@ -195,10 +225,7 @@ def harmonic_chi2(
     for b in range(series.n_bands):
         m = series.band == b
         w = 1.0 / series.dy[m]
-        ph = None if phase_rad is None else phase_rad[m]
-        x = _with_trend(
-            series, m, design_matrix(series.t_s[m], frequency_hz, orders, ph), trend_degree
-        )
+        x = band_design(series, m, frequency_hz, orders, phase_rad, trend_degree, amplitude_change)
         beta = weighted_lstsq(x, series.y[m], w)
         chi2 += float(np.sum(((series.y[m] - x @ beta) * w) ** 2))
         npar += x.shape[1]
