@@ -4,8 +4,9 @@ Reference: the scenario's own spin period (120 s). Under coaxial lasers the phas
 and the phase-angle bisector is the observer direction, so the light curve is a function of
 the observer's body-frame direction alone and the correction in the bisector's frame
 (Harris et al. 1984) holds by construction: the plain periodogram sees the synodic period,
-about 1 % (over 3 of its statistical sigmas) off on this pass, and ``auto`` must give the rotation period within 1 %
-and within 4 of its standard deviations (what the issue asks of a box-wing from one pass).
+about 1 % (over 3 of its statistical sigmas) off on this pass, and ``auto`` must give the
+rotation period within 1 % and within 4 of its standard deviations (what the issue asks of a
+box-wing from one pass).
 """
 
 import numpy as np
