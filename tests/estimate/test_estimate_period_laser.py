@@ -4,8 +4,9 @@ Reference: the scenario's own spin period (120 s). Under coaxial lasers the phas
 and the phase-angle bisector is the observer direction, so the light curve is a function of
 the observer's body-frame direction alone and the correction in the bisector's frame
 (Harris et al. 1984) holds by construction: the plain periodogram sees the synodic period,
-off by more than 1 % on this pass, and ``auto`` must give the rotation period within 1 %
-and within 4 of its standard deviations (what the issue asks of a box-wing from one pass).
+about 1 % (over 3 of its statistical sigmas) off on this pass, and ``auto`` must give the
+rotation period within 1 % and within 4 of its standard deviations (what the issue asks of a
+box-wing from one pass).
 """
 
 import numpy as np
@@ -36,7 +37,8 @@ def test_laser_pass_rotation_period_with_the_synodic_correction(laser_pass):
     plain = estimate_period(laser_pass, source="laser", synodic="report", draws=2)
     auto = estimate_period(laser_pass, source="laser", draws=2)
     assert plain.synodic is not None and not plain.synodic.applied
-    assert abs(plain.period_s / TRUE_PERIOD_S - 1) > 0.01  # the synodic effect is there
+    # the synodic effect is there: 118.90 s, 4.4 of its statistical sigmas (0.25 s) off
+    assert abs(plain.period_s - TRUE_PERIOD_S) > 3 * plain.statistical_std_s
     assert auto.synodic is not None and auto.synodic.applied
     assert abs(auto.period_s / TRUE_PERIOD_S - 1) < 0.01
     assert abs(auto.period_s - TRUE_PERIOD_S) < 4 * auto.period_std_s

@@ -9,9 +9,10 @@ import numpy as np
 
 from speclight.estimate.period.analytic_fap import AnalyticFap
 from speclight.estimate.period.outliers import Outliers
+from speclight.estimate.period.peak_refinement import Peak
 from speclight.estimate.period.period_decision import RotationDecision
 from speclight.estimate.period.period_fap import BootstrapMaxima
-from speclight.estimate.period.periodogram import F64, BandSeries, Peak
+from speclight.estimate.period.periodogram import F64, BandSeries
 from speclight.estimate.period.synodic import SynodicCorrection
 from speclight.estimate.period.two_frequencies import TumblingTest
 

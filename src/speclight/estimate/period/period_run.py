@@ -41,6 +41,7 @@ from speclight.errors import InputError
 from speclight.estimate.inputs.measured import bin_light_curve, read_measured
 from speclight.estimate.period.analytic_fap import AnalyticFap, analytic_fap
 from speclight.estimate.period.outliers import Outliers, find_outliers, without
+from speclight.estimate.period.peak_refinement import Peak, refine_with_model
 from speclight.estimate.period.period_decision import ALPHA, IfSymmetric, rotation_period
 from speclight.estimate.period.period_fap import DRAWS, bootstrap_maxima
 from speclight.estimate.period.period_inputs import magnitude_series
@@ -54,11 +55,9 @@ from speclight.estimate.period.period_result import PeriodResult
 from speclight.estimate.period.periodogram import (
     F64,
     BandSeries,
-    Peak,
     frequency_grid,
     local_maxima,
     multiband_power,
-    refine_peak,
 )
 from speclight.estimate.period.synodic import sidereal_period
 from speclight.estimate.period.two_frequencies import tumbling_test
@@ -97,8 +96,7 @@ def _search(
         )
     top = local_maxima(np.where(np.isfinite(power), power, -np.inf), N_CANDIDATES)
     candidates = [(float(1 / freq[k]), float(power[k])) for k in top]
-    orders = list(range(1, harmonics + 1))
-    peak = refine_peak(series, float(freq[top[0]]), orders, within=(freq[0], freq[-1]))
+    peak = refine_with_model(series, float(freq[top[0]]), harmonics, within=(freq[0], freq[-1]))
     return power, candidates, peak, bool(top[0] == 0)
 
 

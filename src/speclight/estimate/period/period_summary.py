@@ -77,12 +77,17 @@ def summary(r: PeriodResult) -> dict[str, Any]:
             "multi-band Lomb-Scargle (astropy LombScargle per band, nterms = "
             f"{r.harmonics}, chi2-weighted sum; VanderPlas & Ivezic 2015) on magnitudes "
             f"detrended per band and pass; {_fap_method(r)}; period_std_s from the "
-            "curvature of chi2(f) at its minimum (harmonics and a cubic trend per band), "
+            "curvature of chi2(f) at its minimum (the harmonics and the trend per band the "
+            "light curve needs, F-tests: refined_harmonics, refined_trend_degree, "
+            "refined_amplitude_change), "
             "delta chi2 = 1 after scaling by the reduced chi2, times the coloured-noise "
             "factor sqrt(sum w_k / sum (w_k / R_k)) (Kay 1993 ch. 3; never below 1), and "
             "where the synodic correction is not applied the synodic term bound/sqrt(3) in "
             f"quadrature; residuals' lag-1 correlation rho = {r.peak.residual_correlation:.3f}"
         ),
+        "refined_harmonics": list(r.peak.orders),
+        "refined_trend_degree": r.peak.trend_degree,
+        "refined_amplitude_change": r.peak.amplitude_change,
         "candidates": [{"period_s": p, "power": w} for p, w in r.candidates],
         "photometric_period_s": r.decision.photometric_period_s,
         "synodic_period_s": r.decision.rotation_period_s,

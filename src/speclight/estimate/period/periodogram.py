@@ -14,7 +14,8 @@ combined with their ``chi2_0b`` as weights. (astropy's ``LombScargleMultiband(me
 combines the same single-band powers but weights them by the sum of each band's squared powers,
 which is not the chi-square of the joint model; hence the combination here.)
 :func:`harmonic_chi2` is the same model fitted directly (numpy least squares): it serves the
-peak refinement, the P/2P decision and the figures, and checks the astropy sum in the tests.
+peak refinement (:mod:`.peak_refinement`), the P/2P decision and the figures, and checks the
+astropy sum in the tests.
 """
 
 from __future__ import annotations
@@ -26,9 +27,10 @@ from numpy.typing import NDArray
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
-#: Degree of the polynomial in time fitted per band beside the harmonics in the refinement
-#: (and the P/2P test): the detrending before the periodogram takes a little of the signal
-#: with the pass's slow change, and leaves residuals correlated over the pass otherwise.
+#: Degree of the polynomial in time fitted per band beside the harmonics in the P/2P test and
+#: the outlier and tumbling tests, and the refinement's lowest (:mod:`.peak_refinement`): the
+#: detrending before the periodogram takes a little of the signal with the pass's slow
+#: change, and leaves residuals correlated over the pass otherwise.
 TREND_DEGREE = 3
 #: Points per band above which astropy's ``fastchi2`` (extirpolation) beats ``chi2`` (direct).
 FAST_ABOVE = 3000
@@ -138,11 +140,12 @@ def design_matrix(
 
 
 def _with_trend(series: BandSeries, m: NDArray[np.bool_], x: F64, degree: int) -> F64:
-    """``x`` with the columns ``u^1..u^degree``, ``u`` the time scaled to -1..1 over the span."""
+    """``x`` with the columns ``P_1(u)..P_degree(u)`` (Legendre polynomials: well conditioned
+    at high degrees), ``u`` the time scaled to -1..1 over the span."""
     if degree <= 0:
         return x
     u = 2 * (series.t_s[m] - series.t_s.min()) / max(series.span_s, 1e-12) - 1
-    return np.hstack([x, np.stack([u**d for d in range(1, degree + 1)], axis=1)])
+    return np.hstack([x, np.polynomial.legendre.legvander(u, degree)[:, 1:]])
 
 
 def weighted_lstsq(x: F64, y: F64, w: F64) -> F64:
@@ -154,12 +157,40 @@ def weighted_lstsq(x: F64, y: F64, w: F64) -> F64:
     return np.asarray(beta, dtype=np.float64)
 
 
+def band_design(
+    series: BandSeries,
+    m: NDArray[np.bool_],
+    frequency_hz: float,
+    orders: list[int],
+    phase_rad: F64 | None = None,
+    trend_degree: int = 0,
+    amplitude_change: bool = False,
+) -> F64:
+    """Design matrix of the points ``m`` (one band): :func:`design_matrix` with the trend
+    (:func:`_with_trend`) and, with ``amplitude_change``, one more column ``u h(t)``: the
+    band's fitted harmonic curve ``h`` (a first fit without it) times the time ``u`` scaled
+    to -1..1, a light curve whose amplitude changes linearly over the pass (as with the
+    phase angle, Zappala et al. 1990, A&A 231, 548). It is orthogonal to a shift of the
+    frequency (which moves ``h`` by its quadrature ``t h'``), so it takes no information from
+    the frequency."""
+    ph = None if phase_rad is None else phase_rad[m]
+    x = _with_trend(series, m, design_matrix(series.t_s[m], frequency_hz, orders, ph), trend_degree)
+    if not amplitude_change:
+        return x
+    beta = weighted_lstsq(x, series.y[m], 1.0 / series.dy[m])
+    k2 = 2 * len(orders)
+    h = x[:, 1 : 1 + k2] @ beta[1 : 1 + k2]
+    u = 2 * (series.t_s[m] - series.t_s.min()) / max(series.span_s, 1e-12) - 1
+    return np.hstack([x, (u * h)[:, None]])
+
+
 def harmonic_chi2(
     series: BandSeries,
     frequency_hz: float,
     orders: list[int],
     phase_rad: F64 | None = None,
     trend_degree: int = 0,
+    amplitude_change: bool = False,
 ) -> tuple[float, int, list[F64]]:
     """Weighted least-squares fit of the harmonics ``orders`` of ``frequency_hz`` per band,
     with a polynomial in time per band beside the constant (the coefficients of the
@@ -178,6 +209,8 @@ def harmonic_chi2(
         :func:`design_matrix`), or None.
     trend_degree
         Degree of the polynomial trend in time per band (0: the constant alone).
+    amplitude_change
+        Let the harmonics' amplitude change linearly over the pass (:func:`band_design`).
 
     Returns
     -------
@@ -192,10 +225,7 @@ def harmonic_chi2(
     for b in range(series.n_bands):
         m = series.band == b
         w = 1.0 / series.dy[m]
-        ph = None if phase_rad is None else phase_rad[m]
-        x = _with_trend(
-            series, m, design_matrix(series.t_s[m], frequency_hz, orders, ph), trend_degree
-        )
+        x = band_design(series, m, frequency_hz, orders, phase_rad, trend_degree, amplitude_change)
         beta = weighted_lstsq(x, series.y[m], w)
         chi2 += float(np.sum(((series.y[m] - x @ beta) * w) ** 2))
         npar += x.shape[1]
@@ -208,192 +238,3 @@ def local_maxima(power: F64, count: int) -> I64:
     p = np.concatenate([[-np.inf], power, [-np.inf]])
     idx = np.flatnonzero((p[1:-1] > p[:-2]) & (p[1:-1] >= p[2:]))
     return idx[np.argsort(power[idx])[::-1][:count]].astype(np.int64)
-
-
-@dataclass
-class Peak:
-    """A refined periodogram peak.
-
-    Attributes
-    ----------
-    frequency_hz, frequency_std_hz
-        Best frequency and its standard deviation [Hz].
-    chi2, dof
-        Chi-square of the fit at the best frequency and its degrees of freedom.
-    residual_correlation
-        Lag-1 autocorrelation of the residuals (:func:`residual_lag1_correlation`).
-    """
-
-    frequency_hz: float
-    frequency_std_hz: float
-    chi2: float
-    dof: int
-    residual_correlation: float = 0.0
-
-
-def refine_peak(
-    series: BandSeries,
-    frequency_hz: float,
-    orders: list[int],
-    phase_rad: F64 | None = None,
-    trend_degree: int = TREND_DEGREE,
-    within: tuple[float, float] | None = None,
-) -> Peak:
-    """Best frequency near ``frequency_hz`` and its standard deviation.
-
-    The chi-square of the model with the harmonics ``orders`` and a polynomial trend of
-    ``trend_degree`` per band is minimised over ``+-0.1 / span`` around ``frequency_hz`` (a
-    tenth of the peak width; scipy's bounded Brent search, to 1e-6 of that window), cut to
-    ``within`` (the searched frequency range [Hz], if given). Its
-    curvature at the minimum, ``c2`` of ``chi2(f) ~ chi2_min + c2 (f - f0)^2``, comes from a
-    central difference whose step is set to twice the resulting standard deviation (two
-    passes). The standard deviation follows from ``delta chi2 = 1`` after scaling the
-    chi-square by its reduced value at the minimum (so that mis-stated sigmas and model
-    misfit widen it): ``sigma_f = sqrt(chi2_min / dof / c2)`` (Press et al., Numerical
-    Recipes, 15.6). That rule assumes independent residuals; a light curve that changes over
-    a pass leaves residuals correlated over many epochs, so ``sigma_f`` is multiplied by
-    :func:`red_noise_inflation`, from the residuals' spectrum near the harmonics.
-
-    Parameters
-    ----------
-    series
-        The light curves.
-    frequency_hz
-        The peak's frequency on the grid [Hz].
-    orders
-        The harmonics of the model.
-    phase_rad
-        A phase per point added to the harmonics' argument [rad], or None.
-    trend_degree
-        Degree of the polynomial trend in time per band.
-    within
-        The searched frequency range (low, high) [Hz], or None.
-    """
-    from scipy.optimize import minimize_scalar
-
-    def chi(f: float) -> float:
-        return harmonic_chi2(series, f, orders, phase_rad, trend_degree)[0]
-
-    half = 0.1 / series.span_s
-    lo, hi = frequency_hz - half, frequency_hz + half
-    if within is not None:
-        lo, hi = max(lo, float(within[0])), min(hi, float(within[1]))
-    found = minimize_scalar(chi, bounds=(lo, hi), method="bounded", options={"xatol": 1e-6 * half})
-    best = float(found.x)
-    chi2, npar, coefs = harmonic_chi2(series, best, orders, phase_rad, trend_degree)
-    dof = max(series.t_s.size - npar - 1, 1)
-    step, std = half / 10, float("nan")
-    for _ in range(2):
-        c2 = (chi(best + step) + chi(best - step) - 2 * chi2) / (2 * step**2)
-        if not c2 > 0:
-            break
-        std = float(np.sqrt((chi2 / dof) / c2))
-        step = min(2 * std, half)
-    rho, residuals = residual_lag1_correlation(series, best, orders, coefs, phase_rad, trend_degree)
-    inflation = red_noise_inflation(series, best, orders, coefs, residuals)
-    return Peak(best, std * inflation, chi2, dof, rho)
-
-
-def red_noise_inflation(
-    series: BandSeries,
-    frequency_hz: float,
-    orders: list[int],
-    coefs: list[F64],
-    residuals: F64,
-) -> float:
-    """Factor on ``sigma_f`` for residuals that are not white (1 when they are).
-
-    The frequency's variance is inversely proportional to the harmonics' information,
-    ``sum_k k^2 A_k^2 / S(k f)``, with ``S`` the noise's power spectral density (Kay,
-    Fundamentals of Statistical Signal Processing I, 1993, ch. 3, the Cramer-Rao bound in
-    coloured Gaussian noise). ``S`` is measured on the residuals themselves (normalised by
-    their sigmas, all bands pooled): ``R_k`` is the mean Lomb-Scargle power of the residuals
-    in the side bands ``1.5/span <= |f' - k f| <= 6/span`` of each harmonic over their mean
-    power from ``1/span`` to the Nyquist frequency of the median spacing (the local noise
-    level of Montgomery & O'Donoghue 1999, DSSN 13, 28, as a ratio to the white level). The
-    factor is ``sqrt(sum w_k / sum (w_k / R_k))`` with ``w_k = k^2 A_k^2``, the amplitudes
-    ``A_k`` averaged over the bands with weights ``sum 1/dy^2``; it is not allowed below 1.
-
-    Parameters
-    ----------
-    series
-        The light curves.
-    frequency_hz
-        The fitted frequency [Hz].
-    orders
-        The harmonics of the model.
-    coefs
-        The fit's coefficients per band (:func:`harmonic_chi2`).
-    residuals
-        The normalised residuals, in the order of the series' points.
-    """
-    from astropy.timeseries import LombScargle
-
-    amp2 = np.zeros(len(orders))
-    wsum = 0.0
-    k = len(orders)
-    for b, beta in enumerate(coefs):
-        w = float(np.sum(1.0 / series.dy[series.band == b] ** 2))
-        amp2 += w * (beta[1 : 2 * k + 1 : 2] ** 2 + beta[2 : 2 * k + 2 : 2] ** 2)
-        wsum += w
-    order = np.asarray(orders, dtype=float)
-    weight = order**2 * amp2 / wsum
-    if np.sum(weight) <= 0:
-        return 1.0
-    span = series.span_s
-    dt = float(np.median(np.diff(np.unique(series.t_s))))
-    ls = LombScargle(series.t_s, residuals, fit_mean=True, center_data=True)
-    broad = np.linspace(1.0 / span, 0.5 / dt, 2000)
-    level = float(np.mean(ls.power(broad, method="fast")))
-    side = np.concatenate([np.linspace(1.5, 6.0, 10), -np.linspace(1.5, 6.0, 10)]) / span
-    ratio = np.empty(k)
-    for j, o in enumerate(order):
-        near = o * frequency_hz + side
-        near = near[(near > 0) & (near < 0.5 / dt)]
-        ratio[j] = float(np.mean(ls.power(near, method="cython"))) / level if near.size else 1.0
-    ratio = np.maximum(ratio, 1e-3)
-    return max(float(np.sqrt(np.sum(weight) / np.sum(weight / ratio))), 1.0)
-
-
-def residual_lag1_correlation(
-    series: BandSeries,
-    frequency_hz: float,
-    orders: list[int],
-    coefs: list[F64],
-    phase_rad: F64 | None = None,
-    trend_degree: int = 0,
-) -> tuple[float, F64]:
-    """Lag-1 autocorrelation of the normalised residuals, consecutive points of each band
-    pooled (``sum r_i r_(i+1) / sum r_i^2``, capped at 0.99), and the normalised residuals
-    (in the order of the series' points).
-
-    Parameters
-    ----------
-    series
-        The light curves.
-    frequency_hz
-        The fitted frequency [Hz].
-    orders
-        The harmonics of the model.
-    coefs
-        The fit's coefficients per band (:func:`harmonic_chi2`).
-    phase_rad
-        A phase per point added to the harmonics' argument [rad], or None.
-    trend_degree
-        Degree of the polynomial trend in time per band.
-    """
-    num = den = 0.0
-    out = np.zeros(series.y.size)
-    for b, beta in enumerate(coefs):
-        m = series.band == b
-        ph = None if phase_rad is None else phase_rad[m]
-        x = _with_trend(
-            series, m, design_matrix(series.t_s[m], frequency_hz, orders, ph), trend_degree
-        )
-        order = np.argsort(series.t_s[m])
-        res = (series.y[m] - x @ beta) / series.dy[m]
-        out[m] = res
-        r = res[order]
-        num += float(np.sum(r[1:] * r[:-1]))
-        den += float(np.sum(r**2))
-    return (min(num / den, 0.99) if den > 0 else 0.0), out

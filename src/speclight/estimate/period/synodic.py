@@ -19,7 +19,7 @@ the mean rate can then be worse than no correction. So the relation is applied i
 differential form: the light curve is fitted with the rotation phase ``2 pi f t - phi(t)``,
 ``phi`` the PAB's unwrapped azimuth about the spin axis (right-handed) at each epoch, on a
 frequency grid around ``1/P_syn`` (reaching 1.5 times the mean-rate shift, at least one peak
-width), refined as the periodogram peak is (:func:`.periodogram.refine_peak`). The sidereal
+width), refined as the periodogram peak is (:func:`.peak_refinement.refine_peak`). The sidereal
 period of this fit replaces the synodic one only when asked (``apply``; ``speclight period
 --synodic bisector``) and when its chi-square is lower than the plain fit's (same number of
 parameters: ``1..2K`` harmonics of the rotation frequency per band), i.e. when the light
@@ -39,12 +39,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from speclight.estimate.period.peak_refinement import refine_peak
 from speclight.estimate.period.periodogram import (
     F64,
     TREND_DEGREE,
     BandSeries,
     harmonic_chi2,
-    refine_peak,
 )
 
 

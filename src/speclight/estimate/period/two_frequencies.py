@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from speclight.estimate.period.peak_refinement import harmonics_needed, refine_peak
 from speclight.estimate.period.period_decision import nested_f_test
 from speclight.estimate.period.periodogram import (
     F64,
@@ -42,7 +43,6 @@ from speclight.estimate.period.periodogram import (
     design_matrix,
     local_maxima,
     multiband_power,
-    refine_peak,
     weighted_lstsq,
 )
 
@@ -53,8 +53,6 @@ N_COMBINATIONS = 6
 #: p-value of the mixed terms at the unrefined second frequency above which it is not
 #: refined (the refinement only lowers the chi-square of the full model).
 QUICK_P = 0.1
-#: Most harmonics of the first frequency fitted before the second is sought.
-MAX_HARMONICS = 24
 #: Half width of the frequencies left out around each harmonic, in units of ``1/span``.
 EXCLUDE_WIDTH = 2.5
 
@@ -123,19 +121,6 @@ def _lag1(series: BandSeries, resid: F64) -> float:
     return min(num / den, 0.99) if den > 0 else 0.0
 
 
-def _harmonics_needed(series: BandSeries, f1: float, start: int, alpha: float) -> list[int]:
-    """Harmonics ``1..H`` of ``f1``, ``H >= start`` grown while the next one is significant
-    (F-test at ``alpha``), at most :data:`MAX_HARMONICS`: a light curve with glints has many."""
-    h = start
-    chi, npar, _, _ = _fit(series, f1, list(range(1, h + 1)), None, 0, False)
-    while h < MAX_HARMONICS:
-        chi2, npar2, _, _ = _fit(series, f1, list(range(1, h + 2)), None, 0, False)
-        if not nested_f_test(chi, npar, chi2, npar2, series.t_s.size)[1] < alpha:
-            break
-        h, chi, npar = h + 1, chi2, npar2
-    return list(range(1, h + 1))
-
-
 def _reduced(f2: float, f1: float, f_min: float) -> float:
     """The lowest frequency ``|f2 - j f1|`` (``j`` integer) within the grid: the pairs
     ``(f1, f2)`` and ``(f1, |f2 - j f1|)`` span the same combinations, and the residuals'
@@ -177,7 +162,7 @@ def tumbling_test(
     """
     from speclight.estimate.period.analytic_fap import analytic_fap
 
-    orders = _harmonics_needed(series, rotation_hz, 2 * harmonics, alpha)
+    orders = harmonics_needed(series, rotation_hz, 2 * harmonics, alpha)
     _, _, _, resid = _fit(series, rotation_hz, orders, None, 0, False)
     rest = BandSeries(series.t_s, resid, series.dy, series.band, series.n_bands)
     power = multiband_power(rest, frequency_hz, 1)
