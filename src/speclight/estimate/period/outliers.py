@@ -19,11 +19,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from speclight.estimate.period.peak_refinement import residual_lag1_correlation
 from speclight.estimate.period.periodogram import (
     TREND_DEGREE,
     BandSeries,
     harmonic_chi2,
+    residual_lag1_correlation,
 )
 
 #: Expected number of Gaussian points wrongly rejected per light curve (Chauvenet's rule).

@@ -23,8 +23,8 @@ from speclight.estimate.period.periodogram import (
     F64,
     TREND_DEGREE,
     BandSeries,
-    band_design,
     harmonic_chi2,
+    residual_lag1_correlation,
 )
 
 #: Most harmonics of a refinement's model: a light curve with glints has many.
@@ -50,7 +50,7 @@ class Peak:
     chi2, dof
         Chi-square of the fit at the best frequency and its degrees of freedom.
     residual_correlation
-        Lag-1 autocorrelation of the residuals (:func:`residual_lag1_correlation`).
+        Lag-1 autocorrelation of the residuals (:func:`.periodogram.residual_lag1_correlation`).
     white_std_hz
         The standard deviation from the curvature alone, with the sigmas as given [Hz].
     noise_factor
@@ -206,50 +206,6 @@ def red_noise_inflation(
         ratio[j] = float(np.mean(ls.power(near, method="cython"))) / level if near.size else 1.0
     ratio = np.maximum(ratio, 1e-3)
     return max(float(np.sqrt(np.sum(weight) / np.sum(weight / ratio))), 1.0)
-
-
-def residual_lag1_correlation(
-    series: BandSeries,
-    frequency_hz: float,
-    orders: list[int],
-    coefs: list[F64],
-    phase_rad: F64 | None = None,
-    trend_degree: int = 0,
-    amplitude_change: bool = False,
-) -> tuple[float, F64]:
-    """Lag-1 autocorrelation of the normalised residuals, consecutive points of each band
-    pooled (``sum r_i r_(i+1) / sum r_i^2``, capped at 0.99), and the normalised residuals
-    (in the order of the series' points).
-
-    Parameters
-    ----------
-    series
-        The light curves.
-    frequency_hz
-        The fitted frequency [Hz].
-    orders
-        The harmonics of the model.
-    coefs
-        The fit's coefficients per band (:func:`harmonic_chi2`).
-    phase_rad
-        A phase per point added to the harmonics' argument [rad], or None.
-    trend_degree
-        Degree of the polynomial trend in time per band.
-    amplitude_change
-        Whether the model has the amplitude-change column (:func:`.periodogram.band_design`).
-    """
-    num = den = 0.0
-    out = np.zeros(series.y.size)
-    for b, beta in enumerate(coefs):
-        m = series.band == b
-        x = band_design(series, m, frequency_hz, orders, phase_rad, trend_degree, amplitude_change)
-        order = np.argsort(series.t_s[m])
-        res = (series.y[m] - x @ beta) / series.dy[m]
-        out[m] = res
-        r = res[order]
-        num += float(np.sum(r[1:] * r[:-1]))
-        den += float(np.sum(r**2))
-    return (min(num / den, 0.99) if den > 0 else 0.0), out
 
 
 def harmonics_needed(

@@ -91,7 +91,7 @@ def halves_test(
     """Do the two halves of the light curve folded at ``period_s`` differ? (F-test; with
     ``correlated``, counting the full model's residual correlation, :func:`nested_f_test`:
     harder to call them different, used before doubling a period)."""
-    from speclight.estimate.period.peak_refinement import residual_lag1_correlation
+    from speclight.estimate.period.periodogram import residual_lag1_correlation
 
     freq = 1.0 / period_s
     orders = list(range(1, 2 * harmonics + 1))

@@ -238,3 +238,47 @@ def local_maxima(power: F64, count: int) -> I64:
     p = np.concatenate([[-np.inf], power, [-np.inf]])
     idx = np.flatnonzero((p[1:-1] > p[:-2]) & (p[1:-1] >= p[2:]))
     return idx[np.argsort(power[idx])[::-1][:count]].astype(np.int64)
+
+
+def residual_lag1_correlation(
+    series: BandSeries,
+    frequency_hz: float,
+    orders: list[int],
+    coefs: list[F64],
+    phase_rad: F64 | None = None,
+    trend_degree: int = 0,
+    amplitude_change: bool = False,
+) -> tuple[float, F64]:
+    """Lag-1 autocorrelation of the normalised residuals, consecutive points of each band
+    pooled (``sum r_i r_(i+1) / sum r_i^2``, capped at 0.99), and the normalised residuals
+    (in the order of the series' points).
+
+    Parameters
+    ----------
+    series
+        The light curves.
+    frequency_hz
+        The fitted frequency [Hz].
+    orders
+        The harmonics of the model.
+    coefs
+        The fit's coefficients per band (:func:`harmonic_chi2`).
+    phase_rad
+        A phase per point added to the harmonics' argument [rad], or None.
+    trend_degree
+        Degree of the polynomial trend in time per band.
+    amplitude_change
+        Whether the model has the amplitude-change column (:func:`.periodogram.band_design`).
+    """
+    num = den = 0.0
+    out = np.zeros(series.y.size)
+    for b, beta in enumerate(coefs):
+        m = series.band == b
+        x = band_design(series, m, frequency_hz, orders, phase_rad, trend_degree, amplitude_change)
+        order = np.argsort(series.t_s[m])
+        res = (series.y[m] - x @ beta) / series.dy[m]
+        out[m] = res
+        r = res[order]
+        num += float(np.sum(r[1:] * r[:-1]))
+        den += float(np.sum(r**2))
+    return (min(num / den, 0.99) if den > 0 else 0.0), out

@@ -368,8 +368,8 @@ def spin_axis_search(
         from speclight.estimate.spin_axis.spin_axis_period_check import checked_answer
 
         checked = checked_answer(
-            bmap, sfm, with_period(geo, period_s), y, spin_body_axis, refined, grid_deg,
-            chunk, ranging, confidence,
+            bmap, sfm, with_period(geo, period_s), y, spin_body_axis, refined,
+            radec_grid(scan_grid_deg(grid_deg)), grid_terms, chunk, ranging, confidence,
         )  # fmt: skip
     return SpinAxisResult(
         ra,

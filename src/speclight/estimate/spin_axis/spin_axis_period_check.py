@@ -33,6 +33,7 @@ constrained whatever the period).
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -127,7 +128,8 @@ def check_fixed_period(
     y: F64,
     spin_body_axis: ArrayLike | None,
     answer: tuple[float, float, float, float],
-    grid_deg: float,
+    coarse: tuple[F64, F64],
+    terms: Callable,
     chunk: int,
     ranging: RangingTerm | None = None,
 ) -> PeriodCheck:
@@ -146,15 +148,19 @@ def check_fixed_period(
         The spin axis in the body frame (3,), or None (+z).
     answer
         RA, Dec, phase [deg] and misfit of the answer.
-    grid_deg
-        The search's grid step [deg] (the scan's coarse grid is derived from it).
+    coarse
+        The scan's coarse grid: RA and Dec cell centres [deg] (:func:`.spin_axis_core.radec_grid`
+        at :func:`.spin_axis_period_scan.scan_grid_deg` of the search's step).
+    terms
+        The grid pass's sums (:func:`.spin_axis_core.grid_terms`; passed in, as
+        :func:`.spin_axis_period_scan.grid_for_period` takes it, so that this module does not
+        import the core that calls it).
     chunk
         Axes per lookup call (memory, not the result).
     ranging
         The range-offset term with its weight resolved, or None.
     """
-    from speclight.estimate.spin_axis.spin_axis_core import grid_terms, radec_grid
-    from speclight.estimate.spin_axis.spin_axis_period_scan import grid_for_period, scan_grid_deg
+    from speclight.estimate.spin_axis.spin_axis_period_scan import grid_for_period
     from speclight.estimate.spin_axis.spin_axis_refine import refine_candidate
 
     p0 = float(geo.period_s)
@@ -162,9 +168,8 @@ def check_fixed_period(
     if not np.all(np.isfinite(answer)):
         out.note = "the answer is not finite: no period check"
         return out
-    coarse = radec_grid(scan_grid_deg(grid_deg))
     scan = grid_for_period(
-        sfm, geo, y, *coarse, chunk, None, ranging, "sidereal", CHECK_BOUND, coarse, grid_terms
+        sfm, geo, y, *coarse, chunk, None, ranging, "sidereal", CHECK_BOUND, coarse, terms
     )
     assert scan.periods_s is not None
     out.n_periods = int(scan.periods_s.size)
@@ -182,7 +187,7 @@ def check_fixed_period(
     )
     alt_geo = dataclasses.replace(geo, period_s=scan.period_s)
     alt = refine_candidate(
-        bmap, alt_geo, y, spin_body_axis, start, scan_grid_deg(grid_deg) / 2, "nelder-mead",
+        bmap, alt_geo, y, spin_body_axis, start, 180.0 / coarse[0].size, "nelder-mead",
         step, scan.ranging, scan.period_s,
     )  # fmt: skip
     if not (np.isfinite(alt.error) and np.isfinite(alt.period_s)):
@@ -231,7 +236,8 @@ def checked_answer(
     y: F64,
     spin_body_axis: ArrayLike | None,
     answer: tuple[float, float, float, float],
-    grid_deg: float,
+    coarse: tuple[F64, F64],
+    terms: Callable,
     chunk: int,
     ranging: RangingTerm | None,
     confidence: AxisConfidence | None,
@@ -241,7 +247,9 @@ def checked_answer(
     note (parameters as :func:`check_fixed_period`)."""
     if confidence is None or confidence.note.startswith(FLAT_NOTE):
         return None
-    check = check_fixed_period(bmap, sfm, geo, y, spin_body_axis, answer, grid_deg, chunk, ranging)
+    check = check_fixed_period(
+        bmap, sfm, geo, y, spin_body_axis, answer, coarse, terms, chunk, ranging
+    )
     if check.warn:
         confidence.constrained = False
         confidence.note = f"{check.note}; {confidence.note}"
