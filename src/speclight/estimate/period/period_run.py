@@ -59,6 +59,7 @@ from speclight.estimate.period.periodogram import (
     local_maxima,
     multiband_power,
 )
+from speclight.estimate.period.search_edge import search_edge
 from speclight.estimate.period.synodic import sidereal_period
 from speclight.estimate.period.two_frequencies import tumbling_test
 from speclight.scenario import LoadedScenario
@@ -232,6 +233,7 @@ def estimate_period(
         series, list(lc.band_names), freq, power, candidates, peak, harmonics, analytic,
         boot, decision, correction, n_epochs, lc.source, outliers=outliers,
         tumbling=tumbling, rising=rising, notices=notices,
+        edge=search_edge(series, peak, freq, harmonics, decision),
     )  # fmt: skip
 
 
