@@ -30,11 +30,11 @@ chi-square is lower than the plain fit's (same model, so the same number of para
 i.e. when the light curve does follow the bisector. It is not applied by default: on the
 built-in box-wing pass (spin axis passing within 15 deg of the observer) the light curve
 follows the Sun's fixed direction more than the bisector, and the correction moves a
-period found within 0.6 % of the truth 2-6 % away from it (docs/period.md). ``Omega`` (weighted least-squares slope
-of ``phi`` against time, weights ``sum_b 1/sigma^2`` per epoch) and the linear relation's
-period are reported for comparison. Without a known spin axis the correction is bounded by
-the PAB's angular speed on the sky, ``|Omega| <= |dPAB/dt|``:
-``|P_sid - P_syn| <= P^2 |dPAB/dt| / (2 pi)`` (first order), reported instead.
+period found within 0.6 % of the truth 2-6 % away from it (docs/period.md). ``Omega``
+(weighted least-squares slope of ``phi`` against time, weights ``sum_b 1/sigma^2`` per
+epoch) and the linear relation's period are reported for comparison. Without a known spin
+axis the correction is bounded by the PAB's angular speed on the sky, ``|Omega| <=
+|dPAB/dt|``: ``|P_sid - P_syn| <= P^2 |dPAB/dt| / (2 pi)`` (first order), reported instead.
 """
 
 from __future__ import annotations
