@@ -258,13 +258,17 @@ def harmonics_needed(
 ) -> list[int]:  # fmt: skip
     """Harmonics ``1..H`` of ``frequency_hz``, ``H >= start`` grown while the next one is
     significant (F-test at ``alpha``, :func:`.period_decision.nested_f_test`), at most
-    :data:`MAX_HARMONICS`; with a trend of ``trend_degree`` per band and ``phase_rad``
-    added to the harmonics' argument (:func:`refine_peak`)."""
+    :data:`MAX_HARMONICS` and below the Nyquist frequency of the median spacing (a harmonic
+    above it aliases onto lower frequencies: tens of them fitted one cosmic ray); with a
+    trend of ``trend_degree`` per band and ``phase_rad`` added to the harmonics' argument
+    (:func:`refine_peak`)."""
+    dt = float(np.median(np.diff(np.unique(series.t_s))))
+    top = min(MAX_HARMONICS, int(np.ceil(0.5 / (dt * frequency_hz))) - 1)
     h = start
     chi, npar, _ = harmonic_chi2(
         series, frequency_hz, list(range(1, h + 1)), phase_rad, trend_degree
     )
-    while h < MAX_HARMONICS:
+    while h < top:
         chi2, npar2, _ = harmonic_chi2(
             series, frequency_hz, list(range(1, h + 2)), phase_rad, trend_degree
         )
