@@ -52,7 +52,7 @@ def test_a_truth_below_the_shortest_period_is_said(tmp_path: Path) -> None:
     out = estimate_period(_csv(tmp_path / "lc.csv", 3.5), if_symmetric="keep").to_json()
     assert out["detected"] and abs(out["photometric_period_s"] - 7.0) < 0.01
     assert out["search_edge"]["side"] == "shortest"
-    assert "P/2 = 3.5" in out["verdict"] and "below the shortest period searched" in out["verdict"]
+    assert "P/2 = 3.5" in out["verdict"] and "below the shortest one searched" in out["verdict"]
     assert out["period_std_s"] is None
 
 

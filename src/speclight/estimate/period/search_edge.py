@@ -11,7 +11,8 @@ a minimum the bound cuts gives a standard deviation that means nothing (a truth 
 * **below the shortest period**: the halves of the light curve folded at the period found,
   ``P``, agree (:func:`.period_decision.halves_test`) while ``P/2`` is shorter than the
   shortest period searched, so :func:`.period_decision.rotation_period` did not halve it:
-  the light curve repeats in ``P/2`` (or less), outside the range. (A period beyond the
+  ``P`` may be a multiple of a period outside the range (on blind draws also a
+  misidentified peak, 2/3 of the truth, whose misfit makes the halves agree). (A period beyond the
   longest one searched shows as power rising to the range's edge: no period is detected,
   :attr:`.period_result.PeriodResult.rising`.)
 """
@@ -109,7 +110,7 @@ def search_edge(
     return SearchEdge(
         "shortest", shortest,
         f"the halves of the light curve folded at P = {p_ph:.6g} s agree (F = "
-        f"{test.f_statistic:.3g}, p = {test.p_value:.2g} >= {ALPHA:g}): it repeats in P/2 = "
-        f"{p_ph / 2:.6g} s or less, below the shortest period searched ({shortest:.6g} s), "
-        f"so P is a multiple of the photometric period; {not_given}; {shorter}",
+        f"{test.f_statistic:.3g}, p = {test.p_value:.2g} >= {ALPHA:g}): P may be a multiple "
+        f"of a period below the shortest one searched ({shortest:.6g} s), such as P/2 = "
+        f"{p_ph / 2:.6g} s; {not_given}; {shorter}",
     )  # fmt: skip
