@@ -86,6 +86,7 @@ def main() -> None:
     warnings.simplefilter("ignore")
     rng = np.random.default_rng(args.seed)
     pulls, rotations, recovered, nulls, false_det, bounds, seconds = [], 0, 0, 0, 0, 0, []
+    edges = 0
     with tempfile.TemporaryDirectory() as tmp:
         for i in range(args.draws):
             case = draw(rng)
@@ -106,9 +107,11 @@ def main() -> None:
                 p, s = out["period_s"], out["period_std_s"]
                 ok = p is not None and abs(p / truth - 1) < 0.02
                 recovered += ok
-                if ok:
+                edge = out["search_edge"] is not None  # said, and no sigma (docs/period.md)
+                edges += edge
+                if ok and not edge:
                     pulls.append((p - truth) / s)
-                pull = f"pull {(p - truth) / s:+6.2f}" if ok else "MISS"
+                pull = "EDGE" if edge else f"pull {(p - truth) / s:+6.2f}" if ok else "MISS"
                 what = (f"P {truth:8.3f} -> {p if p is None else round(p, 4)} +- "
                         f"{s if s is None else round(s, 4)} {pull} (factor "
                         f"{result.peak.noise_factor:.2f}, harmonics {len(result.peak.orders)}, "
@@ -117,7 +120,8 @@ def main() -> None:
                   f"SNR {case['snr']:5.0f} trend {case['trend']:.2f} K {case['harmonics']} {what}",
                   flush=True)  # fmt: skip
     pulls_a = np.asarray(pulls)
-    print(f"\nrotations: {recovered}/{rotations} recovered ({recovered / max(rotations, 1):.0%})")
+    print(f"\nrotations: {recovered}/{rotations} recovered ({recovered / max(rotations, 1):.0%}); "
+          f"{edges} at an edge of the searched range (no sigma)")  # fmt: skip
     if pulls_a.size > 1:
         beyond2, beyond3 = (float(np.mean(np.abs(pulls_a) > k)) for k in (2, 3))
         print(f"(estimate - truth)/sigma over the recovered: mean {pulls_a.mean():+.2f}, "

@@ -344,7 +344,7 @@ def period(
                 f"{shown('photometric_period_s', '.6g')} s, false-alarm probability "
                 f"{shown('false_alarm_probability', '.2g')})"
             )
-            if summary["tumbling"] and summary["tumbling"]["detected"]:
+            if summary["search_edge"] or (summary["tumbling"] or {}).get("detected"):
                 typer.echo(summary["verdict"])
         for notice in summary["outliers"]:
             typer.echo(

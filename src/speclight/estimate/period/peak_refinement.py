@@ -210,16 +210,23 @@ def red_noise_inflation(
 
 def harmonics_needed(
     series: BandSeries, frequency_hz: float, start: int, alpha: float = ALPHA,
-    trend_degree: int = TREND_DEGREE,
+    trend_degree: int = TREND_DEGREE, phase_rad: F64 | None = None,
 ) -> list[int]:  # fmt: skip
     """Harmonics ``1..H`` of ``frequency_hz``, ``H >= start`` grown while the next one is
     significant (F-test at ``alpha``, :func:`.period_decision.nested_f_test`), at most
-    :data:`MAX_HARMONICS`; with a trend of ``trend_degree`` per band."""
+    :data:`MAX_HARMONICS` and below the Nyquist frequency of the median spacing (a harmonic
+    above it aliases onto lower frequencies: tens of them fitted one cosmic ray); with a
+    trend of ``trend_degree`` per band and ``phase_rad`` added to the harmonics' argument
+    (:func:`refine_peak`)."""
+    dt = float(np.median(np.diff(np.unique(series.t_s))))
+    top = min(MAX_HARMONICS, int(np.ceil(0.5 / (dt * frequency_hz))) - 1)
     h = start
-    chi, npar, _ = harmonic_chi2(series, frequency_hz, list(range(1, h + 1)), None, trend_degree)
-    while h < MAX_HARMONICS:
+    chi, npar, _ = harmonic_chi2(
+        series, frequency_hz, list(range(1, h + 1)), phase_rad, trend_degree
+    )
+    while h < top:
         chi2, npar2, _ = harmonic_chi2(
-            series, frequency_hz, list(range(1, h + 2)), None, trend_degree
+            series, frequency_hz, list(range(1, h + 2)), phase_rad, trend_degree
         )
         if not nested_f_test(chi, npar, chi2, npar2, series.t_s.size)[1] < alpha:
             break
@@ -228,8 +235,9 @@ def harmonics_needed(
 
 
 def trend_degree_needed(
-    series: BandSeries, frequency_hz: float, orders: list[int], alpha: float = ALPHA
-) -> int:
+    series: BandSeries, frequency_hz: float, orders: list[int], alpha: float = ALPHA,
+    phase_rad: F64 | None = None,
+) -> int:  # fmt: skip
     """Degree of the trend per band beside the harmonics ``orders``: from
     :data:`.periodogram.TREND_DEGREE`, grown while the next degree, or the next two together
     (a slow change symmetric about mid-pass has only even Legendre terms), is significant
@@ -237,12 +245,12 @@ def trend_degree_needed(
     cycles in the span."""
     cap = min(int(np.ceil(np.pi * series.span_s * frequency_hz)) - 1, MAX_TREND_DEGREE)
     d = TREND_DEGREE
-    chi, npar, _ = harmonic_chi2(series, frequency_hz, orders, None, d)
+    chi, npar, _ = harmonic_chi2(series, frequency_hz, orders, phase_rad, d)
     while True:
         for step in (1, 2):  # a change symmetric about mid-pass needs only even degrees
             if d + step > cap:
                 return d
-            chi2, npar2, _ = harmonic_chi2(series, frequency_hz, orders, None, d + step)
+            chi2, npar2, _ = harmonic_chi2(series, frequency_hz, orders, phase_rad, d + step)
             if nested_f_test(chi, npar, chi2, npar2, series.t_s.size)[1] < alpha:
                 d, chi, npar = d + step, chi2, npar2
                 break
@@ -255,6 +263,7 @@ def refine_with_model(
     frequency_hz: float,
     harmonics: int,
     within: tuple[float, float] | None = None,
+    phase_rad: F64 | None = None,
 ) -> Peak:
     """The peak near ``frequency_hz`` refined (:func:`refine_peak`) with the ``harmonics``
     of the periodogram and a cubic trend, then again with the model the light curve needs
@@ -275,6 +284,9 @@ def refine_with_model(
         ``K``, the periodogram's harmonics.
     within
         The searched frequency range (low, high) [Hz], or None.
+    phase_rad
+        A phase per point added to the harmonics' argument [rad] (the synodic fit,
+        :mod:`.synodic`), or None.
     """
     half = 0.5 / series.span_s  # the passes stay within the periodogram's peak
     lo, hi = frequency_hz - half, frequency_hz + half
@@ -282,18 +294,17 @@ def refine_with_model(
         lo, hi = max(lo, float(within[0])), min(hi, float(within[1]))
     within = (lo, hi)
     model: tuple[list[int], int, bool] = (list(range(1, harmonics + 1)), TREND_DEGREE, False)
-    peak = refine_peak(series, frequency_hz, model[0], within=within)
+    peak = refine_peak(series, frequency_hz, model[0], phase_rad, within=within)
     for _ in range(MODEL_PASSES):
         f = peak.frequency_hz
-        orders = harmonics_needed(series, f, harmonics)
-        degree = trend_degree_needed(series, f, orders)
-        chosen = (orders, degree, amplitude_change_needed(series, f, orders, degree))
+        orders = harmonics_needed(series, f, harmonics, phase_rad=phase_rad)
+        degree = trend_degree_needed(series, f, orders, phase_rad=phase_rad)
+        change = amplitude_change_needed(series, f, orders, degree, phase_rad=phase_rad)
+        chosen = (orders, degree, change)
         if chosen == model:
             break
         model = chosen
-        better = refine_peak(
-            series, f, orders, trend_degree=degree, within=within, amplitude_change=chosen[2]
-        )
+        better = refine_peak(series, f, orders, phase_rad, degree, within, change)
         if not np.isfinite(better.frequency_std_hz):  # no minimum with a positive curvature
             break
         peak = better
@@ -302,11 +313,11 @@ def refine_with_model(
 
 def amplitude_change_needed(
     series: BandSeries, frequency_hz: float, orders: list[int], trend_degree: int,
-    alpha: float = ALPHA,
+    alpha: float = ALPHA, phase_rad: F64 | None = None,
 ) -> bool:  # fmt: skip
     """Whether the harmonics' amplitude changing linearly over the pass
     (:func:`.periodogram.band_design`, one parameter per band) is significant beside the
     harmonics ``orders`` and the trend (F-test at ``alpha``)."""
-    chi, npar, _ = harmonic_chi2(series, frequency_hz, orders, None, trend_degree)
-    chi2, npar2, _ = harmonic_chi2(series, frequency_hz, orders, None, trend_degree, True)
+    chi, npar, _ = harmonic_chi2(series, frequency_hz, orders, phase_rad, trend_degree)
+    chi2, npar2, _ = harmonic_chi2(series, frequency_hz, orders, phase_rad, trend_degree, True)
     return bool(nested_f_test(chi, npar, chi2, npar2, series.t_s.size)[1] < alpha)

@@ -10,9 +10,10 @@ import numpy as np
 from speclight.estimate.period.analytic_fap import AnalyticFap
 from speclight.estimate.period.outliers import Outliers
 from speclight.estimate.period.peak_refinement import Peak
-from speclight.estimate.period.period_decision import RotationDecision
+from speclight.estimate.period.period_decision import MIN_CYCLES, RotationDecision
 from speclight.estimate.period.period_fap import BootstrapMaxima
 from speclight.estimate.period.periodogram import F64, BandSeries
+from speclight.estimate.period.search_edge import SearchEdge
 from speclight.estimate.period.synodic import SynodicCorrection
 from speclight.estimate.period.two_frequencies import TumblingTest
 
@@ -44,6 +45,7 @@ class PeriodResult:
     tumbling: TumblingTest | None = None
     rising: bool = False
     notices: list[str] = field(default_factory=list)
+    edge: SearchEdge | None = None
 
     @property
     def best_power(self) -> float:
@@ -95,7 +97,10 @@ class PeriodResult:
     @property
     def statistical_std_s(self) -> float:
         """Standard deviation of the rotation period from the fit alone [s]:
-        ``factor P^2 sigma_f`` (the sidereal fit's where applied)."""
+        ``factor P^2 sigma_f`` (the sidereal fit's where applied); NaN at an edge of the
+        searched range (:mod:`.search_edge`)."""
+        if self.edge is not None:
+            return float("nan")
         if self.synodic is not None and self.synodic.sidereal_std_s is not None:
             return self.synodic.sidereal_std_s
         f = self.peak.frequency_hz
@@ -125,22 +130,33 @@ class PeriodResult:
         fap = self.false_alarm_probability
         lo, hi = 1.0 / self.frequency_hz[-1], 1.0 / self.frequency_hz[0]
         if self.detected:
+            edge = (
+                ""
+                if self.edge is None
+                else f", at the edge of the searched range: {self.edge.text}"
+            )
             if self.tumbling is not None and self.tumbling.detected:
-                return f"tumbling: {self.tumbling.text}"
-            return f"period detected (false-alarm probability {fap:.2g} < {DETECTION_FAP:g})"
+                return f"tumbling: {self.tumbling.text}{edge}"
+            return f"period detected (false-alarm probability {fap:.2g} < {DETECTION_FAP:g}){edge}"
         why = (
             "the power rises to the longest period searched"
             if self.rising
             else f"false-alarm probability {fap:.2g} >= {DETECTION_FAP:g}"
         )
         head = f"no period detected between {lo:.4g} and {hi:.4g} s ({why})"
+        default_max = abs(hi * MIN_CYCLES / self.series.span_s - 1) < 0.01
+        beyond = (
+            "a third of the span; one pass cannot measure it"
+            if default_max
+            else "the longest period searched; a larger max_period_s, up to the span, "
+            "searches further"
+        )
         if self.period_lower_bound_s is not None:
             return (
                 f"{head}; the light curve varies more slowly (noise level beside the best "
                 f"peak {self.analytic.noise_level:.3g} times the white level): if the body "
-                f"rotates, its period is longer than {hi:.4g} s (a third of the span; one "
-                "pass cannot measure it), or its light curve does not change with the "
-                "rotation"
+                f"rotates, its period is longer than {hi:.4g} s ({beyond}), or its light "
+                "curve does not change with the rotation"
             )
         return f"{head}; the light curve shows no variation beyond its noise in that range"
 

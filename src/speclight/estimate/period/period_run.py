@@ -11,7 +11,8 @@ Steps (``docs/period.md``):
    harmonic stays below the Nyquist frequency of the median spacing ``dt``), 5 samples per
    peak width ``1/span``; the best peak refined;
 3. outliers (:mod:`.outliers`): single points far off the fit in one band are left out and
-   steps 2-3 run again without them;
+   steps 2-3 run again without them, first about the periodogram's model, then about the
+   model the refinement chooses;
 4. false-alarm probability of the best peak at the noise level beside it: analytic
    (:mod:`.analytic_fap`) or by permutation bootstrap (:mod:`.period_fap`); a period is
    detected below 1 % and when the best peak is not the longest period searched with the
@@ -40,7 +41,7 @@ import numpy as np
 from speclight.errors import InputError
 from speclight.estimate.inputs.measured import bin_light_curve, read_measured
 from speclight.estimate.period.analytic_fap import AnalyticFap, analytic_fap
-from speclight.estimate.period.outliers import Outliers, find_outliers, without
+from speclight.estimate.period.outliers import Outliers, combined, find_outliers, without
 from speclight.estimate.period.peak_refinement import Peak, refine_with_model
 from speclight.estimate.period.period_decision import ALPHA, IfSymmetric, rotation_period
 from speclight.estimate.period.period_fap import DRAWS, bootstrap_maxima
@@ -59,6 +60,7 @@ from speclight.estimate.period.periodogram import (
     local_maxima,
     multiband_power,
 )
+from speclight.estimate.period.search_edge import search_edge
 from speclight.estimate.period.synodic import sidereal_period
 from speclight.estimate.period.two_frequencies import tumbling_test
 from speclight.scenario import LoadedScenario
@@ -208,11 +210,21 @@ def estimate_period(
     )
     freq = frequency_grid(series.span_s, min_p, max_p, SAMPLES_PER_PEAK)
     power, candidates, peak, rising = _search(series, freq, harmonics, lc.source)
-    orders = list(range(1, harmonics + 1))
-    outliers: Outliers | None = find_outliers(series, peak.frequency_hz, orders)
-    if outliers is not None and outliers.index.size:
-        series = without(series, outliers.index)
+    # outliers about the periodogram's model first (one point far off drives the choice of
+    # the model: a cosmic ray took a trend of degree 20), then about the model chosen without
+    # them (harmonics and trend left in the residuals hide smaller ones)
+    n_points = series.t_s.size
+    first = find_outliers(series, peak.frequency_hz, list(range(1, harmonics + 1)))
+    if first.index.size:
+        series = without(series, first.index)
         power, candidates, peak, rising = _search(series, freq, harmonics, lc.source)
+    second = find_outliers(
+        series, peak.frequency_hz, peak.orders, peak.trend_degree, peak.amplitude_change
+    )
+    if second.index.size:
+        series = without(series, second.index)
+        power, candidates, peak, rising = _search(series, freq, harmonics, lc.source)
+    outliers: Outliers | None = combined(first, second, n_points)
     analytic: AnalyticFap = analytic_fap(series, freq, harmonics, peak.frequency_hz)
     boot = bootstrap_maxima(series, freq, harmonics, draws, seed) if boot_wanted else None
     decision = rotation_period(series, 1 / peak.frequency_hz, harmonics, min_p, if_symmetric)
@@ -232,6 +244,7 @@ def estimate_period(
         series, list(lc.band_names), freq, power, candidates, peak, harmonics, analytic,
         boot, decision, correction, n_epochs, lc.source, outliers=outliers,
         tumbling=tumbling, rising=rising, notices=notices,
+        edge=search_edge(series, peak, freq, harmonics, decision),
     )  # fmt: skip
 
 

@@ -92,6 +92,11 @@ def summary(r: PeriodResult) -> dict[str, Any]:
         "photometric_period_s": r.decision.photometric_period_s,
         "synodic_period_s": r.decision.rotation_period_s,
         "period_statistical_std_s": r.statistical_std_s,
+        "search_edge": (
+            None
+            if r.edge is None or not r.detected
+            else {"side": r.edge.side, "bound_s": r.edge.bound_s, "text": r.edge.text}
+        ),
         "period_synodic_std_s": r.synodic_std_s,
         "decision": r.decision.decision,
         "halves_tests": [

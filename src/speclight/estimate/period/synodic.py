@@ -19,18 +19,22 @@ the mean rate can then be worse than no correction. So the relation is applied i
 differential form: the light curve is fitted with the rotation phase ``2 pi f t - phi(t)``,
 ``phi`` the PAB's unwrapped azimuth about the spin axis (right-handed) at each epoch, on a
 frequency grid around ``1/P_syn`` (reaching 1.5 times the mean-rate shift, at least one peak
-width), refined as the periodogram peak is (:func:`.peak_refinement.refine_peak`). The sidereal
-period of this fit replaces the synodic one only when asked (``apply``; ``speclight period
---synodic bisector``) and when its chi-square is lower than the plain fit's (same number of
-parameters: ``1..2K`` harmonics of the rotation frequency per band), i.e. when the light
-curve does follow the bisector. It is not applied by default: on the built-in box-wing pass
-(spin axis passing within 15 deg of the observer) the light curve follows the Sun's fixed
-direction more than the bisector, and the correction moves a period found within 0.6 % of
-the truth 2-6 % away from it (docs/period.md). ``Omega`` (weighted least-squares slope
-of ``phi`` against time, weights ``sum_b 1/sigma^2`` per epoch) and the linear relation's
-period are reported for comparison. Without a known spin axis the correction is bounded by
-the PAB's angular speed on the sky, ``|Omega| <= |dPAB/dt|``:
-``|P_sid - P_syn| <= P^2 |dPAB/dt| / (2 pi)`` (first order), reported instead.
+width), refined as the periodogram peak is, with the model the light curve needs in the
+bisector's frame (:func:`.peak_refinement.refine_with_model`: harmonics from ``2K`` of the
+rotation frequency, the trend's degree and the amplitude change chosen by F-tests; with the
+periodogram's fixed ``1..2K`` and a cubic the sidereal period's sigma was 2x too wide and
+its bias 2.4 times its scatter on a light curve with 4 harmonics and an amplitude change,
+bench/bench_period_synodic_model.py). The sidereal period of this fit replaces the synodic
+one only when asked (``apply``; ``speclight period --synodic bisector``) and when its
+chi-square is lower than the plain fit's (same model, so the same number of parameters),
+i.e. when the light curve does follow the bisector. It is not applied by default: on the
+built-in box-wing pass (spin axis passing within 15 deg of the observer) the light curve
+follows the Sun's fixed direction more than the bisector, and the correction moves a
+period found within 0.6 % of the truth 2-6 % away from it (docs/period.md). ``Omega``
+(weighted least-squares slope of ``phi`` against time, weights ``sum_b 1/sigma^2`` per
+epoch) and the linear relation's period are reported for comparison. Without a known spin
+axis the correction is bounded by the PAB's angular speed on the sky, ``|Omega| <=
+|dPAB/dt|``: ``|P_sid - P_syn| <= P^2 |dPAB/dt| / (2 pi)`` (first order), reported instead.
 """
 
 from __future__ import annotations
@@ -39,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from speclight.estimate.period.peak_refinement import refine_peak
+from speclight.estimate.period.peak_refinement import refine_peak, refine_with_model
 from speclight.estimate.period.periodogram import (
     F64,
     TREND_DEGREE,
@@ -134,6 +138,7 @@ def sidereal_period(
     axis_gcrs: F64 | None,
     apply: bool = True,
     not_applied_why: str = "not asked for (--synodic bisector applies it)",
+    choose_model: bool = True,
 ) -> SynodicCorrection:
     """The sidereal period by the bisector-phase fit (module docstring); without an axis,
     only the bound.
@@ -158,6 +163,11 @@ def sidereal_period(
         Apply the fit to the period (``False``: reported, not applied).
     not_applied_why
         Why it is not applied, written into the correction's ``method``.
+    choose_model
+        Choose the fits' model in the bisector's frame
+        (:func:`.peak_refinement.refine_with_model` from harmonics ``1..2K`` of the rotation
+        frequency and a cubic; the plain fit then takes the same model); ``False``: both
+        keep ``1..2K`` and a cubic (for comparison, bench/bench_period_synodic_model.py).
     """
     speed = bisector_angular_speed(t_s, pab_gcrs, weight)
     bound = float(synodic_period_s**2 * speed / (2 * np.pi))
@@ -175,12 +185,18 @@ def sidereal_period(
     phase = np.interp(series.t_s, t_s, phi)
     orders = list(range(1, 2 * harmonics + 1))
     f_syn = 1.0 / synodic_period_s
-    plain = refine_peak(series, f_syn, orders)
     reach = max(1.5 * abs(rate) / (2 * np.pi), 1.0 / series.span_s)
     grid = np.arange(f_syn - reach, f_syn + reach, 0.1 / series.span_s)
     grid = grid[grid > 0]
     chi = [harmonic_chi2(series, f, orders, phase, TREND_DEGREE)[0] for f in grid]
-    fitted = refine_peak(series, float(grid[int(np.argmin(chi))]), orders, phase)
+    start = float(grid[int(np.argmin(chi))])
+    if choose_model:
+        fitted = refine_with_model(series, start, 2 * harmonics, phase_rad=phase)
+        orders = fitted.orders
+    else:
+        fitted = refine_peak(series, start, orders, phase)
+    degree, change = fitted.trend_degree, fitted.amplitude_change
+    plain = refine_peak(series, f_syn, orders, trend_degree=degree, amplitude_change=change)
     common = (
         f"Omega = {rate:.4g} rad/s (weighted mean rate of the phase-angle bisector's azimuth "
         f"about the spin axis; linear relation P_sid = 1/(1/P_syn + Omega/(2 pi)) = "
