@@ -24,6 +24,7 @@ from speclight.estimate.shape.tumbling import (
     fit_tumbling,
     same_family,
 )
+from speclight.estimate.shape.tumbling_light import ConvexLight
 from speclight.estimate.shape.tumbling_mirror import mirror_plane, mirror_state
 from speclight.estimate.shape.tumbling_run import add_tumbling
 from speclight.target import shapes
@@ -100,9 +101,10 @@ def rendered_far_fit():
     normals, areas = mesh_facets(parts)
     law = scattering_law("lambert")
     common = dict(min_period_h=0.03, max_period_h=0.1, n_starts=0, t0_jd=t_jd[0])
-    fit = fit_tumbling(data, normals, areas, law, initial_states=[far], rate_span=0.015, **common)
+    convex = ConvexLight(normals, areas, law)
+    fit = fit_tumbling(data, convex, initial_states=[far], rate_span=0.015, **common)
     at_truth = fit_tumbling(
-        data, normals, areas, law, initial_states=[truth], rate_span=0.0, grid=False, **common
+        data, convex, initial_states=[truth], rate_span=0.0, grid=False, **common
     )
     mirror = mirror_state(truth, mirror_plane(sun, obs)[0])
     return fit, at_truth, truth, mirror
@@ -148,7 +150,7 @@ def test_far_start_recovers_the_state_when_the_model_is_right():
         np.repeat([0, 1], 60), np.array([False, False]), "tf",
     )  # fmt: skip
     fit = fit_tumbling(
-        data, normals, areas, law, min_period_h=0.03, max_period_h=0.1, n_starts=0,
+        data, ConvexLight(normals, areas, law), min_period_h=0.03, max_period_h=0.1, n_starts=0,
         initial_states=[_far_start()], t0_jd=t_jd[0], rate_span=0.015,
     )  # fmt: skip
     assert any(same_family(f[0], TumblingState(Q0, W0, MOMENTS, 0.0)) for f in fit.families)
@@ -190,7 +192,7 @@ def test_principal_axis_rotation_is_not_tumbling():
         np.repeat([0, 1], 60), np.array([False, False]), "pa",
     )  # fmt: skip
     fit = fit_tumbling(
-        data, normals, areas, law, min_period_h=0.03, max_period_h=0.1, n_starts=0,
+        data, ConvexLight(normals, areas, law), min_period_h=0.03, max_period_h=0.1, n_starts=0,
         t0_jd=t_jd[0], rate_span=0.015,
     )  # fmt: skip
     assert not fit.detected
@@ -222,7 +224,7 @@ def test_principal_axis_rotation_is_not_tumbling_fast():
     tilt = Rotation.from_rotvec(np.deg2rad(20.0) * np.array([1.0, 0.0, 0.0]))
     start = TumblingState(Q0, tilt.apply(w0), np.array([0.6, 0.9, 1.0]), 0.0)
     fit = fit_tumbling(
-        data, normals, areas, law, min_period_h=0.03, max_period_h=0.1, n_starts=0,
+        data, ConvexLight(normals, areas, law), min_period_h=0.03, max_period_h=0.1, n_starts=0,
         initial_states=[start], t0_jd=t_jd[0], rate_span=0.0, grid=False,
     )  # fmt: skip
     assert not fit.detected
