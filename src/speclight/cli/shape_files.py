@@ -34,6 +34,7 @@ def shape_files(
     force: bool,
     bands: list[str] | None = None,
     tumbling_starts: int = 0,
+    tumbling_map: Path | None = None,
 ) -> tuple[xr.Dataset, ShapeRun]:
     """Read ``lc``, invert it, write ``output``, its OBJ and the figure ``plot``.
 
@@ -55,12 +56,19 @@ def shape_files(
         Bands averaged into the brightness (default all).
     tumbling_starts
         Random starts of the tumbling fit (:mod:`speclight.estimate.shape.tumbling_run`; 0: none).
+    tumbling_map
+        Reflectivity map of the target as the tumbling fit's light model (None: the convex
+        model of the scenario's mesh); its header is checked before the run.
     """
     from speclight.io.netcdf import dataset_bytes
     from speclight.io.output import OutputClaim
     from speclight.plot.figure_output import claim_outputs
 
     check_format(fmt)
+    if tumbling_map is not None:
+        from speclight.maps.map_lookup import read_header
+
+        read_header(tumbling_map)  # a complete map, before the run
     inputs = {"light curves": lc, **({"scenario file": scenario} if scenario else {})}
     obj = obj_path(output)
     with claim_outputs(output, plot, force, inputs) as (claim, figure), ExitStack() as stack:
@@ -87,6 +95,7 @@ def shape_files(
                     max_period_h=options.max_period_h,
                     n_starts=tumbling_starts,
                     seed=options.seed,
+                    map_path=tumbling_map,
                 ),
             )
         claim.write(dataset_bytes(ds))
