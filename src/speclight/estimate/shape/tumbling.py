@@ -1,12 +1,12 @@
 """Tumbling (non-principal-axis) rotation: the torque-free state fitted to light curves.
 
 The body's light model is given (``light``, :class:`.tumbling_light.LightModel`: e.g. the
-convex model of the scenario's mesh, or its reflectivity map); the state at ``t0`` is fitted: the attitude ``q0`` (body to
-ecliptic J2000, as a rotation vector), the body rates ``omega0`` [rad/s] and the principal
-moments (body axes principal) as ``I = tr(M) 1 - M`` of second moments
-``M = diag(exp(u1), exp(u2), 1)`` (any ``u`` gives moments that satisfy the triangle
-inequality of a real body), and for calibrated data a log-scale of the brightness. The attitude at
-each epoch comes from speclight's torque-free propagation
+convex model of the scenario's mesh, or its reflectivity map); the state at ``t0`` is
+fitted: the attitude ``q0`` (body to ecliptic J2000, as a rotation vector), the body rates
+``omega0`` [rad/s] and the principal moments (body axes principal) as ``I = tr(M) 1 - M``
+of second moments ``M = diag(exp(u1), exp(u2), 1)`` (any ``u`` gives moments that satisfy
+the triangle inequality of a real body), and for calibrated data a log-scale of the
+brightness. The attitude at each epoch comes from speclight's torque-free propagation
 (:func:`speclight.attitude.torque_free_attitude`, closed form), the brightness from the
 light model (:mod:`.tumbling_light`: the convex model of the EGI, without shadows, or the
 target's reflectivity map, with them).

@@ -103,8 +103,8 @@ def grid_starts(
     n_keep: int = N_KEEP,
 ) -> list[F64]:
     """The ``n_keep`` best grid states (module doc) for the points ``d`` at ``t_s`` [s]
-    from ``t0`` under the light model ``light`` (:mod:`.tumbling_light`), as the fit's state vectors (rotation vector, body rates [rad/s], ``u``,
-    log scale)."""
+    from ``t0`` under the light model ``light`` (:mod:`.tumbling_light`), as the fit's
+    state vectors (rotation vector, body rates [rad/s], ``u``, log scale)."""
     rot = Rotation.random(N_ATTITUDES, rng=rng)
     r_mat = rot.as_matrix()  # (S, 3, 3) body-to-ecliptic at t0
     sun = np.einsum("skj,nk->snj", r_mat, d.sun_ecliptic)  # R^T s, (S, N, 3)
