@@ -138,3 +138,35 @@ def test_band_map_light_refuses_other_bands(box_wing_map):
     with pytest.raises(InputError, match="bands") as err:
         band_map_light(path, ["nope"], bands.response[:1], bands.wavelength_nm)
     assert err.value.field == "map_path"
+
+
+def test_tumbling_run_uses_the_map_for_the_chosen_bands(box_wing_map):
+    """``speclight shape --map``'s light model (tumbling_run.py) is the map's mean factor
+    over the light curves' own bands (the ShapeInput's chosen ones, here the second band
+    alone); without bands (a DAMIT file) the map is refused, naming ``map_path``."""
+    from dataclasses import replace
+
+    from speclight.errors import InputError
+    from speclight.estimate.inputs.band_responses import scenario_band_responses
+    from speclight.estimate.shape.inversion_data import build_inversion_data
+    from speclight.estimate.shape.shape_inputs import ShapeInput
+    from speclight.estimate.shape.tumbling_run import _light
+
+    path, loaded = box_wing_map
+    bands = scenario_band_responses(loaded)
+    second = replace(bands, band_names=bands.band_names[1:2], response=bands.response[1:2])
+    one, three = np.ones((3, 3)), np.ones(3)
+    data = build_inversion_data(
+        np.arange(3.0), three, three, one, one, np.zeros(3, int), np.array([True]), "x"
+    )  # the light model does not read the points
+    inputs = ShapeInput(data, second.band_names, None, None, "m2 sr-1", "x", loaded, second)
+    light = _light(inputs, scattering_law("lambert"), path)
+    alone = band_map_light(path, second.band_names, second.response, bands.wavelength_nm)
+    both = band_map_light(path, bands.band_names[:2], bands.response[:2], bands.wavelength_nm)
+    sun, obs = sun_observer(healpix_directions(1), np.deg2rad(55.0), 0.4)
+    got = light(sun, obs, np.zeros(12))
+    assert np.array_equal(got, alone(sun, obs, np.zeros(12)))
+    assert not np.allclose(got, both(sun, obs, np.zeros(12)), rtol=1e-3)  # bands differ
+    with pytest.raises(InputError) as err:
+        _light(replace(inputs, bands=None), scattering_law("lambert"), path)
+    assert err.value.field == "map_path"
