@@ -26,7 +26,7 @@ moment ratios (within :data:`FAMILY_RELATIVE`); every family is reported.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -49,6 +49,7 @@ from speclight.estimate.shape.tumbling_search import (
     moments_from_u,
     window_schedule,
 )
+from speclight.estimate.shape.tumbling_state import TumblingState
 from speclight.estimate.shape.tumbling_uncertainty import rate_and_ratio_std
 
 F64 = NDArray[np.float64]
@@ -63,52 +64,6 @@ FIRST_EVALUATIONS = 60  # in the continuation's first window (many grid starts)
 N_SEEDS = 6
 PHASE_DRIFT = 0.2  # turns of phase drift over the gap between rate-scale trials
 RATE_SPAN = 0.03  # relative rate error of a seed curve's solution covered by the trials
-
-
-@dataclass(frozen=True)
-class TumblingState:
-    """One fitted torque-free state (module doc).
-
-    Attributes
-    ----------
-    q0
-        (4,) body-to-ecliptic quaternion at ``t0`` (scalar first).
-    omega0_body_rad_s
-        (3,) body rates at ``t0`` [rad/s].
-    moments
-        (3,) principal moments along the body axes, the largest 1 [1].
-    chi2
-        Sum of squared residuals.
-    scale
-        Factor on the brightness (calibrated data; 1 for relative).
-    std
-        (3,) standard deviations of the rate [rad/s] and of the two moment ratios
-        (:mod:`.tumbling_uncertainty`); NaN where not fitted.
-    """
-
-    q0: F64
-    omega0_body_rad_s: F64
-    moments: F64
-    chi2: float
-    scale: float = 1.0
-    std: F64 = field(default_factory=lambda: np.full(3, np.nan))
-
-    @property
-    def momentum_direction(self) -> F64:
-        """Unit angular momentum in ecliptic J2000."""
-        h = quat_rotate(self.q0, self.moments * self.omega0_body_rad_s)
-        return np.asarray(h / np.linalg.norm(h))
-
-    @property
-    def rate_rad_s(self) -> float:
-        """``|H| / I_max`` [rad/s]."""
-        return float(np.linalg.norm(self.moments * self.omega0_body_rad_s) / np.max(self.moments))
-
-    @property
-    def moment_ratios(self) -> F64:
-        """(2,) the smaller moments over the largest, sorted."""
-        m = np.sort(self.moments)
-        return np.asarray(m[:2] / m[2])
 
 
 @dataclass(frozen=True)

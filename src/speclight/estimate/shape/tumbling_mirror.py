@@ -17,14 +17,11 @@ rotator seen near the ecliptic (Kaasalainen & Lamberg 2006, Inverse Problems 22,
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-if TYPE_CHECKING:
-    from speclight.estimate.shape.tumbling import TumblingState
+from speclight.estimate.shape.tumbling_state import TumblingState
 
 F64 = NDArray[np.float64]
 
@@ -54,8 +51,6 @@ def mirror_state(state: TumblingState, normal: F64) -> TumblingState:
     """The mirror image of ``state`` through the plane of unit ``normal`` (module doc):
     attitude ``-M R(q0)``, the same body rates and moments (chi-square not evaluated:
     NaN)."""
-    from speclight.estimate.shape.tumbling import TumblingState
-
     reflect = np.eye(3) - 2.0 * np.outer(normal, normal)
     r_body = Rotation.from_quat(state.q0, scalar_first=True).as_matrix()
     q = Rotation.from_matrix(-reflect @ r_body).as_quat(scalar_first=True)
