@@ -96,14 +96,18 @@ def shape(
             ("--nside", nside, nside in (1, 2, 4, 8, 16)),
             ("--bootstrap", bootstrap, bootstrap >= 0),
             ("--tumbling-starts", tumbling_starts, tumbling_starts >= 0),
-            ("--map", tumbling_map, tumbling_map is None or tumbling_starts > 0),
         ):
             if not ok:
                 raise InputError(
-                    f"{name} = {value} is not accepted (nside: 1, 2, 4, 8 or 16; --map: "
-                    "with --tumbling-starts > 0; the others: >= 0)",
+                    f"{name} = {value} is not accepted (nside: 1, 2, 4, 8 or 16; the others: >= 0)",
                     field=name,
                 )
+        if tumbling_map is not None and tumbling_starts == 0:
+            raise InputError(
+                f"--map {tumbling_map} is the tumbling fit's light model: give it with "
+                "--tumbling-starts N (N > 0)",
+                field="--map",
+            )
         names = [b.strip() for b in bands.split(",") if b.strip()] if bands else None
         options = ShapeOptions(
             *period_range_h,

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import xarray as xr
 
+from speclight.errors import InputError
 from speclight.estimate.shape.minkowski import format_obj
 from speclight.estimate.shape.shape_dataset import shape_dataset
 from speclight.estimate.shape.shape_inputs import check_format, read_shape_input
@@ -68,7 +69,10 @@ def shape_files(
     if tumbling_map is not None:
         from speclight.maps.map_lookup import read_header
 
-        read_header(tumbling_map)  # a complete map, before the run
+        try:
+            read_header(tumbling_map)  # a complete map, before the run
+        except InputError as exc:
+            raise InputError(exc.message, field="map_path") from None
     inputs = {"light curves": lc, **({"scenario file": scenario} if scenario else {})}
     obj = obj_path(output)
     with claim_outputs(output, plot, force, inputs) as (claim, figure), ExitStack() as stack:

@@ -171,7 +171,8 @@ def test_far_start_recovers_the_state_when_the_model_is_right():
     strict=True,
     reason="issue 27 item 3 open: the convex model lacks the shadows of the rendered "
     "box-wing, and its best fit (chi2 3803 against 7497 for the truth's own) has the "
-    "smaller moment ratio 0.53 where the truth has 0.45 (3.9 sigma); BENCHMARKS.md",
+    "smaller moment ratio 0.53 where the truth has 0.45 (3.9 sigma); BENCHMARKS.md. With "
+    "the reflectivity map as the light model it is recovered (the test below)",
 )
 def test_torque_free_box_wing_state_recovered(rendered_far_fit):
     fit, _, truth, mirror = rendered_far_fit
