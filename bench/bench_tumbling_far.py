@@ -29,6 +29,7 @@ from speclight.estimate.shape.egi import mesh_facets
 from speclight.estimate.shape.inversion_data import build_inversion_data
 from speclight.estimate.shape.scattering import scattering_law
 from speclight.estimate.shape.tumbling import TumblingState, fit_tumbling, same_family
+from speclight.estimate.shape.tumbling_light import ConvexLight
 from speclight.estimate.shape.tumbling_mirror import mirror_plane, mirror_state
 from speclight.estimate.shape.tumbling_search import moments_from_u
 from speclight.target import shapes
@@ -86,7 +87,7 @@ def main() -> None:
         )  # fmt: skip
         start = time.process_time()
         fit = fit_tumbling(
-            data, normals, areas, law, min_period_h=0.03, max_period_h=0.1,
+            data, ConvexLight(normals, areas, law), min_period_h=0.03, max_period_h=0.1,
             n_starts=0 if a.method == "grid" else a.random_starts,
             seed=k, t0_jd=t_jd[0], rate_span=0.015, grid=a.method == "grid",
         )  # fmt: skip

@@ -79,6 +79,8 @@ def test_shape_bad_input_exits_2(tmp_path):
         (["--format", "damlt"], "damit"),
         (["--format", "damit", "--law", "lamb"], "lambert"),
         (["--format", "damit", "--nside", "3"], "nside"),
+        (["--format", "damit", "--map", str(tmp_path / "m.zarr")], "--tumbling-starts"),
+        (["--format", "damit", "--tumbling-starts", "1", "--map", str(lc)], "Zarr"),
     ):
         result = CliRunner().invoke(app, [*base, *extra])
         assert result.exit_code == 2, result.output

@@ -16,7 +16,7 @@ from speclight.errors import InputError
 SHAPE_FLAGS = {
     "fmt": "--format", "period_range_h": "--period-range-h", "law": "--law",
     "bands": "--bands", "nside": "--nside", "pole_step_deg": "--pole-step-deg",
-    "loaded": "--scenario", "n_starts": "--tumbling-starts",
+    "loaded": "--scenario", "n_starts": "--tumbling-starts", "map_path": "--map",
 }  # fmt: skip
 
 
@@ -68,6 +68,16 @@ def shape(
             "this many random starts, the scenario's target as the EGI (0: off).",
         ),
     ] = 0,
+    tumbling_map: Annotated[
+        Path | None,
+        typer.Option(
+            "--map",
+            metavar="MAP.zarr",
+            help="Reflectivity map of the scenario's target (speclight reflectivity-map) as "
+            "the tumbling fit's light model, with the shadows (default: the mesh's convex "
+            "model). Needs --tumbling-starts.",
+        ),
+    ] = None,
     plot_file: Plot = None,
     force: Force = False,
 ) -> None:
@@ -92,6 +102,12 @@ def shape(
                     f"{name} = {value} is not accepted (nside: 1, 2, 4, 8 or 16; the others: >= 0)",
                     field=name,
                 )
+        if tumbling_map is not None and tumbling_starts == 0:
+            raise InputError(
+                f"--map {tumbling_map} is the tumbling fit's light model: give it with "
+                "--tumbling-starts N (N > 0)",
+                field="--map",
+            )
         names = [b.strip() for b in bands.split(",") if b.strip()] if bands else None
         options = ShapeOptions(
             *period_range_h,
@@ -107,6 +123,7 @@ def shape(
             ds, _ = shape_files(
                 lc=lc, fmt=fmt, scenario=scenario, options=options, output=output,
                 plot=plot_file, force=force, bands=names, tumbling_starts=tumbling_starts,
+                tumbling_map=tumbling_map,
             )  # fmt: skip
         a = ds.attrs
         if "tumbling_families" in a:

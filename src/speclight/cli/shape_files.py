@@ -12,6 +12,7 @@ from pathlib import Path
 
 import xarray as xr
 
+from speclight.errors import InputError
 from speclight.estimate.shape.minkowski import format_obj
 from speclight.estimate.shape.shape_dataset import shape_dataset
 from speclight.estimate.shape.shape_inputs import check_format, read_shape_input
@@ -34,6 +35,7 @@ def shape_files(
     force: bool,
     bands: list[str] | None = None,
     tumbling_starts: int = 0,
+    tumbling_map: Path | None = None,
 ) -> tuple[xr.Dataset, ShapeRun]:
     """Read ``lc``, invert it, write ``output``, its OBJ and the figure ``plot``.
 
@@ -55,12 +57,22 @@ def shape_files(
         Bands averaged into the brightness (default all).
     tumbling_starts
         Random starts of the tumbling fit (:mod:`speclight.estimate.shape.tumbling_run`; 0: none).
+    tumbling_map
+        Reflectivity map of the target as the tumbling fit's light model (None: the convex
+        model of the scenario's mesh); its header is checked before the run.
     """
     from speclight.io.netcdf import dataset_bytes
     from speclight.io.output import OutputClaim
     from speclight.plot.figure_output import claim_outputs
 
     check_format(fmt)
+    if tumbling_map is not None:
+        from speclight.maps.map_lookup import read_header
+
+        try:
+            read_header(tumbling_map)  # a complete map, before the run
+        except InputError as exc:
+            raise InputError(exc.message, field="map_path") from None
     inputs = {"light curves": lc, **({"scenario file": scenario} if scenario else {})}
     obj = obj_path(output)
     with claim_outputs(output, plot, force, inputs) as (claim, figure), ExitStack() as stack:
@@ -87,6 +99,7 @@ def shape_files(
                     max_period_h=options.max_period_h,
                     n_starts=tumbling_starts,
                     seed=options.seed,
+                    map_path=tumbling_map,
                 ),
             )
         claim.write(dataset_bytes(ds))

@@ -1,14 +1,15 @@
 """Tumbling (non-principal-axis) rotation: the torque-free state fitted to light curves.
 
-The body's EGI (``normals``, ``areas``: e.g. the scenario's mesh, :func:`.egi.mesh_egi`) and
-scattering law are given; the state at ``t0`` is fitted: the attitude ``q0`` (body to
-ecliptic J2000, as a rotation vector), the body rates ``omega0`` [rad/s] and the principal
-moments (body axes principal) as ``I = tr(M) 1 - M`` of second moments
-``M = diag(exp(u1), exp(u2), 1)`` (any ``u`` gives moments that satisfy the triangle
-inequality of a real body), and for calibrated data a log-scale of the areas. The attitude at
-each epoch comes from speclight's torque-free propagation
+The body's light model is given (``light``, :class:`.tumbling_light.LightModel`: e.g. the
+convex model of the scenario's mesh, or its reflectivity map); the state at ``t0`` is
+fitted: the attitude ``q0`` (body to ecliptic J2000, as a rotation vector), the body rates
+``omega0`` [rad/s] and the principal moments (body axes principal) as ``I = tr(M) 1 - M``
+of second moments ``M = diag(exp(u1), exp(u2), 1)`` (any ``u`` gives moments that satisfy
+the triangle inequality of a real body), and for calibrated data a log-scale of the
+brightness. The attitude at each epoch comes from speclight's torque-free propagation
 (:func:`speclight.attitude.torque_free_attitude`, closed form), the brightness from the
-convex model (:func:`.convex_model.facet_brightness`).
+light model (:mod:`.tumbling_light`: the convex model of the EGI, without shadows, or the
+target's reflectivity map, with them).
 
 Light curves do not fix the state uniquely (Kaasalainen 2001, A&A 376, 302; Pravec et al.
 2005, Icarus 173, 108): a body symmetry maps a state onto another with the same light
@@ -25,7 +26,7 @@ moment ratios (within :data:`FAMILY_RELATIVE`); every family is reported.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -35,10 +36,10 @@ from scipy.spatial.transform import Rotation
 
 from speclight.attitude import torque_free_attitude
 from speclight.attitude.quaternion import quat_conjugate, quat_rotate
-from speclight.estimate.shape.convex_model import facet_brightness, relative_residuals
+from speclight.estimate.shape.convex_model import relative_residuals
 from speclight.estimate.shape.ecliptic import angular_distance_deg
 from speclight.estimate.shape.inversion_data import InversionData
-from speclight.estimate.shape.scattering import ScatteringLaw
+from speclight.estimate.shape.tumbling_light import LightModel
 from speclight.estimate.shape.tumbling_mirror import mirror_plane, mirror_state
 from speclight.estimate.shape.tumbling_principal import ALPHA as PRINCIPAL_ALPHA
 from speclight.estimate.shape.tumbling_principal import lag1_correlation, principal_axis_test
@@ -48,6 +49,7 @@ from speclight.estimate.shape.tumbling_search import (
     moments_from_u,
     window_schedule,
 )
+from speclight.estimate.shape.tumbling_state import TumblingState
 from speclight.estimate.shape.tumbling_uncertainty import rate_and_ratio_std
 
 F64 = NDArray[np.float64]
@@ -62,52 +64,6 @@ FIRST_EVALUATIONS = 60  # in the continuation's first window (many grid starts)
 N_SEEDS = 6
 PHASE_DRIFT = 0.2  # turns of phase drift over the gap between rate-scale trials
 RATE_SPAN = 0.03  # relative rate error of a seed curve's solution covered by the trials
-
-
-@dataclass(frozen=True)
-class TumblingState:
-    """One fitted torque-free state (module doc).
-
-    Attributes
-    ----------
-    q0
-        (4,) body-to-ecliptic quaternion at ``t0`` (scalar first).
-    omega0_body_rad_s
-        (3,) body rates at ``t0`` [rad/s].
-    moments
-        (3,) principal moments along the body axes, the largest 1 [1].
-    chi2
-        Sum of squared residuals.
-    scale
-        Factor on the areas (calibrated data; 1 for relative).
-    std
-        (3,) standard deviations of the rate [rad/s] and of the two moment ratios
-        (:mod:`.tumbling_uncertainty`); NaN where not fitted.
-    """
-
-    q0: F64
-    omega0_body_rad_s: F64
-    moments: F64
-    chi2: float
-    scale: float = 1.0
-    std: F64 = field(default_factory=lambda: np.full(3, np.nan))
-
-    @property
-    def momentum_direction(self) -> F64:
-        """Unit angular momentum in ecliptic J2000."""
-        h = quat_rotate(self.q0, self.moments * self.omega0_body_rad_s)
-        return np.asarray(h / np.linalg.norm(h))
-
-    @property
-    def rate_rad_s(self) -> float:
-        """``|H| / I_max`` [rad/s]."""
-        return float(np.linalg.norm(self.moments * self.omega0_body_rad_s) / np.max(self.moments))
-
-    @property
-    def moment_ratios(self) -> F64:
-        """(2,) the smaller moments over the largest, sorted."""
-        m = np.sort(self.moments)
-        return np.asarray(m[:2] / m[2])
 
 
 @dataclass(frozen=True)
@@ -132,10 +88,8 @@ class TumblingFit:
 
 
 class _Problem:
-    def __init__(
-        self, data: InversionData, normals: F64, areas: F64, law: ScatteringLaw, t0_jd: float
-    ) -> None:
-        self.data, self.normals, self.areas, self.law = data, normals, areas, law
+    def __init__(self, data: InversionData, light: LightModel, t0_jd: float) -> None:
+        self.data, self.light = data, light
         self.t0_jd = t0_jd
         self.t_s = (data.time_jd - t0_jd) * SECONDS_PER_DAY
         self.calibrated = bool(np.any(data.calibrated))
@@ -151,17 +105,13 @@ class _Problem:
         qc = quat_conjugate(q)
         s_b = quat_rotate(qc, self.data.sun_ecliptic)
         o_b = quat_rotate(qc, self.data.observer_ecliptic)
-        lum = scale * facet_brightness(
-            s_b, o_b, self.normals, self.areas, self.law, self.data.cos_half_phase
-        )
+        lum = scale * self.light(s_b, o_b, self.data.cos_half_phase)
         return relative_residuals(self.data, lum)
 
 
 def fit_tumbling(
     data: InversionData,
-    normals: F64,
-    areas: F64,
-    law: ScatteringLaw,
+    light: LightModel,
     *,
     min_period_h: float,
     max_period_h: float,
@@ -195,9 +145,7 @@ def fit_tumbling(
     with threadpool_limits(limits=1, user_api="blas"):  # small matrices (shape_run.py)
         return _fit_tumbling(
             data,
-            normals,
-            areas,
-            law,
+            light,
             min_period_h,
             max_period_h,
             n_starts,
@@ -211,9 +159,7 @@ def fit_tumbling(
 
 def _fit_tumbling(
     data: InversionData,
-    normals: F64,
-    areas: F64,
-    law: ScatteringLaw,
+    light: LightModel,
     min_period_h: float,
     max_period_h: float,
     n_starts: int,
@@ -230,12 +176,12 @@ def _fit_tumbling(
         t0_jd = float(np.mean(data.time_jd[in_seed][[0, -1]]))
     rng = np.random.default_rng(seed)
     seed_data = data.subset(in_seed)
-    seed_prob = _Problem(seed_data, normals, areas, law, t0_jd)
+    seed_prob = _Problem(seed_data, light, t0_jd)
     x_starts = [_state_vector(s, 1.0) for s in initial_states or []]
     x_starts += [_random_start(rng, min_period_h, max_period_h) for _ in range(n_starts)]
     first = _continued(seed_prob, x_starts, min_period_h, max_period_h, grid, rng)
     seeds = [fam[0] for fam in _families(_within(first, seed_prob))][:N_SEEDS]
-    prob = _Problem(data, normals, areas, law, t0_jd)
+    prob = _Problem(data, light, t0_jd)
     if data.n_curves == 1:
         final = first
     else:
@@ -278,14 +224,12 @@ def _continued(
     starts = list(x_starts)
     for k, half in enumerate(halves):
         index = np.flatnonzero(np.abs(prob.t_s) <= half)
-        window = _Problem(d.subset(index), prob.normals, prob.areas, prob.law, t0_jd)
+        window = _Problem(d.subset(index), prob.light, t0_jd)
         if k == 0 and grid:
             starts += grid_starts(
                 window.data,
                 window.t_s,
-                prob.normals,
-                prob.areas,
-                prob.law,
+                prob.light,
                 min_period_h=min_period_h,
                 max_period_h=max_period_h,
                 rng=rng,

@@ -17,25 +17,13 @@ rotator seen near the ecliptic (Kaasalainen & Lamberg 2006, Inverse Problems 22,
 
 from __future__ import annotations
 
-import dataclasses
-from typing import Protocol, TypeVar
-
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
+from speclight.estimate.shape.tumbling_state import TumblingState
+
 F64 = NDArray[np.float64]
-
-
-class _Attitude(Protocol):
-    """A state with ``q0`` and ``chi2`` fields (:class:`.tumbling.TumblingState`; not imported
-    here: the fit imports this module)."""
-
-    @property
-    def q0(self) -> F64: ...
-
-
-State = TypeVar("State", bound=_Attitude)
 
 
 def mirror_plane(sun: F64, observer: F64) -> tuple[F64, float]:
@@ -59,11 +47,13 @@ def mirror_plane(sun: F64, observer: F64) -> tuple[F64, float]:
     return np.asarray(vt[2]), float(singular[2] / np.sqrt(v.shape[0]))
 
 
-def mirror_state(state: State, normal: F64) -> State:
+def mirror_state(state: TumblingState, normal: F64) -> TumblingState:
     """The mirror image of ``state`` through the plane of unit ``normal`` (module doc):
     attitude ``-M R(q0)``, the same body rates and moments (chi-square not evaluated:
     NaN)."""
     reflect = np.eye(3) - 2.0 * np.outer(normal, normal)
     r_body = Rotation.from_quat(state.q0, scalar_first=True).as_matrix()
     q = Rotation.from_matrix(-reflect @ r_body).as_quat(scalar_first=True)
-    return dataclasses.replace(state, q0=np.asarray(q), chi2=float("nan"))  # type: ignore[type-var]
+    return TumblingState(
+        np.asarray(q), state.omega0_body_rad_s, state.moments, float("nan"), state.scale
+    )

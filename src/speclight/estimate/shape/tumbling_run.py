@@ -1,8 +1,11 @@
 """Tumbling states for ``speclight shape --tumbling-starts N``: the scenario's target as the
 EGI, its torque-free attitude (when it has one) as a first start, the families as data.
 
-The EGI is the scenario's target mesh (:func:`.egi.mesh_facets`: faces as the render sees
-them, without the shadows parts cast on each other); the law is the run's. Variables added
+The light model (:mod:`.tumbling_light`) is the convex model of the scenario's target mesh
+(:func:`.egi.mesh_facets`: faces as the render sees them, without the shadows parts cast on
+each other) under the run's law, or, with ``map_path``, the target's reflectivity map (made
+by ``speclight reflectivity-map`` from the same scenario: rendered, so with the shadows),
+its band rates turned into the mean reflectance factor of the light curves' bands. Variables added
 to SHAPE.nc along ``family`` (lowest chi-square first): ``tumbling_chi2``,
 ``tumbling_momentum_direction(family, xyz)`` (ecliptic J2000), ``tumbling_rate`` [rad s-1],
 ``tumbling_moment_ratio(family, ratio)``, their standard deviations ``tumbling_rate_std``
@@ -14,6 +17,8 @@ correlation counted), ``tumbling_members``, the best state's
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import xarray as xr
 
@@ -23,6 +28,7 @@ from speclight.estimate.shape.egi import mesh_facets
 from speclight.estimate.shape.scattering import ScatteringLaw
 from speclight.estimate.shape.shape_inputs import ShapeInput
 from speclight.estimate.shape.tumbling import TumblingFit, TumblingState, fit_tumbling
+from speclight.estimate.shape.tumbling_light import ConvexLight, LightModel, band_map_light
 
 
 def _prior(inputs: ShapeInput, t0_jd: float) -> list[TumblingState]:
@@ -60,6 +66,7 @@ def tumbling_fit(
     max_period_h: float,
     n_starts: int,
     seed: int,
+    map_path: str | Path | None = None,
 ) -> TumblingFit:
     """Fit the torque-free state of the scenario's target to ``inputs`` (module doc)."""
     if inputs.loaded is None or inputs.loaded.scenario.target is None:
@@ -67,20 +74,13 @@ def tumbling_fit(
             "tumbling states need a scenario with a target (its mesh is the EGI): give `loaded`",
             field="n_starts",
         )
-    from speclight.simulation.reflection import build_target
-
-    target = build_target(inputs.loaded)
-    normals, areas = mesh_facets(
-        [(p.vertices_m, p.faces) for p in target.parts if p.sphere_radius_m is None]
-    )
     d = inputs.data
+    light = _light(inputs, law, map_path)
     seed_curve = int(np.argmax(np.bincount(d.curve)))
     t0 = float(np.mean(d.time_jd[d.curve == seed_curve][[0, -1]]))
     return fit_tumbling(
         d,
-        normals,
-        areas,
-        law,
+        light,
         min_period_h=min_period_h,
         max_period_h=max_period_h,
         n_starts=n_starts,
@@ -88,6 +88,26 @@ def tumbling_fit(
         initial_states=_prior(inputs, t0),
         t0_jd=t0,
     )
+
+
+def _light(inputs: ShapeInput, law: ScatteringLaw, map_path: str | Path | None) -> LightModel:
+    """The map's light model with ``map_path``, else the convex model of the target's mesh."""
+    assert inputs.loaded is not None
+    if map_path is not None:
+        if inputs.bands is None:
+            raise InputError(
+                "a reflectivity map needs speclight light curves (band rates), not DAMIT's",
+                field="map_path",
+            )
+        b = inputs.bands  # the bands averaged into the brightness
+        return band_map_light(map_path, b.band_names, b.response, b.wavelength_nm)
+    from speclight.simulation.reflection import build_target
+
+    target = build_target(inputs.loaded)
+    normals, areas = mesh_facets(
+        [(p.vertices_m, p.faces) for p in target.parts if p.sphere_radius_m is None]
+    )
+    return ConvexLight(normals, areas, law)
 
 
 def add_tumbling(ds: xr.Dataset, fit: TumblingFit) -> xr.Dataset:

@@ -22,9 +22,8 @@ from scipy.spatial.transform import Rotation
 
 from speclight.attitude import torque_free_attitude
 from speclight.attitude.quaternion import quat_to_matrix
-from speclight.estimate.shape.convex_model import facet_brightness
 from speclight.estimate.shape.inversion_data import InversionData
-from speclight.estimate.shape.scattering import ScatteringLaw
+from speclight.estimate.shape.tumbling_light import LightModel
 
 F64 = NDArray[np.float64]
 SECONDS_PER_DAY = 86400.0
@@ -96,9 +95,7 @@ def _misfit(d: InversionData, lum: F64) -> F64:
 def grid_starts(
     d: InversionData,
     t_s: F64,
-    normals: F64,
-    areas: F64,
-    law: ScatteringLaw,
+    light: LightModel,
     *,
     min_period_h: float,
     max_period_h: float,
@@ -106,8 +103,8 @@ def grid_starts(
     n_keep: int = N_KEEP,
 ) -> list[F64]:
     """The ``n_keep`` best grid states (module doc) for the points ``d`` at ``t_s`` [s]
-    from ``t0``, as the fit's state vectors (rotation vector, body rates [rad/s], ``u``,
-    log scale)."""
+    from ``t0`` under the light model ``light`` (:mod:`.tumbling_light`), as the fit's
+    state vectors (rotation vector, body rates [rad/s], ``u``, log scale)."""
     rot = Rotation.random(N_ATTITUDES, rng=rng)
     r_mat = rot.as_matrix()  # (S, 3, 3) body-to-ecliptic at t0
     sun = np.einsum("skj,nk->snj", r_mat, d.sun_ecliptic)  # R^T s, (S, N, 3)
@@ -126,7 +123,7 @@ def grid_starts(
                     m_ref = quat_to_matrix(q)  # (N, 3, 3) body at t to body at t0
                     s_b = np.einsum("nkj,snk->snj", m_ref, sun).reshape(-1, 3)
                     o_b = np.einsum("nkj,snk->snj", m_ref, obs).reshape(-1, 3)
-                    lum = facet_brightness(s_b, o_b, normals, areas, law, chp)
+                    lum = light(s_b, o_b, chp)
                     chi2 = _misfit(d, lum.reshape(N_ATTITUDES, -1))
                     for s in np.argsort(chi2)[:n_keep]:
                         x = np.concatenate([rot[int(s)].as_rotvec(), w0, u, [0.0]])
