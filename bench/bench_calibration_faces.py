@@ -17,7 +17,8 @@ simulated rates in the six roughness values (central differences of half step
 * the linearised maximum-likelihood estimate ``(J^T W J)^-1 J^T W (m - c)`` of the side
   faces with ``+z`` and ``-z`` held at the truth, from the draw's measurements and from
   :data:`bench_calibration_fit.GENERATOR_DRAWS` new draws of the simulation's own noise
-  generator, divided by either sigma;
+  generator (seeded after the draw's own seed, so that no two draws share noise), divided
+  by either sigma;
 * the deviance per measurement at the truth.
 
 ``--fits N`` also fits the first N draws from their far start (default method) and prints
@@ -90,9 +91,10 @@ def check(d: dict, lc: MeasuredLightCurve) -> dict[str, np.ndarray | float]:
     exposure = float(d["instrument"]["exposure_s"])
     read_e = float(d["instrument"]["noise"].get("read_noise_e", 0.0))
     background = (noise.background_e[0] - read_e**2) / exposure
+    first = int(d["instrument"]["noise"]["seed"]) + 1  # redraws differ between draws
     redraws = np.array([
         estimate(simulate_measurement(c, exposure, sky_count_rate_per_s=background,
-                                      read_noise_e=read_e, seed=k))
+                                      read_noise_e=read_e, seed=first + k))
         for k in range(GENERATOR_DRAWS)
     ])  # fmt: skip
     n_used = int(np.count_nonzero(likelihood.mask(c)))
