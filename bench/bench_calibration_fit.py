@@ -19,6 +19,8 @@ them with the default method from the start:
 * **faces** (``--kind faces``, not in ``both``): that cube with a material per face, each
   face's roughness drawn on its own, all started from one value; the ``+z`` and ``-z`` faces
   (along the spin axis) never glint, and the fit must say that it cannot constrain them.
+  Its fits take minutes: ``bench_calibration_faces.py`` checks the same draws at the truth
+  without fits (marginal and conditional Fisher sigmas, linearised pulls, noise redraws).
 
 It prints, per kind, the fraction recovered (converged, and within 3 reported sigmas of the
 truth), the standard deviation and the median absolute value of the pulls ``(estimate -
