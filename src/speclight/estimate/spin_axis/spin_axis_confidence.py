@@ -77,6 +77,8 @@ JACKKNIFE_BLOCKS = 10
 MAX_NOISE_RATIO = 10.0
 #: How the note of a flat surface starts.
 FLAT_NOTE = "the data do not constrain the axis"
+#: The tangent rotation ``x[:2]`` to the axis's (east, north) offset (:func:`_sigmas`).
+EAST_NORTH = np.array([[0.0, 1.0], [-1.0, 0.0]])
 
 
 @dataclass
@@ -147,15 +149,21 @@ def sandwich_covariance(r: F64, jac: F64, n_t: int) -> tuple[F64, F64, int]:
     return np.asarray(a_inv @ s @ a_inv, dtype=np.float64), a_inv, lag
 
 
-def jackknife_covariance(model: SpinMisfit, x0: F64, ranged: bool) -> F64:
-    """Delete-a-block jackknife covariance (K, K) of the parameters ``x`` (Efron & Stein
-    1981; Kuensch 1989, Ann. Stat. 17, 1217, doi:10.1214/aos/1176347265): the pass is cut
-    into :data:`JACKKNIFE_BLOCKS` runs of consecutive epochs, the fit is repeated without
-    each (L-BFGS-B with the analytic gradient, from ``x0``), and ``C = (G - 1) / G sum_g
-    (x_g - mean x)(x_g - mean x)^T``. It sees what the residuals do to the answer: noise
-    and a map error that varies along the pass alike."""
+def refit(model: SpinMisfit, x0: F64) -> F64:
+    """The parameters (K,) minimising ``model``'s misfit from ``x0`` (L-BFGS-B, analytic
+    gradient)."""
     from scipy.optimize import minimize
 
+    res = minimize(
+        model.misfit_and_gradient, x0, jac=True, method="L-BFGS-B",
+        options={"maxiter": 100, "ftol": 1e-12, "gtol": 1e-9},
+    )  # fmt: skip
+    return np.asarray(res.x, dtype=float)
+
+
+def jackknife_refits(model: SpinMisfit, x0: F64, ranged: bool) -> F64:
+    """The refits (G, K) of the delete-a-block jackknife: the pass cut into
+    :data:`JACKKNIFE_BLOCKS` runs of consecutive epochs, the fit repeated without each."""
     n_t = model.y.shape[0]
     edges = np.linspace(0, n_t, JACKKNIFE_BLOCKS + 1).astype(int)
     xs = []
@@ -173,14 +181,36 @@ def jackknife_covariance(model: SpinMisfit, x0: F64, ranged: bool) -> F64:
             if ranged and model.ranging is not None
             else model.ranging,
         )
-        res = minimize(
-            sub.misfit_and_gradient, x0, jac=True, method="L-BFGS-B",
-            options={"maxiter": 100, "ftol": 1e-12, "gtol": 1e-9},
-        )  # fmt: skip
-        xs.append(np.asarray(res.x, dtype=float))
-    x = np.array(xs)
-    d = x - x.mean(axis=0)
-    return np.asarray((JACKKNIFE_BLOCKS - 1) / JACKKNIFE_BLOCKS * (d.T @ d))
+        xs.append(refit(sub, x0))
+    return np.array(xs)
+
+
+def jackknife_spread(xs: F64) -> F64:
+    """``(G - 1) / G sum_g (x_g - mean x)(x_g - mean x)^T`` (K, K) of refits ``xs`` (G, K)."""
+    d = xs - xs.mean(axis=0)
+    return np.asarray((xs.shape[0] - 1) / xs.shape[0] * (d.T @ d))
+
+
+def jackknife_covariance(model: SpinMisfit, x0: F64, ranged: bool) -> F64:
+    """Delete-a-block jackknife covariance (K, K) of the parameters ``x`` (Efron & Stein
+    1981; Kuensch 1989, Ann. Stat. 17, 1217, doi:10.1214/aos/1176347265): the pass is cut
+    into :data:`JACKKNIFE_BLOCKS` runs of consecutive epochs, the fit is repeated without
+    each (:func:`jackknife_refits`, from ``x0``), and :func:`jackknife_spread` of the refits.
+    It sees what the residuals do to the answer: noise and a map error that varies along
+    the pass alike."""
+    return jackknife_spread(jackknife_refits(model, x0, ranged))
+
+
+def half_resolution(model: SpinMisfit) -> SpinMisfit | None:
+    """``model`` on its map coarsened to half its ``nside``
+    (:func:`.spin_axis_continuation.coarsen_map`), or None for ``nside`` 1 (none coarser);
+    the ranging term (its own map) is kept as it is."""
+    from speclight.estimate.spin_axis.spin_axis_continuation import coarsen_map
+
+    nside = model.bmap.header.nside
+    if nside < 2:
+        return None
+    return dataclasses.replace(model, bmap=coarsen_map(model.bmap, nside // 2, None))
 
 
 def map_error_covariance(model: SpinMisfit, x0: F64) -> F64:
@@ -188,27 +218,17 @@ def map_error_covariance(model: SpinMisfit, x0: F64) -> F64:
     halving the map's resolution.
 
     The map's HEALPix interpolation errs by ``k h^2`` (bilinear, ``h`` the pixel size), so
-    the answer refitted (L-BFGS-B, analytic gradient, from ``x0``) on the map coarsened to
-    half its ``nside`` (:func:`.spin_axis_continuation.coarsen_map`: ``2 h``, ``4 k h^2``)
-    moves by about 3 times what the map's error does to it: ``sigma_map = |shift| / 3`` on
-    each axis component (the shift's direction is that of the coarse map's error, not the
-    map's: only its size is used). Zero for a map of ``nside`` 1 (none coarser); the
-    ranging term (its own map) is kept as it is.
+    the answer refitted (:func:`refit`, from ``x0``) on the map coarsened to half its
+    ``nside`` (:func:`half_resolution`: ``2 h``, ``4 k h^2``) moves by about 3 times what
+    the map's error does to it: ``sigma_map = |shift| / 3`` on each axis component (the
+    shift's direction is that of the coarse map's error, not the map's: only its size is
+    used). Zero for a map of ``nside`` 1.
     """
-    from scipy.optimize import minimize
-
-    from speclight.estimate.spin_axis.spin_axis_continuation import coarsen_map
-
     k = x0.size
-    nside = model.bmap.header.nside
-    if nside < 2:
+    coarse = half_resolution(model)
+    if coarse is None:
         return np.zeros((k, k))
-    coarse = dataclasses.replace(model, bmap=coarsen_map(model.bmap, nside // 2, None))
-    res = minimize(
-        coarse.misfit_and_gradient, x0, jac=True, method="L-BFGS-B",
-        options={"maxiter": 100, "ftol": 1e-12, "gtol": 1e-9},
-    )  # fmt: skip
-    shift = np.asarray(res.x, dtype=float)[:2] - x0[:2]
+    shift = refit(coarse, x0)[:2] - x0[:2]
     if not np.all(np.isfinite(shift)):
         return np.zeros((k, k))
     out = np.zeros((k, k))
@@ -256,56 +276,77 @@ def axis_confidence(
         ``jackknife-map`` (that plus :func:`map_error_covariance`) or ``sandwich``
         (:func:`sandwich_covariance`).
     """
-    out = AxisConfidence()
+    cov = a_inv = None
+    lag, period_scale = 0, float("nan")
+    if np.all(np.isfinite(refined[:3])):
+        model = SpinMisfit.around(
+            bmap, geo, y, spin_body_axis, refined[0], refined[1], free_period,
+            ranging,  # type: ignore[arg-type]
+        )  # fmt: skip
+        x0 = np.array([0.0, 0.0, np.radians(refined[2])] + ([0.0] if free_period else []))
+        got = _covariance(model, x0, ranging is not None, method)
+        if got is not None:
+            cov, a_inv, lag = got
+        if free_period:
+            step = np.array([0, 0, 0, 1e-6])
+            period_scale = abs(model.period_s(x0 + step) - model.period_s(x0)) / 1e-6
+    return confidence_from_covariance(
+        cov, a_inv, error, dec_deg, ra_deg, refined, y, lag, period_scale
+    )
+
+
+def _covariance(
+    model: SpinMisfit, x0: F64, ranged: bool, method: str
+) -> tuple[F64, F64, int] | None:
+    """(C, A^-1, lag) of ``method`` (:func:`axis_confidence`), or None where the model has
+    no finite residuals or no gradient there."""
+    r, jac = model.residuals(x0)
+    if jac is None or not np.all(np.isfinite(r)) or not np.any(jac):
+        return None
+    cov, a_inv, lag = sandwich_covariance(r, jac, model.y.shape[0])
+    if method in ("jackknife", "jackknife-map"):  # plus the sandwich: never below the
+        cov = cov + jackknife_covariance(model, x0, ranged)  # local curvature
+    if method == "jackknife-map":
+        cov = cov + map_error_covariance(model, x0)
+    return cov, a_inv, lag
+
+
+def confidence_from_covariance(
+    cov: F64 | None,
+    a_inv: F64 | None,
+    error: F64,
+    dec_deg: F64,
+    ra_deg: F64,
+    refined: tuple[float, float, float, float],
+    y: F64,
+    hac_lag: int = 0,
+    period_scale: float = float("nan"),
+) -> AxisConfidence:
+    """Sigmas, regions and verdict from the parameters' covariance ``cov`` (K, K) and
+    ``A^-1`` (K, K) (None: no sigmas; module doc), the grid's misfit surface ``error``
+    (n_dec, n_ra) on cells ``dec_deg``, ``ra_deg`` [deg], the refined solution (RA, Dec,
+    phase [deg], misfit), the measured curves ``y`` (T, B) and, with a free period, the
+    period's change per unit of its parameter ``period_scale`` [s]."""
+    out = AxisConfidence(hac_lag=hac_lag)
     finite = np.isfinite(error)
     e_min = float(np.min(error[finite])) if finite.any() else float("nan")
     out.contrast = float(np.median(error[finite]) / e_min) if e_min > 0 else float("nan")
     out.noise_floor = noise_floor(y)
     if np.isfinite(refined[3]) and out.noise_floor > 0:
         out.noise_ratio = float(refined[3] / out.noise_floor)
-    if np.all(np.isfinite(refined[:3])):
-        _sigmas(out, bmap, geo, y, spin_body_axis, refined, free_period, ranging, method)
+    if cov is not None and a_inv is not None:
+        _sigmas(out, cov, a_inv, period_scale)
     _regions(out, error, dec_deg, ra_deg, refined)
     out.constrained, out.note = _verdict(out)
     return out
 
 
-def _sigmas(
-    out: AxisConfidence,
-    bmap: ReflectivityMap,
-    geo: EpochGeometry,
-    y: F64,
-    spin_body_axis: ArrayLike | None,
-    refined: tuple[float, float, float, float],
-    free_period: bool,
-    ranging: object | None,
-    method: str,
-) -> None:
-    model = SpinMisfit.around(
-        bmap,
-        geo,
-        y,
-        spin_body_axis,
-        refined[0],
-        refined[1],
-        free_period,
-        ranging,  # type: ignore[arg-type]
-    )
-    x0 = np.array([0.0, 0.0, np.radians(refined[2])] + ([0.0] if free_period else []))
-    r, jac = model.residuals(x0)
-    if jac is None or not np.all(np.isfinite(r)) or not np.any(jac):
-        return
-    cov, a_inv, out.hac_lag = sandwich_covariance(r, jac, y.shape[0])
-    if method in ("jackknife", "jackknife-map"):  # plus the sandwich: never below the
-        cov = cov + jackknife_covariance(model, x0, ranging is not None)  # local curvature
-    if method == "jackknife-map":
-        cov = cov + map_error_covariance(model, x0)
+def _sigmas(out: AxisConfidence, cov: F64, a_inv: F64, period_scale: float) -> None:
     # x = (a, b): a tilts the axis towards -b_frame... (:mod:`.spin_axis_gradient`): the
     # tangent rotation (a, b) moves the axis by (b, -a) in the frame's (x, y); x is the
     # ascending node (east), y north of it
-    t = np.array([[0.0, 1.0], [-1.0, 0.0]])
-    c_ax = t @ cov[:2, :2] @ t.T
-    a_ax = t @ a_inv[:2, :2] @ t.T
+    c_ax = EAST_NORTH @ cov[:2, :2] @ EAST_NORTH.T
+    a_ax = EAST_NORTH @ a_inv[:2, :2] @ EAST_NORTH.T
     var = np.diag(c_ax)
     if not np.all(np.isfinite(var)) or np.any(var <= 0):
         return
@@ -314,9 +355,8 @@ def _sigmas(
     out.correlation_east_north = float(c_ax[0, 1] / np.sqrt(var[0] * var[1]))
     out.sigma_axis_deg = float(np.sqrt(np.max(np.linalg.eigvalsh(c_ax)))) * deg
     out.sigma_phase_deg = float(np.sqrt(max(cov[2, 2], 0.0))) * deg
-    if free_period:
-        dp = abs(model.period_s(x0 + np.array([0, 0, 0, 1e-6])) - model.period_s(x0)) / 1e-6
-        out.sigma_period_s = float(np.sqrt(max(cov[3, 3], 0.0)) * dp)
+    if cov.shape[0] > 3 and np.isfinite(period_scale):
+        out.sigma_period_s = float(np.sqrt(max(cov[3, 3], 0.0)) * period_scale)
     try:
         out.misfit_per_chi2 = float(np.trace(c_ax @ np.linalg.inv(a_ax)) / 2.0)
     except np.linalg.LinAlgError:
