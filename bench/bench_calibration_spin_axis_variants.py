@@ -35,6 +35,8 @@ VARIANTS = {
     "default": "jackknife + sandwich (default)",
     "sandwich": "sandwich (HAC) alone",
     "map-iso": "default + |s|^2 / 9 isotropic (jackknife-map)",
+    "map-iso-half": "default + |s|^2 / 18 per component (isotropic: E|m|^2 = |s|^2 / 9)",
+    "sandwich-iso-half": "sandwich + |s|^2 / 18 per component (no jackknife)",
     "map-rank1": "default + s s^T / 9 (rank 1, along the half-map shift)",
     "richardson": "answer - s / 3; sandwich + jackknife of the corrected answer",
     "richardson-rank1": "answer - s / 3; that + s s^T / 9 (the correction's size as its error)",
@@ -98,10 +100,14 @@ def _covariance(p: dict, key: str) -> np.ndarray | None:
     if key == "default":
         return default
     s = p["xc"] - p["x0"]
+    iso = np.zeros_like(default)
+    iso[0, 0] = iso[1, 1] = float(np.sum(s[:2] ** 2)) / 9.0
     if key == "map-iso":
-        iso = np.zeros_like(default)
-        iso[0, 0] = iso[1, 1] = float(np.sum(s[:2] ** 2)) / 9.0
         return default + iso
+    if key == "map-iso-half":
+        return default + iso / 2
+    if key == "sandwich-iso-half":
+        return sand + iso / 2
     if key == "map-rank1":
         return default + _rank1(s)
     corrected = sand + jackknife_spread(p["xs"] - (p["xcs"] - p["xs"]) / 3)
