@@ -22,18 +22,22 @@ import numpy as np
 from speclight.estimate.spin_axis.spin_axis_confidence import (
     EAST_NORTH,
     confidence_from_covariance,
-    half_resolution,
-    jackknife_refits,
-    jackknife_spread,
-    refit,
     sandwich_covariance,
 )
 from speclight.estimate.spin_axis.spin_axis_core import angular_distance_deg
 from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
+from speclight.estimate.spin_axis.spin_axis_jackknife import (
+    half_resolution,
+    jackknife_refits,
+    jackknife_spread,
+    refit,
+    shrunk_jackknife_spread,
+)
 
 VARIANTS = {
     "default": "jackknife + sandwich (default)",
     "sandwich": "sandwich (HAC) alone",
+    "shrunk": "sandwich + jackknife, its axis block shrunk to isotropic (Ledoit-Wolf)",
     "map-iso": "default + |s|^2 / 9 isotropic (jackknife-map)",
     "map-iso-half": "default + |s|^2 / 18 per component (isotropic: E|m|^2 = |s|^2 / 9)",
     "sandwich-iso-half": "sandwich + |s|^2 / 18 per component (no jackknife)",
@@ -91,7 +95,7 @@ def _rank1(s: np.ndarray) -> np.ndarray:
 
 
 def _covariance(p: dict, key: str) -> np.ndarray | None:
-    if "xs" not in p or (key != "default" and key != "sandwich" and "xc" not in p):
+    if "xs" not in p or (key not in ("default", "sandwich", "shrunk") and "xc" not in p):
         return None
     sand = p["sandwich"]
     if key == "sandwich":
@@ -99,6 +103,8 @@ def _covariance(p: dict, key: str) -> np.ndarray | None:
     default = sand + jackknife_spread(p["xs"])
     if key == "default":
         return default
+    if key == "shrunk":
+        return sand + shrunk_jackknife_spread(p["xs"])[0]
     s = p["xc"] - p["x0"]
     iso = np.zeros_like(default)
     iso[0, 0] = iso[1, 1] = float(np.sum(s[:2] ** 2)) / 9.0

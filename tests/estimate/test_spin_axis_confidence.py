@@ -148,7 +148,7 @@ def test_block_jackknife_z_is_students_t_under_the_null(rho) -> None:
 def test_jackknife_spread_of_the_mean_is_the_variance_of_the_mean() -> None:
     # delete-one jackknife of the sample mean: its variance estimate is s^2 / n exactly
     # (Efron & Stein 1981; Efron 1982, "The jackknife, the bootstrap...", eq. 3.5)
-    from speclight.estimate.spin_axis.spin_axis_confidence import jackknife_spread
+    from speclight.estimate.spin_axis.spin_axis_jackknife import jackknife_spread
 
     v = np.random.default_rng(8).normal(size=(12, 2))
     n = v.shape[0]
@@ -191,3 +191,26 @@ def test_confidence_sigmas_are_east_and_north_of_the_spin_model() -> None:
     rho = want[0, 1] / np.sqrt(want[0, 0] * want[1, 1])
     np.testing.assert_allclose(got.correlation_east_north, rho, atol=1e-6)
     assert abs(rho) > 0.05  # a correlation whose sign is tested
+
+
+def test_ledoit_wolf_shrinkage_by_hand_and_consistent() -> None:
+    # Ledoit & Wolf (2004) Lemma 3.2 worked by hand for deviations (+-1, 0), (0, 0) twice:
+    # S = diag(1/2, 0), mu = 1/4, delta^2 = 1/8, beta^2 = (1/4) / 4 = 1/16: lambda = 1/2;
+    # (G - 1) (lambda mu I + (1 - lambda) S) = 3 diag(3/8, 1/8)
+    from speclight.estimate.spin_axis.spin_axis_jackknife import (
+        jackknife_spread,
+        shrunk_jackknife_spread,
+    )
+
+    xs = np.array([[1.0, 0.0, 0.2], [-1.0, 0.0, 0.2], [0.0, 0.0, 0.2], [0.0, 0.0, 0.2]])
+    cov, lam = shrunk_jackknife_spread(xs)
+    np.testing.assert_allclose(lam, 0.5, rtol=1e-12)
+    np.testing.assert_allclose(cov[:2, :2], np.diag([9 / 8, 3 / 8]), rtol=1e-12)
+    # the target keeps the trace (mu = trace / 2); with many refits of a clearly
+    # anisotropic spread the intensity goes to 0 (their Theorem 3.2): beta^2 ~ 1 / G
+    v = np.random.default_rng(4).normal(size=(4000, 3)) * [1.0, 0.1, 1.0]
+    cov, lam = shrunk_jackknife_spread(v)
+    plain = jackknife_spread(v)
+    np.testing.assert_allclose(np.trace(cov[:2, :2]), np.trace(plain[:2, :2]), rtol=1e-12)
+    assert lam < 0.01
+    np.testing.assert_allclose(cov, plain, rtol=0.02, atol=0.02 * plain[0, 0])

@@ -1,12 +1,17 @@
 """How well the data pin the spin axis: sigmas, a confidence region, and what cannot be trusted.
 
-**Sigmas**: the delete-a-block jackknife (:func:`jackknife_covariance`) plus the sandwich
-below. The jackknife sees what the residuals along the pass do to the answer, noise and map
-error alike, but on a flat or one-sided surface its refits may not move (a singular
-covariance); the sandwich adds the local curvature's floor. The sum counts the noise twice,
-a conservative choice the calibration bench supports (BENCHMARKS.md "Spin-axis calibration":
-robust error / sigma 0.95-1.0 over 50 blind draws, a heavier tail where the map's error
-pulls the answer; the jackknife alone 1.4-1.7, the sandwich alone 1.5-2.8).
+**Sigmas** (``method="jackknife-shrunk"``, the default): the delete-a-block jackknife
+(:func:`jackknife_refits`) plus the sandwich below, the jackknife's axis block shrunk
+towards isotropic by Ledoit and Wolf's intensity (:func:`shrunk_jackknife_spread`). The
+jackknife sees what the residuals along the pass do to the answer, noise and map error alike
+(on the calibration bench, where the map's error is almost the whole error, it gives its
+size), but ten refits cannot resolve the shape of the axis block: a thin ellipse can be a
+chance of the ten, and the map's error then lies across it (19 sigma in one draw of
+BENCHMARKS.md "Spin-axis calibration"). The shrinkage keeps the refits' shape only as far
+as they resolve it, their size always; the sandwich adds the local curvature's floor and
+shape (on a flat or one-sided surface the refits may not move). ``method="jackknife"``
+keeps the refits' shape (the default before; a 1.9 east tail), ``"jackknife-map"`` adds the
+map-error term below, ``"sandwich"`` is the sandwich alone.
 
 **Sandwich** (White 1980, Econometrica 48, 817, doi:10.2307/1912934;
 Newey & West 1987, Econometrica 55, 703, doi:10.2307/1913610): at the refined solution the
@@ -22,8 +27,10 @@ this is the usual ``sigma^2 (J^T J)^-1``.
 
 **The map's own error** (``method="jackknife-map"``, not the default): the answer's shift
 on the map at half its resolution over 3 as an isotropic variance on the axis
-(:func:`map_error_covariance`). It removes the tail the map's error causes but widens the
-other sigmas (error / sigma standard deviations 0.70 / 0.60 over 50 blind draws).
+(:func:`map_error_covariance`). The bench found the shift no measure of the map's error:
+against the answer refitted on the truth's finer map, its east and north components
+correlate -0.02 and -0.45 (50 draws), so the Richardson-corrected answer (minus the shift
+/ 3) is worse (median error 1.2 against 0.6 deg) and the term only widens every sigma.
 
 **Region**: with ``C_aa`` the axis block of ``C`` and ``(A^-1)_aa`` that of ``A^-1``, a
 misfit rise of ``Delta e`` over the grid (the phase minimised, as the surface is) is
@@ -57,6 +64,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
+from speclight.estimate.spin_axis.spin_axis_jackknife import (
+    JACKKNIFE_BLOCKS as JACKKNIFE_BLOCKS,  # the period check's blocks too
+)
+from speclight.estimate.spin_axis.spin_axis_jackknife import (
+    jackknife_covariance,
+    jackknife_refits,
+    map_error_covariance,
+    shrunk_jackknife_spread,
+)
 from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, angular_distance_deg
 from speclight.maps.map_lookup import ReflectivityMap
 
@@ -71,8 +87,6 @@ MAX_REGION_FRACTION = 0.05
 MAX_SIGMA_DEG = 30.0
 #: 95 % cells farther than this from the refined axis [deg]: a second region.
 SECOND_REGION_DEG = 20.0
-#: Blocks of consecutive epochs of the jackknife.
-JACKKNIFE_BLOCKS = 10
 #: Refined misfit over this times the noise floor: flagged.
 MAX_NOISE_RATIO = 10.0
 #: How the note of a flat surface starts.
@@ -149,93 +163,6 @@ def sandwich_covariance(r: F64, jac: F64, n_t: int) -> tuple[F64, F64, int]:
     return np.asarray(a_inv @ s @ a_inv, dtype=np.float64), a_inv, lag
 
 
-def refit(model: SpinMisfit, x0: F64) -> F64:
-    """The parameters (K,) minimising ``model``'s misfit from ``x0`` (L-BFGS-B, analytic
-    gradient)."""
-    from scipy.optimize import minimize
-
-    res = minimize(
-        model.misfit_and_gradient, x0, jac=True, method="L-BFGS-B",
-        options={"maxiter": 100, "ftol": 1e-12, "gtol": 1e-9},
-    )  # fmt: skip
-    return np.asarray(res.x, dtype=float)
-
-
-def jackknife_refits(model: SpinMisfit, x0: F64, ranged: bool) -> F64:
-    """The refits (G, K) of the delete-a-block jackknife: the pass cut into
-    :data:`JACKKNIFE_BLOCKS` runs of consecutive epochs, the fit repeated without each."""
-    n_t = model.y.shape[0]
-    edges = np.linspace(0, n_t, JACKKNIFE_BLOCKS + 1).astype(int)
-    xs = []
-    for g in range(JACKKNIFE_BLOCKS):
-        keep = np.ones(n_t, dtype=bool)
-        keep[edges[g] : edges[g + 1]] = False
-        geo = model.geo
-        sub = dataclasses.replace(
-            model,
-            geo=EpochGeometry(
-                geo.sun_gcrs[keep], geo.observer_gcrs[keep], geo.t_s[keep], geo.period_s
-            ),
-            y=model.y[keep],
-            ranging=model.ranging.select(keep)
-            if ranged and model.ranging is not None
-            else model.ranging,
-        )
-        xs.append(refit(sub, x0))
-    return np.array(xs)
-
-
-def jackknife_spread(xs: F64) -> F64:
-    """``(G - 1) / G sum_g (x_g - mean x)(x_g - mean x)^T`` (K, K) of refits ``xs`` (G, K)."""
-    d = xs - xs.mean(axis=0)
-    return np.asarray((xs.shape[0] - 1) / xs.shape[0] * (d.T @ d))
-
-
-def jackknife_covariance(model: SpinMisfit, x0: F64, ranged: bool) -> F64:
-    """Delete-a-block jackknife covariance (K, K) of the parameters ``x`` (Efron & Stein
-    1981; Kuensch 1989, Ann. Stat. 17, 1217, doi:10.1214/aos/1176347265): the pass is cut
-    into :data:`JACKKNIFE_BLOCKS` runs of consecutive epochs, the fit is repeated without
-    each (:func:`jackknife_refits`, from ``x0``), and :func:`jackknife_spread` of the refits.
-    It sees what the residuals do to the answer: noise and a map error that varies along
-    the pass alike."""
-    return jackknife_spread(jackknife_refits(model, x0, ranged))
-
-
-def half_resolution(model: SpinMisfit) -> SpinMisfit | None:
-    """``model`` on its map coarsened to half its ``nside``
-    (:func:`.spin_axis_continuation.coarsen_map`), or None for ``nside`` 1 (none coarser);
-    the ranging term (its own map) is kept as it is."""
-    from speclight.estimate.spin_axis.spin_axis_continuation import coarsen_map
-
-    nside = model.bmap.header.nside
-    if nside < 2:
-        return None
-    return dataclasses.replace(model, bmap=coarsen_map(model.bmap, nside // 2, None))
-
-
-def map_error_covariance(model: SpinMisfit, x0: F64) -> F64:
-    """An isotropic variance (K, K) on the axis block for the map's own error, measured by
-    halving the map's resolution.
-
-    The map's HEALPix interpolation errs by ``k h^2`` (bilinear, ``h`` the pixel size), so
-    the answer refitted (:func:`refit`, from ``x0``) on the map coarsened to half its
-    ``nside`` (:func:`half_resolution`: ``2 h``, ``4 k h^2``) moves by about 3 times what
-    the map's error does to it: ``sigma_map = |shift| / 3`` on each axis component (the
-    shift's direction is that of the coarse map's error, not the map's: only its size is
-    used). Zero for a map of ``nside`` 1.
-    """
-    k = x0.size
-    coarse = half_resolution(model)
-    if coarse is None:
-        return np.zeros((k, k))
-    shift = refit(coarse, x0)[:2] - x0[:2]
-    if not np.all(np.isfinite(shift)):
-        return np.zeros((k, k))
-    out = np.zeros((k, k))
-    out[0, 0] = out[1, 1] = float(np.sum(shift**2)) / 9.0
-    return out
-
-
 def axis_confidence(
     bmap: ReflectivityMap,
     geo: EpochGeometry,
@@ -247,7 +174,7 @@ def axis_confidence(
     ra_deg: F64,
     free_period: bool = False,
     ranging: object | None = None,
-    method: str = "jackknife",
+    method: str = "jackknife-shrunk",
 ) -> AxisConfidence:
     """Sigmas, regions and flags of the refined solution (module doc).
 
@@ -272,9 +199,10 @@ def axis_confidence(
     ranging
         The range-offset term (:class:`.spin_axis_ranging.RangingTerm`), or None.
     method
-        The covariance: ``jackknife`` (:func:`jackknife_covariance` plus the sandwich),
-        ``jackknife-map`` (that plus :func:`map_error_covariance`) or ``sandwich``
-        (:func:`sandwich_covariance`).
+        The covariance (module doc): ``jackknife-shrunk`` (the sandwich plus
+        :func:`shrunk_jackknife_spread`), ``jackknife`` (the sandwich plus
+        :func:`jackknife_covariance`), ``jackknife-map`` (that plus
+        :func:`map_error_covariance`) or ``sandwich`` (:func:`sandwich_covariance`).
     """
     cov = a_inv = None
     lag, period_scale = 0, float("nan")
@@ -304,7 +232,9 @@ def _covariance(
     if jac is None or not np.all(np.isfinite(r)) or not np.any(jac):
         return None
     cov, a_inv, lag = sandwich_covariance(r, jac, model.y.shape[0])
-    if method in ("jackknife", "jackknife-map"):  # plus the sandwich: never below the
+    if method == "jackknife-shrunk":
+        cov = cov + shrunk_jackknife_spread(jackknife_refits(model, x0, ranged))[0]
+    elif method in ("jackknife", "jackknife-map"):  # plus the sandwich: never below the
         cov = cov + jackknife_covariance(model, x0, ranged)  # local curvature
     if method == "jackknife-map":
         cov = cov + map_error_covariance(model, x0)
