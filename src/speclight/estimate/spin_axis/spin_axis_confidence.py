@@ -1,17 +1,22 @@
 """How well the data pin the spin axis: sigmas, a confidence region, and what cannot be trusted.
 
-**Sigmas** (``method="jackknife-shrunk"``, the default): the delete-a-block jackknife
-(:func:`jackknife_refits`) plus the sandwich below, the jackknife's axis block shrunk
-towards isotropic by Ledoit and Wolf's intensity (:func:`shrunk_jackknife_spread`). The
-jackknife sees what the residuals along the pass do to the answer, noise and map error alike
-(on the calibration bench, where the map's error is almost the whole error, it gives its
-size), but ten refits cannot resolve the shape of the axis block: a thin ellipse can be a
-chance of the ten, and the map's error then lies across it (19 sigma in one draw of
-BENCHMARKS.md "Spin-axis calibration"). The shrinkage keeps the refits' shape only as far
-as they resolve it, their size always; the sandwich adds the local curvature's floor and
-shape (on a flat or one-sided surface the refits may not move). ``method="jackknife"``
-keeps the refits' shape (the default before; a 1.9 east tail), ``"jackknife-map"`` adds the
-map-error term below, ``"sandwich"`` is the sandwich alone.
+**Sigmas** (``method="jackknife"``, the default): the delete-a-block jackknife
+(:func:`.spin_axis_jackknife.jackknife_covariance`) plus the sandwich below. The jackknife
+sees what the residuals along the pass do to the answer, noise and map error alike (on the
+calibration bench, where the map's error is almost the whole error, it gives its size), but
+on a flat or one-sided surface its refits may not move (a singular covariance); the
+sandwich adds the local curvature's floor. The sum counts the noise twice, a conservative
+choice (BENCHMARKS.md "Spin-axis calibration": robust error / sigma ~1 over 50 blind draws
+of one seed, 1.1-2.0 over another, with a heavier tail where the map's error pulls the
+answer). Ten refits cannot resolve the shape of the axis block: a thin ellipse can be a
+chance of the ten, the map's error then lying across it (19 sigma in one draw).
+``method="jackknife-shrunk"`` (not the default) shrinks the jackknife's axis block towards
+isotropic by Ledoit and Wolf's intensity
+(:func:`.spin_axis_jackknife.shrunk_jackknife_spread`), keeping the refits' shape only as
+far as they resolve it: better on both calibration seeds (error / sigma standard deviations
+1.88 / 1.10 -> 1.15 / 1.03 and 1.82 / 4.81 -> 1.41 / 2.19) but not within 0.8-1.25 on the
+second, so not adopted. ``"jackknife-map"`` adds the map-error term below, ``"sandwich"`` is
+the sandwich alone.
 
 **Sandwich** (White 1980, Econometrica 48, 817, doi:10.2307/1912934;
 Newey & West 1987, Econometrica 55, 703, doi:10.2307/1913610): at the refined solution the
@@ -27,10 +32,11 @@ this is the usual ``sigma^2 (J^T J)^-1``.
 
 **The map's own error** (``method="jackknife-map"``, not the default): the answer's shift
 on the map at half its resolution over 3 as an isotropic variance on the axis
-(:func:`map_error_covariance`). The bench found the shift no measure of the map's error:
-against the answer refitted on the truth's finer map, its east and north components
-correlate -0.02 and -0.45 (50 draws), so the Richardson-corrected answer (minus the shift
-/ 3) is worse (median error 1.2 against 0.6 deg) and the term only widens every sigma.
+(:func:`.spin_axis_jackknife.map_error_covariance`). The bench found the shift no measure
+of the map's error: against the answer refitted on the truth's finer map, its east and
+north components correlate -0.02 and -0.45 (50 draws; -0.36, -0.07 over 50 others), so the
+Richardson-corrected answer (minus the shift / 3) is worse (median error 1.2 against 0.6
+deg) and the term only widens every sigma.
 
 **Region**: with ``C_aa`` the axis block of ``C`` and ``(A^-1)_aa`` that of ``A^-1``, a
 misfit rise of ``Delta e`` over the grid (the phase minimised, as the surface is) is
@@ -174,7 +180,7 @@ def axis_confidence(
     ra_deg: F64,
     free_period: bool = False,
     ranging: object | None = None,
-    method: str = "jackknife-shrunk",
+    method: str = "jackknife",
 ) -> AxisConfidence:
     """Sigmas, regions and flags of the refined solution (module doc).
 
@@ -199,9 +205,9 @@ def axis_confidence(
     ranging
         The range-offset term (:class:`.spin_axis_ranging.RangingTerm`), or None.
     method
-        The covariance (module doc): ``jackknife-shrunk`` (the sandwich plus
-        :func:`shrunk_jackknife_spread`), ``jackknife`` (the sandwich plus
-        :func:`jackknife_covariance`), ``jackknife-map`` (that plus
+        The covariance (module doc): ``jackknife`` (the sandwich plus
+        :func:`jackknife_covariance`), ``jackknife-shrunk`` (the sandwich plus
+        :func:`shrunk_jackknife_spread`), ``jackknife-map`` (that plus
         :func:`map_error_covariance`) or ``sandwich`` (:func:`sandwich_covariance`).
     """
     cov = a_inv = None
