@@ -2,7 +2,9 @@
 
 Run: ``.venv/bin/python bench/bench_calibration_spin_axis.py [--draws 50] [--wrong-draws 10]
 [--period-draws 10] [--sphere-draws 10] [--grid-deg 4]
-[--phases 36] [--folder DIR] [--seed 0]``
+[--phases 36] [--folder DIR] [--seed 0] [--save FILE.pkl] [--load FILE.pkl]``
+(``--save`` keeps the period-known draws' refits; ``--load`` reports them again, no search:
+every covariance variant of ``bench_calibration_spin_axis_variants.py`` side by side)
 
 Targets and maps (built once in ``--folder``, reused): the box-wing example at 100 nm bins;
 the search uses a passive map at 32 px of 768 directions (HEALPix nside 8, 7.3 deg apart) x
@@ -33,6 +35,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
+import pickle
 import platform
 import re
 import time
@@ -40,10 +43,17 @@ from pathlib import Path
 
 import numpy as np
 
+from bench_calibration_spin_axis_variants import (
+    VARIANTS,
+    oracle_report,
+    variant,
+)
+from bench_calibration_spin_axis_variants import _tangent_error as _tangent_error
+from bench_calibration_spin_axis_variants import parts as _parts
+from bench_calibration_spin_axis_variants import shift_text as _shift_text
 from speclight.attitude.quaternion import quat_to_matrix
 from speclight.attitude.spin import spin_attitude
 from speclight.estimate.inputs.reflectance_factors import read_reflectance_factors
-from speclight.estimate.spin_axis.spin_axis_confidence import axis_confidence
 from speclight.estimate.spin_axis.spin_axis_core import angular_distance_deg, spin_axis_search
 from speclight.estimate.spin_axis.spin_axis_lookup import (
     EpochGeometry,
@@ -108,19 +118,6 @@ def _geometry(folder: Path) -> EpochGeometry:
     return EpochGeometry(ep.sun_gcrs[ok], ep.observer_gcrs[ok], ep.t_s[ok], 120.0)
 
 
-def _tangent_error(ra: float, dec: float, ra0: float, dec0: float) -> tuple[float, float]:
-    """(east, north) [deg] of (ra, dec) from (ra0, dec0): the azimuthal equidistant
-    projection about the truth (the angular distance along the bearing; the gnomonic one
-    used before flips the sign of answers more than 90 deg away)."""
-    r, d, r0, d0 = np.radians([ra, dec, ra0, dec0])
-    c = np.sin(d0) * np.sin(d) + np.cos(d0) * np.cos(d) * np.cos(r - r0)
-    x = np.cos(d) * np.sin(r - r0)
-    y = np.cos(d0) * np.sin(d) - np.sin(d0) * np.cos(d) * np.cos(r - r0)
-    rho = np.arccos(np.clip(c, -1.0, 1.0))
-    scale = rho / np.hypot(x, y) if np.hypot(x, y) > 0 else 1.0
-    return float(np.degrees(x * scale)), float(np.degrees(y * scale))
-
-
 def _draw(rng: np.random.Generator, geo_all: EpochGeometry, truth_map, search, args, period_off):
     z = rng.normal(size=3)
     z /= np.linalg.norm(z)
@@ -151,50 +148,28 @@ def _draw(rng: np.random.Generator, geo_all: EpochGeometry, truth_map, search, a
     c = res.confidence
     g_ref = dataclasses.replace(geo, period_s=res.refined_period_s)
     warned = res.period_check is not None and res.period_check.warn
-    sand, with_map = (
-        axis_confidence(
-            bmap,
-            g_ref,
-            y,
-            None,
-            res.refined,
-            res.error.T,
-            res.dec_deg,
-            res.ra_deg,
-            free_period=bound is not None,
-            method=m,
-        )
-        for m in ("sandwich", "jackknife-map")
-    )
-    for other in (sand, with_map):  # the period check's warning, as the default has it
-        other.constrained = other.constrained and not warned
+    parts = _parts(bmap, g_ref, y, res, bound is not None, truth_map)
     err = float(angular_distance_deg(res.refined[0], res.refined[1], ra, dec))
     east, north = _tangent_error(res.refined[0], res.refined[1], ra, dec)
     print(
         f"draw: error {err:.2f} deg (east {east:+.2f}, north {north:+.2f}), sigmas "
-        f"{c.sigma_east_deg:.2f}, {c.sigma_north_deg:.2f} (with the map's "
-        f"{with_map.sigma_east_deg:.2f}, {with_map.sigma_north_deg:.2f}), constrained "
-        f"{c.constrained}, warned {warned}",
+        f"{c.sigma_east_deg:.2f}, {c.sigma_north_deg:.2f}, constrained {c.constrained}, "
+        f"warned {warned}; half-map shift / 3 {_shift_text(parts)}",
         flush=True,
     )
     return dict(
-        err=err, east=east, north=north, noise=noise, c=c, sand=sand, map=with_map,
-        period=period, period_err=res.refined_period_s - period, y=y.shape, warned=warned,
-        checked=res.period_check is not None,
+        err=err, east=east, north=north, noise=noise, c=c, period=period,
+        period_err=res.refined_period_s - period, y=y.shape, warned=warned,
+        checked=res.period_check is not None, truth=(ra, dec), parts=parts,
     )  # fmt: skip
 
 
 def _report(label: str, rows: list[dict]) -> None:
     if not rows:
         return
-    names = {
-        "c": "jackknife + sandwich (default)",
-        "map": "jackknife + sandwich + map error (jackknife-map)",
-        "sand": "sandwich (HAC)",
-    }
-    for key, name in names.items():
+    for key, name in VARIANTS.items():
         print(f"\n### sigmas: {name}")
-        _report_one(label, [dict(r, c=r[key]) for r in rows])
+        _report_one(label, [variant(r, key) for r in rows])
     warned = np.array([r["warned"] for r in rows])
     got = np.array([r["err"] for r in rows]) < 5.0
     print(
@@ -273,7 +248,14 @@ def main() -> None:
     ap.add_argument("--phases", type=int, default=36)
     ap.add_argument("--folder", type=Path, default=Path("/tmp/bench_calibration_spin_axis"))
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--save", type=Path, default=None, help="pickle the period-known draws")
+    ap.add_argument("--load", type=Path, default=None, help="report saved draws, run none")
     args = ap.parse_args()
+    if args.load is not None:
+        rows = pickle.loads(args.load.read_bytes())
+        _report("box-wing, period known (saved draws)", rows)
+        oracle_report(rows)
+        return
     args.folder.mkdir(parents=True, exist_ok=True)
     print(
         f"# {time.strftime('%Y-%m-%d %H:%M')} on {platform.node()} ({os.cpu_count()} CPUs, "
@@ -287,7 +269,10 @@ def main() -> None:
     truth = load_band_map(truth_bw)
     t0 = time.perf_counter()
     rows = [_draw(rng, geo, truth, search, args, "") for _ in range(args.draws)]
+    if args.save is not None:
+        args.save.write_bytes(pickle.dumps(rows))
     _report("box-wing, period known", rows)
+    oracle_report(rows)
     rows = [_draw(rng, geo, truth, search, args, "fixed") for _ in range(args.wrong_draws)]
     _report("box-wing, period 2-6 % off and fixed (the period check)", rows)
     rows = [_draw(rng, geo, truth, search, args, "free") for _ in range(args.period_draws)]
@@ -301,7 +286,8 @@ def main() -> None:
     con = [r["c"].constrained for r in rows]
     print(f"\n## Lambertian sphere: {len(rows)} draws: said constrained {np.mean(con):.2f}")
     print("notes:", sorted({r["c"].note.split(":")[0] for r in rows}))
-    print(f"example note: {rows[0]['c'].note}")
+    if rows:
+        print(f"example note: {rows[0]['c'].note}")
     print(f"\n{time.perf_counter() - t0:.0f} s for the draws (load {os.getloadavg()[0]:.1f})")
 
 

@@ -265,9 +265,9 @@ def test_map_error_variance_is_the_shift_on_the_half_resolution_map_over_three()
     # axis component is (shift / 3)^2 (bilinear interpolation errs by k h^2: module doc)
     from scipy.optimize import minimize
 
-    from speclight.estimate.spin_axis.spin_axis_confidence import map_error_covariance
     from speclight.estimate.spin_axis.spin_axis_continuation import coarsen_map
     from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
+    from speclight.estimate.spin_axis.spin_axis_jackknife import map_error_covariance
     from speclight.estimate.spin_axis.spin_axis_misfit import exact_misfit
 
     ra, dec, phase0, period = 40.0, 25.0, 50.0, 37.0

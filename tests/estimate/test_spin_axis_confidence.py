@@ -143,3 +143,74 @@ def test_block_jackknife_z_is_students_t_under_the_null(rho) -> None:
     # sampling error of a variance of t(9) values: sqrt((2 + 6 / 5) / n_draws) relative
     assert np.var(z) == pytest.approx(9 / 7, rel=5 * np.sqrt(3.2 / n_draws))
     assert np.isnan(block_jackknife_z(np.ones(5), 10))
+
+
+def test_jackknife_spread_of_the_mean_is_the_variance_of_the_mean() -> None:
+    # delete-one jackknife of the sample mean: its variance estimate is s^2 / n exactly
+    # (Efron & Stein 1981; Efron 1982, "The jackknife, the bootstrap...", eq. 3.5)
+    from speclight.estimate.spin_axis.spin_axis_jackknife import jackknife_spread
+
+    v = np.random.default_rng(8).normal(size=(12, 2))
+    n = v.shape[0]
+    refits = (v.sum(axis=0) - v) / (n - 1)  # the mean without each sample
+    want = np.cov(v.T, ddof=1) / n
+    np.testing.assert_allclose(jackknife_spread(refits), want, rtol=1e-12, atol=1e-15)
+
+
+def test_confidence_sigmas_are_east_and_north_of_the_spin_model() -> None:
+    # reference: the spin model's own conversion of the tangent parameters to RA, Dec
+    # (SpinMisfit.to_spin_model, frames and quaternions), differentiated numerically:
+    # east = dRA cos(Dec), north = dDec; the covariance propagated through that Jacobian
+    from speclight.estimate.spin_axis.spin_axis_confidence import confidence_from_covariance
+    from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
+
+    ra, dec = 250.0, -35.0
+    geo = _turning_pass(0.0, 20)
+    model = SpinMisfit.around(None, geo, np.ones((20, 2)), None, ra, dec)  # type: ignore[arg-type]
+    h = 1e-6
+    jac = np.zeros((2, 3))
+    for k in range(2):
+        step = np.zeros(3)
+        step[k] = h
+        r1, d1 = model.to_spin_model(step)[:2]
+        r0, d0 = model.to_spin_model(-step)[:2]
+        jac[:, k] = [(r1 - r0) * np.cos(np.radians(dec)) / (2 * h), (d1 - d0) / (2 * h)]
+    b = np.random.default_rng(2).normal(size=(3, 3))
+    cov = 1e-4 * (b @ b.T + 0.1 * np.eye(3))
+    want = jac @ cov @ jac.T  # [deg^2]
+    err = np.ones((5, 10))
+    err[2, 3] = 0.5
+    got = confidence_from_covariance(
+        cov, np.eye(3), err, np.linspace(-60, 60, 5), np.arange(10) * 36.0, (ra, dec, 0.0, 0.5),
+        1.0 + 0.01 * np.random.default_rng(1).normal(size=(20, 2)),
+    )  # fmt: skip
+    # central differences of step 1e-6 rad: relative error ~1e-8 (h^2 over the curvature)
+    np.testing.assert_allclose(
+        [got.sigma_east_deg, got.sigma_north_deg], np.sqrt(np.diag(want)), rtol=1e-6
+    )
+    rho = want[0, 1] / np.sqrt(want[0, 0] * want[1, 1])
+    np.testing.assert_allclose(got.correlation_east_north, rho, atol=1e-6)
+    assert abs(rho) > 0.05  # a correlation whose sign is tested
+
+
+def test_ledoit_wolf_shrinkage_by_hand_and_consistent() -> None:
+    # Ledoit & Wolf (2004) Lemma 3.2 worked by hand for deviations (+-1, 0), (0, 0) twice:
+    # S = diag(1/2, 0), mu = 1/4, delta^2 = 1/8, beta^2 = (1/4) / 4 = 1/16: lambda = 1/2;
+    # (G - 1) (lambda mu I + (1 - lambda) S) = 3 diag(3/8, 1/8)
+    from speclight.estimate.spin_axis.spin_axis_jackknife import (
+        jackknife_spread,
+        shrunk_jackknife_spread,
+    )
+
+    xs = np.array([[1.0, 0.0, 0.2], [-1.0, 0.0, 0.2], [0.0, 0.0, 0.2], [0.0, 0.0, 0.2]])
+    cov, lam = shrunk_jackknife_spread(xs)
+    np.testing.assert_allclose(lam, 0.5, rtol=1e-12)
+    np.testing.assert_allclose(cov[:2, :2], np.diag([9 / 8, 3 / 8]), rtol=1e-12)
+    # the target keeps the trace (mu = trace / 2); with many refits of a clearly
+    # anisotropic spread the intensity goes to 0 (their Theorem 3.2): beta^2 ~ 1 / G
+    v = np.random.default_rng(4).normal(size=(4000, 3)) * [1.0, 0.1, 1.0]
+    cov, lam = shrunk_jackknife_spread(v)
+    plain = jackknife_spread(v)
+    np.testing.assert_allclose(np.trace(cov[:2, :2]), np.trace(plain[:2, :2]), rtol=1e-12)
+    assert lam < 0.01
+    np.testing.assert_allclose(cov, plain, rtol=0.02, atol=0.02 * plain[0, 0])

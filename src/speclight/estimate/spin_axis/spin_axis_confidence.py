@@ -1,12 +1,22 @@
 """How well the data pin the spin axis: sigmas, a confidence region, and what cannot be trusted.
 
-**Sigmas**: the delete-a-block jackknife (:func:`jackknife_covariance`) plus the sandwich
-below. The jackknife sees what the residuals along the pass do to the answer, noise and map
-error alike, but on a flat or one-sided surface its refits may not move (a singular
-covariance); the sandwich adds the local curvature's floor. The sum counts the noise twice,
-a conservative choice the calibration bench supports (BENCHMARKS.md "Spin-axis calibration":
-robust error / sigma 0.95-1.0 over 50 blind draws, a heavier tail where the map's error
-pulls the answer; the jackknife alone 1.4-1.7, the sandwich alone 1.5-2.8).
+**Sigmas** (``method="jackknife"``, the default): the delete-a-block jackknife
+(:func:`.spin_axis_jackknife.jackknife_covariance`) plus the sandwich below. The jackknife
+sees what the residuals along the pass do to the answer, noise and map error alike (on the
+calibration bench, where the map's error is almost the whole error, it gives its size), but
+on a flat or one-sided surface its refits may not move (a singular covariance); the
+sandwich adds the local curvature's floor. The sum counts the noise twice, a conservative
+choice (BENCHMARKS.md "Spin-axis calibration": robust error / sigma ~1 over 50 blind draws
+of one seed, 1.1-2.0 over another, with a heavier tail where the map's error pulls the
+answer). Ten refits cannot resolve the shape of the axis block: a thin ellipse can be a
+chance of the ten, the map's error then lying across it (19 sigma in one draw).
+``method="jackknife-shrunk"`` (not the default) shrinks the jackknife's axis block towards
+isotropic by Ledoit and Wolf's intensity
+(:func:`.spin_axis_jackknife.shrunk_jackknife_spread`), keeping the refits' shape only as
+far as they resolve it: better on both calibration seeds (error / sigma standard deviations
+1.88 / 1.10 -> 1.15 / 1.03 and 1.82 / 4.81 -> 1.41 / 2.19) but not within 0.8-1.25 on the
+second, so not adopted. ``"jackknife-map"`` adds the map-error term below, ``"sandwich"`` is
+the sandwich alone.
 
 **Sandwich** (White 1980, Econometrica 48, 817, doi:10.2307/1912934;
 Newey & West 1987, Econometrica 55, 703, doi:10.2307/1913610): at the refined solution the
@@ -22,8 +32,11 @@ this is the usual ``sigma^2 (J^T J)^-1``.
 
 **The map's own error** (``method="jackknife-map"``, not the default): the answer's shift
 on the map at half its resolution over 3 as an isotropic variance on the axis
-(:func:`map_error_covariance`). It removes the tail the map's error causes but widens the
-other sigmas (error / sigma standard deviations 0.70 / 0.60 over 50 blind draws).
+(:func:`.spin_axis_jackknife.map_error_covariance`). The bench found the shift no measure
+of the map's error: against the answer refitted on the truth's finer map, its east and
+north components correlate -0.02 and -0.45 (50 draws; -0.36, -0.07 over 50 others), so the
+Richardson-corrected answer (minus the shift / 3) is worse (median error 1.2 against 0.6
+deg) and the term only widens every sigma.
 
 **Region**: with ``C_aa`` the axis block of ``C`` and ``(A^-1)_aa`` that of ``A^-1``, a
 misfit rise of ``Delta e`` over the grid (the phase minimised, as the surface is) is
@@ -57,6 +70,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
+from speclight.estimate.spin_axis.spin_axis_jackknife import (
+    JACKKNIFE_BLOCKS as JACKKNIFE_BLOCKS,  # the period check's blocks too
+)
+from speclight.estimate.spin_axis.spin_axis_jackknife import (
+    jackknife_covariance,
+    jackknife_refits,
+    map_error_covariance,
+    shrunk_jackknife_spread,
+)
 from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, angular_distance_deg
 from speclight.maps.map_lookup import ReflectivityMap
 
@@ -71,12 +93,12 @@ MAX_REGION_FRACTION = 0.05
 MAX_SIGMA_DEG = 30.0
 #: 95 % cells farther than this from the refined axis [deg]: a second region.
 SECOND_REGION_DEG = 20.0
-#: Blocks of consecutive epochs of the jackknife.
-JACKKNIFE_BLOCKS = 10
 #: Refined misfit over this times the noise floor: flagged.
 MAX_NOISE_RATIO = 10.0
 #: How the note of a flat surface starts.
 FLAT_NOTE = "the data do not constrain the axis"
+#: The tangent rotation ``x[:2]`` to the axis's (east, north) offset (:func:`_sigmas`).
+EAST_NORTH = np.array([[0.0, 1.0], [-1.0, 0.0]])
 
 
 @dataclass
@@ -147,75 +169,6 @@ def sandwich_covariance(r: F64, jac: F64, n_t: int) -> tuple[F64, F64, int]:
     return np.asarray(a_inv @ s @ a_inv, dtype=np.float64), a_inv, lag
 
 
-def jackknife_covariance(model: SpinMisfit, x0: F64, ranged: bool) -> F64:
-    """Delete-a-block jackknife covariance (K, K) of the parameters ``x`` (Efron & Stein
-    1981; Kuensch 1989, Ann. Stat. 17, 1217, doi:10.1214/aos/1176347265): the pass is cut
-    into :data:`JACKKNIFE_BLOCKS` runs of consecutive epochs, the fit is repeated without
-    each (L-BFGS-B with the analytic gradient, from ``x0``), and ``C = (G - 1) / G sum_g
-    (x_g - mean x)(x_g - mean x)^T``. It sees what the residuals do to the answer: noise
-    and a map error that varies along the pass alike."""
-    from scipy.optimize import minimize
-
-    n_t = model.y.shape[0]
-    edges = np.linspace(0, n_t, JACKKNIFE_BLOCKS + 1).astype(int)
-    xs = []
-    for g in range(JACKKNIFE_BLOCKS):
-        keep = np.ones(n_t, dtype=bool)
-        keep[edges[g] : edges[g + 1]] = False
-        geo = model.geo
-        sub = dataclasses.replace(
-            model,
-            geo=EpochGeometry(
-                geo.sun_gcrs[keep], geo.observer_gcrs[keep], geo.t_s[keep], geo.period_s
-            ),
-            y=model.y[keep],
-            ranging=model.ranging.select(keep)
-            if ranged and model.ranging is not None
-            else model.ranging,
-        )
-        res = minimize(
-            sub.misfit_and_gradient, x0, jac=True, method="L-BFGS-B",
-            options={"maxiter": 100, "ftol": 1e-12, "gtol": 1e-9},
-        )  # fmt: skip
-        xs.append(np.asarray(res.x, dtype=float))
-    x = np.array(xs)
-    d = x - x.mean(axis=0)
-    return np.asarray((JACKKNIFE_BLOCKS - 1) / JACKKNIFE_BLOCKS * (d.T @ d))
-
-
-def map_error_covariance(model: SpinMisfit, x0: F64) -> F64:
-    """An isotropic variance (K, K) on the axis block for the map's own error, measured by
-    halving the map's resolution.
-
-    The map's HEALPix interpolation errs by ``k h^2`` (bilinear, ``h`` the pixel size), so
-    the answer refitted (L-BFGS-B, analytic gradient, from ``x0``) on the map coarsened to
-    half its ``nside`` (:func:`.spin_axis_continuation.coarsen_map`: ``2 h``, ``4 k h^2``)
-    moves by about 3 times what the map's error does to it: ``sigma_map = |shift| / 3`` on
-    each axis component (the shift's direction is that of the coarse map's error, not the
-    map's: only its size is used). Zero for a map of ``nside`` 1 (none coarser); the
-    ranging term (its own map) is kept as it is.
-    """
-    from scipy.optimize import minimize
-
-    from speclight.estimate.spin_axis.spin_axis_continuation import coarsen_map
-
-    k = x0.size
-    nside = model.bmap.header.nside
-    if nside < 2:
-        return np.zeros((k, k))
-    coarse = dataclasses.replace(model, bmap=coarsen_map(model.bmap, nside // 2, None))
-    res = minimize(
-        coarse.misfit_and_gradient, x0, jac=True, method="L-BFGS-B",
-        options={"maxiter": 100, "ftol": 1e-12, "gtol": 1e-9},
-    )  # fmt: skip
-    shift = np.asarray(res.x, dtype=float)[:2] - x0[:2]
-    if not np.all(np.isfinite(shift)):
-        return np.zeros((k, k))
-    out = np.zeros((k, k))
-    out[0, 0] = out[1, 1] = float(np.sum(shift**2)) / 9.0
-    return out
-
-
 def axis_confidence(
     bmap: ReflectivityMap,
     geo: EpochGeometry,
@@ -252,60 +205,84 @@ def axis_confidence(
     ranging
         The range-offset term (:class:`.spin_axis_ranging.RangingTerm`), or None.
     method
-        The covariance: ``jackknife`` (:func:`jackknife_covariance` plus the sandwich),
-        ``jackknife-map`` (that plus :func:`map_error_covariance`) or ``sandwich``
-        (:func:`sandwich_covariance`).
+        The covariance (module doc): ``jackknife`` (the sandwich plus
+        :func:`jackknife_covariance`), ``jackknife-shrunk`` (the sandwich plus
+        :func:`shrunk_jackknife_spread`), ``jackknife-map`` (that plus
+        :func:`map_error_covariance`) or ``sandwich`` (:func:`sandwich_covariance`).
     """
-    out = AxisConfidence()
+    cov = a_inv = None
+    lag, period_scale = 0, float("nan")
+    if np.all(np.isfinite(refined[:3])):
+        model = SpinMisfit.around(
+            bmap, geo, y, spin_body_axis, refined[0], refined[1], free_period,
+            ranging,  # type: ignore[arg-type]
+        )  # fmt: skip
+        x0 = np.array([0.0, 0.0, np.radians(refined[2])] + ([0.0] if free_period else []))
+        got = _covariance(model, x0, ranging is not None, method)
+        if got is not None:
+            cov, a_inv, lag = got
+        if free_period:
+            step = np.array([0, 0, 0, 1e-6])
+            period_scale = abs(model.period_s(x0 + step) - model.period_s(x0)) / 1e-6
+    return confidence_from_covariance(
+        cov, a_inv, error, dec_deg, ra_deg, refined, y, lag, period_scale
+    )
+
+
+def _covariance(
+    model: SpinMisfit, x0: F64, ranged: bool, method: str
+) -> tuple[F64, F64, int] | None:
+    """(C, A^-1, lag) of ``method`` (:func:`axis_confidence`), or None where the model has
+    no finite residuals or no gradient there."""
+    r, jac = model.residuals(x0)
+    if jac is None or not np.all(np.isfinite(r)) or not np.any(jac):
+        return None
+    cov, a_inv, lag = sandwich_covariance(r, jac, model.y.shape[0])
+    if method == "jackknife-shrunk":
+        cov = cov + shrunk_jackknife_spread(jackknife_refits(model, x0, ranged))[0]
+    elif method in ("jackknife", "jackknife-map"):  # plus the sandwich: never below the
+        cov = cov + jackknife_covariance(model, x0, ranged)  # local curvature
+    if method == "jackknife-map":
+        cov = cov + map_error_covariance(model, x0)
+    return cov, a_inv, lag
+
+
+def confidence_from_covariance(
+    cov: F64 | None,
+    a_inv: F64 | None,
+    error: F64,
+    dec_deg: F64,
+    ra_deg: F64,
+    refined: tuple[float, float, float, float],
+    y: F64,
+    hac_lag: int = 0,
+    period_scale: float = float("nan"),
+) -> AxisConfidence:
+    """Sigmas, regions and verdict from the parameters' covariance ``cov`` (K, K) and
+    ``A^-1`` (K, K) (None: no sigmas; module doc), the grid's misfit surface ``error``
+    (n_dec, n_ra) on cells ``dec_deg``, ``ra_deg`` [deg], the refined solution (RA, Dec,
+    phase [deg], misfit), the measured curves ``y`` (T, B) and, with a free period, the
+    period's change per unit of its parameter ``period_scale`` [s]."""
+    out = AxisConfidence(hac_lag=hac_lag)
     finite = np.isfinite(error)
     e_min = float(np.min(error[finite])) if finite.any() else float("nan")
     out.contrast = float(np.median(error[finite]) / e_min) if e_min > 0 else float("nan")
     out.noise_floor = noise_floor(y)
     if np.isfinite(refined[3]) and out.noise_floor > 0:
         out.noise_ratio = float(refined[3] / out.noise_floor)
-    if np.all(np.isfinite(refined[:3])):
-        _sigmas(out, bmap, geo, y, spin_body_axis, refined, free_period, ranging, method)
+    if cov is not None and a_inv is not None:
+        _sigmas(out, cov, a_inv, period_scale)
     _regions(out, error, dec_deg, ra_deg, refined)
     out.constrained, out.note = _verdict(out)
     return out
 
 
-def _sigmas(
-    out: AxisConfidence,
-    bmap: ReflectivityMap,
-    geo: EpochGeometry,
-    y: F64,
-    spin_body_axis: ArrayLike | None,
-    refined: tuple[float, float, float, float],
-    free_period: bool,
-    ranging: object | None,
-    method: str,
-) -> None:
-    model = SpinMisfit.around(
-        bmap,
-        geo,
-        y,
-        spin_body_axis,
-        refined[0],
-        refined[1],
-        free_period,
-        ranging,  # type: ignore[arg-type]
-    )
-    x0 = np.array([0.0, 0.0, np.radians(refined[2])] + ([0.0] if free_period else []))
-    r, jac = model.residuals(x0)
-    if jac is None or not np.all(np.isfinite(r)) or not np.any(jac):
-        return
-    cov, a_inv, out.hac_lag = sandwich_covariance(r, jac, y.shape[0])
-    if method in ("jackknife", "jackknife-map"):  # plus the sandwich: never below the
-        cov = cov + jackknife_covariance(model, x0, ranging is not None)  # local curvature
-    if method == "jackknife-map":
-        cov = cov + map_error_covariance(model, x0)
+def _sigmas(out: AxisConfidence, cov: F64, a_inv: F64, period_scale: float) -> None:
     # x = (a, b): a tilts the axis towards -b_frame... (:mod:`.spin_axis_gradient`): the
     # tangent rotation (a, b) moves the axis by (b, -a) in the frame's (x, y); x is the
     # ascending node (east), y north of it
-    t = np.array([[0.0, 1.0], [-1.0, 0.0]])
-    c_ax = t @ cov[:2, :2] @ t.T
-    a_ax = t @ a_inv[:2, :2] @ t.T
+    c_ax = EAST_NORTH @ cov[:2, :2] @ EAST_NORTH.T
+    a_ax = EAST_NORTH @ a_inv[:2, :2] @ EAST_NORTH.T
     var = np.diag(c_ax)
     if not np.all(np.isfinite(var)) or np.any(var <= 0):
         return
@@ -314,9 +291,8 @@ def _sigmas(
     out.correlation_east_north = float(c_ax[0, 1] / np.sqrt(var[0] * var[1]))
     out.sigma_axis_deg = float(np.sqrt(np.max(np.linalg.eigvalsh(c_ax)))) * deg
     out.sigma_phase_deg = float(np.sqrt(max(cov[2, 2], 0.0))) * deg
-    if free_period:
-        dp = abs(model.period_s(x0 + np.array([0, 0, 0, 1e-6])) - model.period_s(x0)) / 1e-6
-        out.sigma_period_s = float(np.sqrt(max(cov[3, 3], 0.0)) * dp)
+    if cov.shape[0] > 3 and np.isfinite(period_scale):
+        out.sigma_period_s = float(np.sqrt(max(cov[3, 3], 0.0)) * period_scale)
     try:
         out.misfit_per_chi2 = float(np.trace(c_ax @ np.linalg.inv(a_ax)) / 2.0)
     except np.linalg.LinAlgError:
