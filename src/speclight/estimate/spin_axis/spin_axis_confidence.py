@@ -96,6 +96,11 @@ MAX_SIGMA_DEG = 30.0
 SECOND_REGION_DEG = 20.0
 #: Refined misfit over this times the noise floor: flagged.
 MAX_NOISE_RATIO = 10.0
+#: Refined misfit over this times the noise floor (and up to :data:`MAX_NOISE_RATIO`): the
+#: model's own error dominates the residuals; said after the sigmas (BENCHMARKS.md
+#: "Spin-axis calibration: the map's error and the shrunk jackknife": the map's error is
+#: then nearly the whole error and the sigmas may understate it).
+MODEL_ERROR_RATIO = 2.0
 #: How the note of a flat surface starts.
 FLAT_NOTE = "the data do not constrain the axis"
 #: The tangent rotation ``x[:2]`` to the axis's (east, north) offset (:func:`_sigmas`).
@@ -357,6 +362,13 @@ def _verdict(out: AxisConfidence) -> tuple[bool, str]:
             f"{out.sigma_north_deg:.3g}); 95 % region {100 * out.region95_fraction:.3g} % "
             "of the sphere"
         )
+        if out.noise_ratio > MODEL_ERROR_RATIO:
+            notes.append(
+                f"the misfit is {out.noise_ratio:.3g} times the noise floor: the map's (or the "
+                "spin model's) own error dominates the residuals, and the sigmas count it only "
+                "as far as the jackknife's refits see it: they may be too small "
+                "(docs/spin-axis.md, Sigmas)"
+            )
     return constrained, "; ".join(notes)
 
 
