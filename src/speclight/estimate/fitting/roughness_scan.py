@@ -80,7 +80,7 @@ def coordinate_scan(
     sweeps
         Sweeps over the materials, at most.
     """
-    grid = np.geomspace(problem.lo, problem.hi, points)
+    grid = scan_grid(problem, points)
     x = np.clip(np.asarray(start, dtype=float), problem.lo, problem.hi)
     best = problem.chi2(x)
     n_sweeps = 0
@@ -103,11 +103,16 @@ def coordinate_scan(
     return Scan(x, grid, profile, flat, n_sweeps)
 
 
+def scan_grid(problem: RoughnessProblem, points: int = SCAN_POINTS) -> F64:
+    """The ``points`` roughness values of the scans, log-spaced over the bounds [1]."""
+    return np.geomspace(problem.lo, problem.hi, points)
+
+
 def common_start(problem: RoughnessProblem, n: int, points: int = SCAN_POINTS) -> F64:
     """The best point of the common line of ``n`` roughness values: all at one of the
-    ``points`` log-spaced grid values (:func:`coordinate_scan`'s grid); where a fit from
+    ``points`` values of :func:`scan_grid` (:func:`coordinate_scan`'s grid); where a fit from
     another start misfits, the fit starts again there (:func:`.roughness_fit.solve`)."""
-    grid = np.geomspace(problem.lo, problem.hi, points)
+    grid = scan_grid(problem, points)
     values = [problem.chi2(np.full(n, g)) for g in grid]
     return np.full(n, grid[int(np.argmin(values))])
 
@@ -122,4 +127,4 @@ def _along(problem: RoughnessProblem, x: F64, k: int, grid: F64) -> F64:
     return out
 
 
-__all__ = ["MAX_SWEEPS", "SCAN_POINTS", "Scan", "common_start", "coordinate_scan"]
+__all__ = ["MAX_SWEEPS", "SCAN_POINTS", "Scan", "common_start", "coordinate_scan", "scan_grid"]
