@@ -310,9 +310,10 @@ def spin_axis_search(
     ra, dec = radec_grid(grid_deg)
     from speclight.estimate.spin_axis.spin_axis_period_scan import grid_for_period, scan_grid_deg
 
+    coarse = radec_grid(scan_grid_deg(grid_deg))  # the period scans' grid (both of them)
     scan = grid_for_period(
-        sfm, geo, y, ra, dec, chunk, progress, ranging, period_kind, period_bound,
-        radec_grid(scan_grid_deg(grid_deg)), grid_terms,
+        sfm, geo, y, ra, dec, chunk, progress, ranging, period_kind, period_bound, coarse,
+        grid_terms,
     )  # fmt: skip
     flat, ranging, kind = scan.misfit, scan.ranging, scan.kind
     if not np.any(np.isfinite(flat)):
@@ -369,7 +370,7 @@ def spin_axis_search(
 
         checked = checked_answer(
             bmap, sfm, with_period(geo, period_s), y, spin_body_axis, refined,
-            radec_grid(scan_grid_deg(grid_deg)), grid_terms, chunk, ranging, confidence,
+            coarse, grid_terms, chunk, ranging, confidence,
         )  # fmt: skip
     return SpinAxisResult(
         ra,
