@@ -8,9 +8,10 @@ by ``speclight reflectivity-map`` from the same scenario: rendered, so with the 
 its band rates turned into the mean reflectance factor of the light curves' bands. Variables added
 to SHAPE.nc along ``family`` (lowest chi-square first): ``tumbling_chi2``,
 ``tumbling_momentum_direction(family, xyz)`` (ecliptic J2000), ``tumbling_rate`` [rad s-1],
-``tumbling_moment_ratio(family, ratio)``, their standard deviations ``tumbling_rate_std``
-and ``tumbling_moment_ratio_std`` (:mod:`.tumbling_uncertainty`: linearised, residual
-correlation counted), ``tumbling_members``, the best state's
+``tumbling_moment_ratio(family, ratio)``, their standard deviations ``tumbling_rate_std``,
+``tumbling_moment_ratio_std`` and ``tumbling_momentum_direction_std(family, east_north)``
+[rad] (:mod:`.tumbling_uncertainty`: linearised, residual correlation counted),
+``tumbling_members``, the best state's
 ``tumbling_q0(family, quaternion)`` and ``tumbling_omega0(family, xyz)`` [rad s-1] at
 ``tumbling_t0_jd``.
 """
@@ -146,8 +147,13 @@ def add_tumbling(ds: xr.Dataset, fit: TumblingFit) -> xr.Dataset:
         ),
         "tumbling_moment_ratio_std": (
             ("family", "ratio"),
-            [s.std[1:] for s in best],
+            [s.std[1:3] for s in best],
             {"units": "1", "long_name": "standard deviation of tumbling_moment_ratio"},
+        ),
+        "tumbling_momentum_direction_std": (
+            ("family", "east_north"),
+            [s.std[3:5] for s in best],
+            {"units": "rad", "long_name": "std of the momentum direction, east and north"},
         ),
         "tumbling_q0": (
             ("family", "quaternion"),

@@ -30,7 +30,8 @@ class TumblingState:
     scale
         Factor on the brightness (calibrated data; 1 for relative).
     std
-        (3,) standard deviations of the rate [rad/s] and of the two moment ratios
+        (5,) standard deviations of the rate [rad/s], of the two moment ratios [1] and
+        of the momentum direction along the local east and north [rad]
         (:mod:`.tumbling_uncertainty`); NaN where not fitted.
     """
 
@@ -39,7 +40,7 @@ class TumblingState:
     moments: F64
     chi2: float
     scale: float = 1.0
-    std: F64 = field(default_factory=lambda: np.full(3, np.nan))
+    std: F64 = field(default_factory=lambda: np.full(5, np.nan))
 
     @property
     def momentum_direction(self) -> F64:

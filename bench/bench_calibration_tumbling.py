@@ -1,0 +1,163 @@
+"""Calibration of the tumbling state's standard deviations over blind noise draws (issue 27
+item 4).
+
+Truths as in ``bench_tumbling_far.py`` (the dishless box-wing, a random torque-free state,
+two 10-min passes 90 min apart, a point every 10 s, 1 % noise); for each truth
+``--noise-draws`` noise draws; each draw refitted from the truth itself (this measures the
+sigma, not the search): trust-region least squares on all points, as
+:func:`speclight.estimate.shape.tumbling.fit_tumbling` refines. The pulls
+``(estimate - truth) / sigma`` of the rate ``|H| / I_max``, both moment ratios and the
+momentum direction (east and north at the estimate) should have a standard deviation near
+1. Both covariance estimators of :mod:`speclight.estimate.shape.tumbling_uncertainty`
+(``sandwich``, ``scalar``) are computed on the same fits.
+
+``--model convex``: light curves from the convex model, fitted with it (noise only).
+``--model map``: light curves rendered by speclight (128 px, the shadows), fitted with the
+box-wing's reflectivity map (nside 8, phase angles 30-110 deg, 32 rolls, 64 px, built once):
+model error. A draw whose fit leaves the truth's family (``same_family``) is counted and
+left out of the pulls.
+
+    .venv/bin/python bench/bench_calibration_tumbling.py --truths 10 --noise-draws 5
+    .venv/bin/python bench/bench_calibration_tumbling.py --model map --truths 10 --noise-draws 5
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+from bench_tumbling_far import WHITE, draw_truth, geometry, render
+from scipy.optimize import least_squares
+
+from speclight.attitude import torque_free_attitude
+from speclight.attitude.quaternion import quat_conjugate, quat_rotate
+from speclight.estimate.shape.convex_model import facet_brightness
+from speclight.estimate.shape.egi import mesh_facets
+from speclight.estimate.shape.inversion_data import build_inversion_data
+from speclight.estimate.shape.scattering import scattering_law
+from speclight.estimate.shape.tumbling import (
+    MAX_EVALUATIONS,
+    TumblingState,
+    _Problem,
+    _state_vector,
+    same_family,
+)
+from speclight.estimate.shape.tumbling_light import (
+    ConvexLight,
+    LightModel,
+    MapLight,
+    tabulated_map,
+)
+from speclight.estimate.shape.tumbling_uncertainty import (
+    SUMMARY,
+    CovarianceMethod,
+    momentum_basis,
+    momentum_direction,
+    state_summary,
+    state_std,
+)
+from speclight.target import shapes
+from speclight.target.parts import Part, Target
+
+METHODS: tuple[CovarianceMethod, ...] = ("sandwich", "scalar")
+
+
+def box_wing() -> tuple[Target, np.ndarray, np.ndarray]:
+    """The dishless white box-wing as one part, and its facets' normals and areas."""
+    parts = [(p.vertices_m, p.faces) for p in shapes.box_wing(WHITE, dish=False).parts]
+    normals, areas = mesh_facets(parts)
+    offsets = np.cumsum([0] + [len(v) for v, _ in parts[:-1]])
+    faces = np.vstack([f + o for (_, f), o in zip(parts, offsets, strict=True)])
+    mesh = Target(parts=(Part("body", np.vstack([v for v, _ in parts]), faces, WHITE),))
+    return mesh, normals, areas
+
+
+def pulls_of(x_fit: np.ndarray, x_truth: np.ndarray, std: np.ndarray) -> np.ndarray:
+    """(5,) ``(estimate - truth) / sigma`` of the summary, the direction's components in
+    the estimate's east/north basis (small angles)."""
+    east, north = momentum_basis(momentum_direction(x_fit))
+    diff = state_summary(x_fit, east, north) - state_summary(x_truth, east, north)
+    return np.asarray(diff / std)
+
+
+def report(name: str, pulls: list[np.ndarray]) -> None:
+    z = np.array(pulls)
+    print(f"{name}: {len(z)} draws")
+    for j, q in enumerate(SUMMARY):
+        zj = z[:, j]
+        mad = 1.4826 * np.median(np.abs(zj - np.median(zj)))
+        print(
+            f"  {q:15s} std {np.std(zj, ddof=1):.3f} mean {np.mean(zj):+.3f} "
+            f"robust std {mad:.3f} median |z| {np.median(np.abs(zj)):.3f} "
+            f"max |z| {np.max(np.abs(zj)):.1f}"
+        )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--truths", type=int, default=10)
+    ap.add_argument("--noise-draws", type=int, default=5)
+    ap.add_argument("--seed", type=int, default=2027)
+    ap.add_argument("--model", choices=["convex", "map"], default="convex")
+    ap.add_argument("--render-px", type=int, default=128)
+    a = ap.parse_args()
+    mesh, normals, areas = box_wing()
+    law = scattering_law("lambert")
+    light: LightModel = ConvexLight(normals, areas, law)
+    if a.model == "map":
+        start = time.perf_counter()
+        rmap = tabulated_map(
+            lambda s_b, o_b: render(mesh, s_b, o_b, 64), nside=8,
+            phase_angle_deg=np.arange(30.0, 120.0, 10.0), n_rolls=32,
+        )  # fmt: skip
+        light = MapLight(rmap)
+        print(f"map built in {time.perf_counter() - start:.1f} s (wall)", flush=True)
+    t_s, sun, obs = geometry()
+    chp = np.sqrt(0.5 * (1 + np.sum(sun * obs, axis=1)))
+    t_jd = 2459000.5 + t_s / 86400.0
+    rng = np.random.default_rng(a.seed)
+    pulls: dict[str, list[np.ndarray]] = {m: [] for m in METHODS}
+    left = 0
+    cpu0 = time.process_time()
+    for k in range(a.truths):
+        truth = draw_truth(rng)
+        q, _ = torque_free_attitude(t_s, truth.moments, truth.q0, truth.omega0_body_rad_s)
+        qc = quat_conjugate(q)
+        sun_b, obs_b = quat_rotate(qc, sun), quat_rotate(qc, obs)
+        if a.model == "map":
+            y = render(mesh, sun_b, obs_b, a.render_px)
+        else:
+            y = facet_brightness(sun_b, obs_b, normals, areas, law, chp)
+        sigma = 0.01 * np.mean(y)
+        x_truth = _state_vector(truth, 1.0)[:8]
+        for j in range(a.noise_draws):
+            data = build_inversion_data(
+                t_jd, y + sigma * rng.normal(size=y.size), np.full(y.size, sigma), sun, obs,
+                np.repeat([0, 1], 60), np.array([False, False]), "bench",
+            )  # fmt: skip
+            prob = _Problem(data, light, t_jd[0])
+            res = least_squares(
+                prob.residuals, x_truth, method="trf", x_scale="jac", max_nfev=MAX_EVALUATIONS
+            )
+            q0, w0, moments, _ = prob.state(np.append(res.x, 0.0))
+            if not same_family(TumblingState(q0, w0, moments, 0.0), truth):
+                left += 1
+                print(f"truth {k} draw {j}: left the truth's family (chi2 {2 * res.cost:.1f})")
+                continue
+            line = f"truth {k} draw {j}: chi2 {2 * res.cost:.1f}"
+            for m in METHODS:
+                z = pulls_of(res.x, x_truth, state_std(res.x, res.jac, res.fun, m))
+                pulls[m].append(z)
+                line += f" | {m} " + " ".join(f"{v:+.2f}" for v in z)
+            print(line, flush=True)
+    print(
+        f"{a.model}, seed {a.seed}: {a.truths} truths x {a.noise_draws} noise draws, "
+        f"{left} left the family; CPU {time.process_time() - cpu0:.0f} s"
+    )
+    for m in METHODS:
+        report(m, pulls[m])
+
+
+if __name__ == "__main__":
+    main()
