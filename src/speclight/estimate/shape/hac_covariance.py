@@ -65,3 +65,19 @@ def hac_covariance(jac: F64, residuals: F64, bandwidth: float | None = None) -> 
         meat += weight * (cross + cross.T)
     bread = np.linalg.pinv(jac.T @ jac)
     return np.asarray(bread @ meat @ bread * n / max(n - p, 1))
+
+
+def block_jackknife_covariance(jac: F64, residuals: F64, n_blocks: int) -> F64:
+    """(P, P) delete-a-block jackknife covariance, linearised (Kunsch 1989, Ann. Stat. 17,
+    1217): the points in ``n_blocks`` contiguous blocks in time order; leaving block ``g``
+    out moves the solution by the Gauss-Newton step ``(B - J_g^T J_g)^+ J_g^T r_g``, and
+    the covariance is ``(G - 1) / G`` times the sum of the steps' outer products about
+    their mean."""
+    bread = jac.T @ jac
+    steps = []
+    for idx in np.array_split(np.arange(len(residuals)), n_blocks):
+        jg = jac[idx]
+        steps.append(np.linalg.pinv(bread - jg.T @ jg) @ (jg.T @ residuals[idx]))
+    d = np.array(steps) - np.mean(steps, axis=0)
+    return np.asarray((n_blocks - 1) / n_blocks * d.T @ d)
+

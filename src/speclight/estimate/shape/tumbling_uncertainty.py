@@ -27,15 +27,20 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import stats
 from scipy.spatial.transform import Rotation
 
 from speclight.attitude.quaternion import quat_rotate
-from speclight.estimate.shape.hac_covariance import hac_covariance
+from speclight.estimate.shape.hac_covariance import block_jackknife_covariance, hac_covariance
 from speclight.estimate.shape.tumbling_principal import lag1_correlation
 from speclight.estimate.shape.tumbling_search import moments_from_u
 
 F64 = NDArray[np.float64]
-CovarianceMethod = Literal["sandwich", "scalar"]
+CovarianceMethod = Literal["sandwich", "jackknife", "scalar"]
+#: Contiguous blocks of the delete-a-block jackknife.
+JACKKNIFE_BLOCKS = 20
+#: Weight of the model-error term (module doc).
+MODEL_ERROR_WEIGHT = 1.0
 #: Step of the central differences: of the rotation vector [rad], the rates [relative] and
 #: ``u`` [1].
 STEP = 1e-6
@@ -70,28 +75,49 @@ def state_summary(x: F64, east: F64, north: F64) -> F64:
     return np.array([rate, m[0] / m[2], m[1] / m[2], h @ east, h @ north])
 
 
+def excess_share(residuals: F64, n_par: int) -> float:
+    """Share of the chi-square above the noise floor: ``max(0, 1 - q / chi2)``, ``q`` the
+    99 % point of chi-square with ``n - n_par`` degrees of freedom (0 where the residuals
+    are the stated noise)."""
+    chi2 = float(np.sum(residuals**2))
+    floor = float(stats.chi2.ppf(0.99, max(len(residuals) - n_par, 1)))
+    return max(0.0, 1.0 - floor / chi2) if chi2 > 0 else 0.0
+
+
 def parameter_covariance(
-    jac: F64, residuals: F64, method: CovarianceMethod = "sandwich"
+    jac: F64,
+    residuals: F64,
+    method: CovarianceMethod = "jackknife",
+    model_error_weight: float = MODEL_ERROR_WEIGHT,
 ) -> F64:
     """(P, P) linearised covariance of the state vector (module doc); ``jac`` (N, P) and
-    ``residuals`` (N,) at the solution, in time order."""
-    if method == "sandwich":
-        return hac_covariance(jac, residuals)
+    ``residuals`` (N,) at the solution, in time order; the base estimate times
+    ``1 + model_error_weight f``, ``f`` the :func:`excess_share`."""
     n, p = jac.shape
-    rho = max(lag1_correlation(residuals), 0.0)
-    s2 = float(np.sum(residuals**2)) / max(n - p, 1) * (1 + rho) / (1 - rho)
-    return np.asarray(s2 * np.linalg.pinv(jac.T @ jac))
+    if method == "sandwich":
+        cov = hac_covariance(jac, residuals)
+    elif method == "jackknife":
+        cov = block_jackknife_covariance(jac, residuals, min(JACKKNIFE_BLOCKS, n))
+    else:
+        rho = max(lag1_correlation(residuals), 0.0)
+        s2 = float(np.sum(residuals**2)) / max(n - p, 1) * (1 + rho) / (1 - rho)
+        cov = s2 * np.linalg.pinv(jac.T @ jac)
+    return np.asarray(cov * (1.0 + model_error_weight * excess_share(residuals, p)))
 
 
 def state_std(
-    x: F64, jac: F64, residuals: F64, method: CovarianceMethod = "sandwich"
+    x: F64,
+    jac: F64,
+    residuals: F64,
+    method: CovarianceMethod = "jackknife",
+    model_error_weight: float = MODEL_ERROR_WEIGHT,
 ) -> F64:
     """(5,) standard deviations of :func:`state_summary` at the solution ``x`` (module
     doc): the rate [rad/s], the two moment ratios [1], the momentum direction along east
     and north [rad]; ``jac`` (N, P) and ``residuals`` (N,) at ``x`` (``P`` its first
     parameters)."""
     p = jac.shape[1]
-    cov = parameter_covariance(jac, residuals, method)
+    cov = parameter_covariance(jac, residuals, method, model_error_weight)
     east, north = momentum_basis(momentum_direction(x))
     grad = np.zeros((len(SUMMARY), p))
     rate_step = STEP * float(np.linalg.norm(x[3:6]))
