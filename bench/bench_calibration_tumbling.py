@@ -15,11 +15,12 @@ momentum direction (east and north at the estimate) should have a standard devia
 ``--model map``: light curves rendered by speclight (128 px, the shadows), fitted with the
 box-wing's reflectivity map (nside 8, phase angles 30-110 deg, 32 rolls, 64 px, built once):
 model error. ``--model convex-on-render``: the rendered curves fitted with the convex model
-(no shadows: a larger model error). A draw whose fit leaves the truth's family (``same_family``) is counted and
-left out of the pulls.
+(no shadows: a larger model error). A draw whose fit leaves the truth's family
+(``same_family``) is counted and left out of the pulls.
 
     .venv/bin/python bench/bench_calibration_tumbling.py --truths 10 --noise-draws 5
-    .venv/bin/python bench/bench_calibration_tumbling.py --model map --truths 10 --noise-draws 5
+    .venv/bin/python bench/bench_calibration_tumbling.py --model map --truths 40 --noise-draws 2
+    .venv/bin/python bench/bench_calibration_tumbling.py --pool A.npz B.npz  # pooled pulls
 """
 
 from __future__ import annotations
@@ -28,9 +29,9 @@ import argparse
 import time
 
 import numpy as np
-from bench_tumbling_far import WHITE, draw_truth, geometry, render
 from scipy.optimize import least_squares
 
+from bench_tumbling_far import WHITE, draw_truth, geometry, render
 from speclight.attitude import torque_free_attitude
 from speclight.attitude.quaternion import quat_conjugate, quat_rotate
 from speclight.estimate.shape.convex_model import facet_brightness
@@ -56,8 +57,8 @@ from speclight.estimate.shape.tumbling_uncertainty import (
     CovarianceMethod,
     momentum_basis,
     momentum_direction,
-    state_summary,
     state_std,
+    state_summary,
 )
 from speclight.target import shapes
 from speclight.target.parts import Part, Target
@@ -104,7 +105,16 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=2027)
     ap.add_argument("--model", choices=["convex", "map", "convex-on-render"], default="convex")
     ap.add_argument("--render-px", type=int, default=128)
+    ap.add_argument("--save", help="write the pulls of every variant to this .npz")
+    ap.add_argument("--pool", nargs="+", help="report the pulls of these .npz files pooled")
     a = ap.parse_args()
+    if a.pool:
+        files = [np.load(f) for f in a.pool]
+        print(f"pooled: {', '.join(a.pool)}")
+        for m, w in VARIANTS:
+            key = f"{m}_{w:g}"
+            report(f"{m}, model-error weight {w:g}", list(np.vstack([f[key] for f in files])))
+        return
     mesh, normals, areas = box_wing()
     law = scattering_law("lambert")
     light: LightModel = ConvexLight(normals, areas, law)
@@ -162,6 +172,8 @@ def main() -> None:
     )
     for m, w in VARIANTS:
         report(f"{m}, model-error weight {w:g}", pulls[m, w])
+    if a.save:
+        np.savez(a.save, **{f"{m}_{w:g}": np.array(z) for (m, w), z in pulls.items()})
 
 
 if __name__ == "__main__":

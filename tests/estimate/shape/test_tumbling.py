@@ -268,6 +268,7 @@ def test_principal_axis_rotation_is_not_tumbling_fast():
     assert ds.attrs["tumbling_detected"] == 0
     assert np.all(np.isfinite(ds.tumbling_rate_std)) and np.all(ds.tumbling_rate_std > 0)
     assert np.all(np.isfinite(ds.tumbling_moment_ratio_std))
+    assert ds.tumbling_momentum_direction_std.dims == ("family", "east_north")
 
 
 def test_body_symmetry_keeps_the_family():
