@@ -148,3 +148,9 @@ def test_state_std_against_sampling():
     spread = np.std([state_summary(s, east, north) for s in samples], axis=0, ddof=1)
     assert len(std) == len(SUMMARY)
     np.testing.assert_allclose(std, spread, rtol=4 * np.sqrt(1 / (2 * n)) + 0.01)
+
+
+def test_unknown_method_names_the_choices():
+    j = _jacobian(A_TRUE, K_TRUE)
+    with pytest.raises(ValueError, match=r"method = 'bootstrap'.*jackknife"):
+        parameter_covariance(j, np.ones(T.size), "bootstrap")  # type: ignore[arg-type]

@@ -10,7 +10,7 @@ to SHAPE.nc along ``family`` (lowest chi-square first): ``tumbling_chi2``,
 ``tumbling_momentum_direction(family, xyz)`` (ecliptic J2000), ``tumbling_rate`` [rad s-1],
 ``tumbling_moment_ratio(family, ratio)``, their standard deviations ``tumbling_rate_std``,
 ``tumbling_moment_ratio_std`` and ``tumbling_momentum_direction_std(family, east_north)``
-[rad] (:mod:`.tumbling_uncertainty`: linearised, residual correlation counted),
+[rad] (:mod:`.tumbling_uncertainty`: block jackknife with a model-error term),
 ``tumbling_members``, the best state's
 ``tumbling_q0(family, quaternion)`` and ``tumbling_omega0(family, xyz)`` [rad s-1] at
 ``tumbling_t0_jd``.

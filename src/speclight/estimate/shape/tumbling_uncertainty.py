@@ -41,7 +41,7 @@ standard deviations follow from ``C`` through central differences of the summary
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Literal, get_args
 
 import numpy as np
 from numpy.typing import NDArray
@@ -49,6 +49,7 @@ from scipy import stats
 from scipy.spatial.transform import Rotation
 
 from speclight.attitude.quaternion import quat_rotate
+from speclight.errors import InputError
 from speclight.estimate.shape.tumbling_principal import lag1_correlation
 from speclight.estimate.shape.tumbling_search import moments_from_u
 
@@ -173,10 +174,16 @@ def parameter_covariance(
         cov = hac_covariance(jac, residuals)
     elif method == "jackknife":
         cov = block_jackknife_covariance(jac, residuals, min(JACKKNIFE_BLOCKS, n))
-    else:
+    elif method == "scalar":
         rho = max(lag1_correlation(residuals), 0.0)
         s2 = float(np.sum(residuals**2)) / max(n - p, 1) * (1 + rho) / (1 - rho)
         cov = s2 * np.linalg.pinv(jac.T @ jac)
+    else:
+        raise InputError(
+            f"method = {method!r} is not a covariance method; choose one of "
+            f"{', '.join(get_args(CovarianceMethod))}",
+            field="method",
+        )
     return np.asarray(cov * (1.0 + model_error_weight * excess_share(residuals, p)))
 
 
