@@ -25,13 +25,13 @@ of three base estimates (:data:`CovarianceMethod`):
 **Model-error term.** Every residual-based estimate sees only what the fit leaves: where
 the light model is wrong (a map's interpolation, shadows a convex model lacks) the part of
 the misfit that looks like a change of state is absorbed into the state, biasing it, and
-is missing from the residuals. Measured on rendered light curves fitted with the
-reflectivity map, the bias of the state is 1.3-2 times what a misfit of the same size
-independent of the Jacobian would cause (BENCHMARKS.md, "Tumbling uncertainty"). So the
-base estimate is multiplied by ``1 + w f``, ``f`` the share of the chi-square above the
-noise floor (:func:`excess_share`: 0 when the residuals are the stated noise, so noise
-alone keeps the base estimate) and ``w`` = :data:`MODEL_ERROR_WEIGHT`, calibrated over
-blind draws (the bench ``bench/bench_calibration_tumbling.py``).
+is missing from the residuals. On rendered light curves fitted with the reflectivity map
+every residual-based estimate above came out 1.5-2.7 times too small (BENCHMARKS.md,
+"Tumbling uncertainty"). So the base estimate is multiplied by ``1 + w f``, ``f`` the
+share of the chi-square above the noise floor (:func:`excess_share`: 0 when the residuals
+are the stated noise, so noise alone keeps the base estimate) and ``w`` =
+:data:`MODEL_ERROR_WEIGHT`, calibrated over blind draws (``bench/bench_calibration_tumbling.py``:
+tuned on 200 random states of the box-wing with its map, checked on 60 others).
 
 The summary (:func:`state_summary`): the rate ``|H| / I_max`` [rad/s], the sorted moment
 ratios, and the unit angular momentum's components along the local east (increasing
