@@ -63,7 +63,8 @@ class ShapeInput:
     source
         What was read, in words.
     loaded
-        The scenario (speclight input), else None.
+        The scenario (speclight input; with a DAMIT file the one given, for its target),
+        else None.
     bands
         The chosen bands' responses (speclight input), else None.
     """
@@ -98,7 +99,8 @@ def read_shape_input(
     check_format(fmt)
     src = str(path)
     if fmt == "damit":
-        return ShapeInput(from_damit(read_damit_lc(path), src), [], None, None, "1", src)
+        # the scenario, when given, only for its target (the tumbling fit's convex model)
+        return ShapeInput(from_damit(read_damit_lc(path), src), [], None, None, "1", src, loaded)
     return _speclight_input(Path(path), loaded, bands)
 
 
