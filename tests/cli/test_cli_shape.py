@@ -90,9 +90,9 @@ def test_shape_bad_input_exits_2(tmp_path):
         (["--format", "damit", "--nside", "3"], "nside"),
         (["--format", "damit", "--map", str(tmp_path / "m.zarr")], "--tumbling-starts"),
         (["--format", "damit", "--tumbling-starts", "1", "--map", str(lc)], "Zarr"),
-        (["--format", "damit", "--map-resolution", "4"], "--tumbling-starts"),
+        (["--format", "damit", "--map-nside", "4"], "--tumbling-starts"),
         (["--format", "damit", "--no-map"], "--tumbling-starts"),
-        (["--format", "damit", "--tumbling-starts", "1", "--map-resolution", "3"], "1, 2, 4"),
+        (["--format", "damit", "--tumbling-starts", "1", "--map-nside", "3"], "1, 2, 4"),
         (["--format", "damit", "--tumbling-starts", "1"], "--scenario"),
         (
             [
@@ -100,7 +100,7 @@ def test_shape_bad_input_exits_2(tmp_path):
                 "damit",
                 "--tumbling-starts",
                 "1",
-                "--map-resolution",
+                "--map-nside",
                 "2",
                 "--scenario",
                 str(_scenario(tmp_path)),

@@ -17,7 +17,7 @@ SHAPE_FLAGS = {
     "fmt": "--format", "period_range_h": "--period-range-h", "law": "--law",
     "bands": "--bands", "nside": "--nside", "pole_step_deg": "--pole-step-deg",
     "loaded": "--scenario", "n_starts": "--tumbling-starts", "map_path": "--map",
-    "map_resolution": "--map-resolution", "no_map": "--no-map",
+    "map_resolution": "--map-nside", "no_map": "--no-map",
 }  # fmt: skip
 
 
@@ -80,15 +80,15 @@ def shape(
             "--tumbling-starts.",
         ),
     ] = None,
-    map_resolution: Annotated[
+    map_nside: Annotated[
         int | None,
         typer.Option(
-            "--map-resolution",
+            "--map-nside",
             metavar="NSIDE",
-            help="Resolution of the map built from the scenario without --map: HEALPix nside "
-            "(1, 2, 4, 8 or 16) of its 12 NSIDE^2 phase-vector directions, with 4 NSIDE rolls, "
-            "phase angles every 80/NSIDE deg around the light curves' and renders of 8 NSIDE "
-            "px. Default 8 (768 directions, 32 rolls, 10 deg, 64 px).",
+            help="Resolution of the reflectivity map built from the scenario without --map: "
+            "the HEALPix nside of its 12 NSIDE^2 phase-vector directions (1, 2, 4, 8 or 16; "
+            "default 8), with 32 rolls, phase angles every 10 deg around the light curves' "
+            "and renders of 64 px. Cached: a rerun does not render again.",
         ),
     ] = None,
     no_map: Annotated[
@@ -112,7 +112,7 @@ def shape(
     def run() -> None:
         from speclight.cli.shape_files import shape_files
         from speclight.estimate.shape.shape_run import ShapeOptions
-        from speclight.estimate.shape.tumbling_map import map_resolution as map_resolution_of
+        from speclight.maps.writer.cached_map import MapResolution
 
         for name, value, ok in (
             ("--nside", nside, nside in (1, 2, 4, 8, 16)),
@@ -126,7 +126,7 @@ def shape(
                 )
         for flag, given, text in (
             ("--map", tumbling_map is not None, f"--map {tumbling_map}"),
-            ("--map-resolution", map_resolution is not None, f"--map-resolution {map_resolution}"),
+            ("--map-nside", map_nside is not None, f"--map-nside {map_nside}"),
             ("--no-map", no_map, "--no-map"),
         ):
             if given and tumbling_starts == 0:
@@ -146,8 +146,11 @@ def shape(
             seed=seed,
             progress=True,
         )
+        resolution = None
+        if map_nside is not None:
+            with flag_names(nside="--map-nside"):
+                resolution = MapResolution.of_nside(map_nside)
         with flag_names(**SHAPE_FLAGS):
-            resolution = None if map_resolution is None else map_resolution_of(map_resolution)
             ds, _ = shape_files(
                 lc=lc, fmt=fmt, scenario=scenario, options=options, output=output,
                 plot=plot_file, force=force, bands=names, tumbling_starts=tumbling_starts,

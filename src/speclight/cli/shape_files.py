@@ -18,7 +18,7 @@ from speclight.estimate.shape.minkowski import format_obj
 from speclight.estimate.shape.shape_dataset import shape_dataset
 from speclight.estimate.shape.shape_inputs import check_format, read_shape_input
 from speclight.estimate.shape.shape_run import ShapeOptions, ShapeRun, resolve_law, run_shape
-from speclight.estimate.shape.tumbling_map import MapResolution
+from speclight.maps.writer.cached_map import MapResolution
 
 
 def obj_path(output: str | Path) -> Path:

@@ -1,5 +1,5 @@
 """The tumbling fit's light model chosen and its reflectivity map built from the scenario
-(tumbling_run.py :func:`tumbling_light`, tumbling_map.py): built when absent, found in the
+(tumbling_run.py :func:`tumbling_light`, maps/writer/cached_map.py): built when absent, found in the
 cache on a rerun, equal to a map made by ``speclight reflectivity-map`` with the same
 settings (an independent route: the command line on a scenario file), refused for DAMIT
 light curves. Maps at the smallest resolution (12 directions, 4 rolls, 8 px) to stay fast."""
@@ -21,13 +21,13 @@ from speclight.estimate.shape.inversion_data import build_inversion_data
 from speclight.estimate.shape.scattering import scattering_law
 from speclight.estimate.shape.shape_inputs import ShapeInput
 from speclight.estimate.shape.tumbling_light import ConvexLight, band_map_light
-from speclight.estimate.shape.tumbling_map import map_phase_angles_deg, map_resolution
 from speclight.estimate.shape.tumbling_run import tumbling_light
 from speclight.maps.map_geometry import sun_observer
+from speclight.maps.writer.cached_map import MapResolution, map_phase_angles_deg
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # tests/estimate: map_scenarios
 F32_EPS = float(np.finfo(np.float32).eps)
-TINY = map_resolution(1)  # 12 directions, 4 rolls, phase angles every 80 deg, 8 px
+TINY = MapResolution(1, 4, 80.0, 8)  # 12 directions, 4 rolls, phase angles every 80 deg, 8 px
 LAW = scattering_law("lambert")
 
 
@@ -158,8 +158,9 @@ def test_no_map_and_contradictions(scenario, tmp_path):
             tumbling_light(inputs, LAW, **kwargs)
         assert err.value.field == field
     with pytest.raises(InputError, match="1, 2, 4, 8, 16") as err:
-        map_resolution(3)
-    assert err.value.field == "map_resolution"
+        MapResolution.of_nside(3)
+    assert err.value.field == "nside"
+    assert MapResolution.of_nside() == MapResolution(8, 32, 10.0, 64)  # docs/shape.md
 
 
 def test_map_phase_angles_cover_the_data():

@@ -6,20 +6,23 @@ reflectivity map (rendered, so with the shadows its parts cast on each other), i
 rates turned into the mean reflectance factor of the light curves' bands: the map given
 (``map_path``, made by ``speclight reflectivity-map`` from the same scenario), the
 scenario's own (``render.mode: map``), or else one built from the scenario and cached
-(:mod:`.tumbling_map`). DAMIT light curves have no bands, and with ``no_map=True`` no
-map is used: the convex model of the scenario's target mesh (:func:`.egi.mesh_facets`:
-faces as the render sees them, without shadows) under the run's law. Variables added
-to SHAPE.nc along ``family`` (lowest chi-square first): ``tumbling_chi2``,
-``tumbling_momentum_direction(family, xyz)`` (ecliptic J2000), ``tumbling_rate`` [rad s-1],
-``tumbling_moment_ratio(family, ratio)``, their standard deviations ``tumbling_rate_std``
-and ``tumbling_moment_ratio_std`` (:mod:`.tumbling_uncertainty`: linearised, residual
-correlation counted), ``tumbling_members``, the best state's
+(:mod:`speclight.maps.writer.cached_map`). DAMIT light curves have no bands, and with
+``no_map=True`` no map is used: the convex model of the scenario's target mesh
+(:func:`.egi.mesh_facets`: faces as the render sees them, without shadows) under the
+run's law.
+
+Variables added to SHAPE.nc along ``family`` (lowest chi-square first): ``tumbling_chi2``,
+``tumbling_momentum_direction(family, xyz)`` (ecliptic J2000), ``tumbling_rate``
+[rad s-1], ``tumbling_moment_ratio(family, ratio)``, their standard deviations
+``tumbling_rate_std`` and ``tumbling_moment_ratio_std`` (:mod:`.tumbling_uncertainty`:
+linearised, residual correlation counted), ``tumbling_members``, the best state's
 ``tumbling_q0(family, quaternion)`` and ``tumbling_omega0(family, xyz)`` [rad s-1] at
-``tumbling_t0_jd``; attributes ``tumbling_light_model`` (``reflectivity map`` or
-``convex model``, with why) and, with a map, ``tumbling_map`` (its path),
-``tumbling_map_origin`` (given, the scenario's, built in this run, or from the cache),
-``tumbling_map_nside``, ``tumbling_map_rolls``, ``tumbling_map_phase_angle_deg`` and
-``tumbling_map_resolution_px``.
+``tumbling_t0_jd``. Attributes of the light model: ``tumbling_light_model``
+(``reflectivity map`` or ``convex model``), ``tumbling_light_note`` (why, or where the
+map comes from: given, the scenario's, built in this run or from the cache, with its
+resolution) and, with a map, ``tumbling_map`` (its path), ``tumbling_map_nside``,
+``tumbling_map_rolls``, ``tumbling_map_phase_angle_deg`` and
+``tumbling_map_resolution_px`` (read from the map).
 """
 
 from __future__ import annotations
@@ -39,7 +42,7 @@ from speclight.estimate.shape.scattering import ScatteringLaw
 from speclight.estimate.shape.shape_inputs import ShapeInput
 from speclight.estimate.shape.tumbling import TumblingFit, TumblingState, fit_tumbling
 from speclight.estimate.shape.tumbling_light import ConvexLight, LightModel, band_map_light
-from speclight.estimate.shape.tumbling_map import MapResolution, scenario_map
+from speclight.maps.writer.cached_map import MapResolution, scenario_map
 from speclight.scenario import LoadedScenario
 
 
@@ -131,7 +134,6 @@ class TumblingLight:
             h = read_header(self.map_path)
             out.update(
                 tumbling_map=str(self.map_path),
-                tumbling_map_origin=self.note,
                 tumbling_map_nside=h.nside,
                 tumbling_map_rolls=int(h.roll_deg.size),
                 tumbling_map_phase_angle_deg=h.phase_angle_deg,
@@ -163,13 +165,13 @@ def tumbling_light(
         A reflectivity map of the scenario's target to use (``speclight reflectivity-map``).
     no_map
         True: the convex model of the mesh; else, without ``map_path``, the scenario's map
-        (``render.mode: map``) or one built from it (:func:`.tumbling_map.scenario_map`).
+        (``render.mode: map``) or one built from it (:func:`.cached_map.scenario_map`).
     map_resolution
-        Resolution of the map built (default :func:`.tumbling_map.map_resolution`).
+        Resolution of the map built (default :meth:`.cached_map.MapResolution.of_nside`).
     cache_dir
         Cache folder of the built maps (default :func:`speclight.cache.cache_root`).
     progress, say
-        The build's progress bar and its messages (:func:`.tumbling_map.scenario_map`).
+        The build's progress bar and its messages (:func:`.cached_map.scenario_map`).
     """
     loaded = _require_target(inputs)
     if map_path is not None and (no_map or map_resolution is not None):

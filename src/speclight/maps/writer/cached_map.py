@@ -1,19 +1,21 @@
-"""The tumbling fit's reflectivity map built from the scenario, cached between runs.
+"""A reflectivity map built from a scenario into the cache, found there on a rerun.
 
-``speclight shape --tumbling-starts N --scenario S`` without ``--map`` renders the
-scenario's target into a reflectivity map (:func:`speclight.maps.writer.reflectivity_map`,
-the writer of ``speclight reflectivity-map``: the same store, the same renders) at a modest
-resolution (:class:`MapResolution`), over the phase angles of the light curves, and keeps it
-in the cache folder (:func:`speclight.cache.cache_root`, ``tumbling-maps/``) under a name
-made from a hash of what the map depends on: the scenario's target, materials, spectrum,
-render settings and instrument (and the files they name, by their SHA-256), the resolution
-and the phase angles. A rerun finds it there and does not render again; an interrupted build
-resumes where it stopped (the writer's resume).
+:func:`scenario_map` renders the scenario's target into a reflectivity map
+(:func:`.reflectivity_map_run.reflectivity_map`, the writer of ``speclight
+reflectivity-map``: the same store, the same renders) at a modest resolution
+(:class:`MapResolution`: the scenario's ``render.resolution_px`` replaced), over the phase
+angles asked for, and keeps it in the cache folder (:func:`speclight.cache.cache_root`,
+``tumbling-maps/``) under a name made from a hash of what the map depends on: the scenario's
+target, materials, spectrum, render settings, instrument and illumination (and the files
+they name, by their SHA-256), the resolution and the phase angles. A rerun finds it there
+and does not render again; an interrupted build resumes where it stopped (the writer's
+resume). ``speclight shape --tumbling-starts N`` uses it for its light model
+(:mod:`speclight.estimate.shape.tumbling_run`).
 
 The default resolution (HEALPix nside 8, 32 rolls, phase angles every 10 deg, 64 px) is the
-one measured on the rendered box-wing of the tests (BENCHMARKS.md, "a reflectivity map as
-the light model"): the map's own error there is a chi-square of about 750 on 120 points
-(the render's own pixel error at 64 px is of that size), the convex model's about 7,500.
+one measured on the rendered box-wing of the shape tests (BENCHMARKS.md, "a reflectivity
+map as the light model"): the map's own error there is a chi-square of about 750 on 120
+points (the render's own pixel error at 64 px is of that size), the convex model's 7,500.
 """
 
 from __future__ import annotations
@@ -30,19 +32,20 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.errors import InputError
+from speclight.maps.writer.reflectivity_map_run import MAX_PHASE_ANGLE_DEG, reflectivity_map
 from speclight.scenario import LoadedScenario
 
 F64 = NDArray[np.float64]
 #: Sub-folder of the cache folder holding the built maps.
 CACHE_KIND = "tumbling-maps"
-#: Accepted values of :func:`map_resolution`'s ``nside`` (the HEALPix nside of the map).
+#: Accepted values of :meth:`MapResolution.of_nside` (the HEALPix nside of the map).
 MAP_NSIDES = (1, 2, 4, 8, 16)
-#: Default of :func:`map_resolution` (the measured one, module doc).
+#: Default of :meth:`MapResolution.of_nside` (the measured one, module doc).
 DEFAULT_MAP_NSIDE = 8
+#: Rolls, phase-angle step [deg] and render size [px] of :meth:`MapResolution.of_nside`.
+DEFAULT_ROLLS, DEFAULT_PHASE_STEP_DEG, DEFAULT_RESOLUTION_PX = 32, 10.0, 64
 #: Scenario sections a map depends on (the rest, time, orbit, attitude and site, not).
 MAP_SECTIONS = ("target", "spectrum", "render", "instrument", "illumination")
-#: Largest phase angle a map stores [deg] (:mod:`speclight.maps.writer`).
-MAX_PHASE_ANGLE_DEG = 179.0
 #: Bumped when the way a map is built here changes (old cache entries are then not used).
 BUILD_VERSION = 1
 
@@ -68,25 +71,26 @@ class MapResolution:
     phase_step_deg: float
     resolution_px: int
 
+    @classmethod
+    def of_nside(cls, nside: int = DEFAULT_MAP_NSIDE) -> MapResolution:
+        """HEALPix ``nside`` (``12 nside^2`` phase-vector directions) with
+        :data:`DEFAULT_ROLLS` rolls, phase angles every :data:`DEFAULT_PHASE_STEP_DEG` deg
+        and renders of :data:`DEFAULT_RESOLUTION_PX` px (module doc: the directions are what
+        a glint needs, the rolls what the shadows need)."""
+        if nside not in MAP_NSIDES:
+            raise InputError(
+                f"nside = {nside} is not accepted (a HEALPix nside: "
+                f"{', '.join(map(str, MAP_NSIDES))})",
+                field="nside",
+            )
+        return cls(nside, DEFAULT_ROLLS, DEFAULT_PHASE_STEP_DEG, DEFAULT_RESOLUTION_PX)
+
     def describe(self) -> str:
         """One line, e.g. ``HEALPix nside 8, 32 rolls, phase angles every 10 deg, 64 px``."""
         return (
             f"HEALPix nside {self.nside}, {self.rolls} rolls, phase angles every "
             f"{self.phase_step_deg:g} deg, {self.resolution_px} px"
         )
-
-
-def map_resolution(nside: int = DEFAULT_MAP_NSIDE) -> MapResolution:
-    """The resolution of one knob: HEALPix ``nside``, ``4 nside`` rolls, phase angles every
-    ``80 / nside`` deg and renders of ``8 nside`` px, so that every axis refines together
-    (``nside`` 8: 768 directions, 32 rolls, 10 deg, 64 px, the measured default)."""
-    if nside not in MAP_NSIDES:
-        raise InputError(
-            f"map_resolution = {nside} is not accepted (a HEALPix nside: "
-            f"{', '.join(map(str, MAP_NSIDES))})",
-            field="map_resolution",
-        )
-    return MapResolution(nside, 4 * nside, 80.0 / nside, 8 * nside)
 
 
 def map_phase_angles_deg(phase_angle_deg: F64, step_deg: float) -> list[float]:
@@ -147,18 +151,18 @@ def scenario_map(
     progress: bool = False,
     say: Callable[[str], None] | None = None,
 ) -> ScenarioMap:
-    """The reflectivity map of ``loaded``'s target covering ``phase_angle_deg`` (the light
-    curves' phase angles [deg]), from the cache or built there (module doc).
+    """The reflectivity map of ``loaded``'s target covering ``phase_angle_deg`` [deg], from
+    the cache or built there (module doc).
 
     Parameters
     ----------
     loaded
         The scenario of the light curves (target, materials, spectrum, render, bands).
     phase_angle_deg
-        The light curves' phase angles [deg]: the map stores multiples of the resolution's
-        step around them.
+        The phase angles to cover [deg] (e.g. the light curves'): the map stores multiples
+        of the resolution's step around them.
     resolution
-        The map's resolution (default :func:`map_resolution`).
+        The map's resolution (default :meth:`MapResolution.of_nside`).
     cache_dir
         The cache folder (default :func:`speclight.cache.cache_root`).
     progress
@@ -167,10 +171,9 @@ def scenario_map(
         Called with one line before a build (what, where, how many renders) and after it.
     """
     from speclight.maps.map_lookup import read_header
-    from speclight.maps.writer import reflectivity_map
     from speclight.scenario.overrides import with_overrides
 
-    res = resolution if resolution is not None else map_resolution()
+    res = resolution if resolution is not None else MapResolution.of_nside()
     angles = map_phase_angles_deg(phase_angle_deg, res.phase_step_deg)
     map_loaded = with_overrides(loaded, {"render.resolution_px": res.resolution_px})
     path = map_cache_path(map_loaded, res, angles, cache_dir)
@@ -201,8 +204,8 @@ def scenario_map(
         first = next(iter(run.failed.items()), ("?", "unknown"))
         raise InputError(
             f"the reflectivity map {path} is unfinished: {len(run.failed)} chunk(s) failed "
-            f"(chunk {first[0]}: {first[1]}); run again to retry them, or give map_path",
-            field="map_path",
+            f"(chunk {first[0]}: {first[1]}); run again to retry them",
+            field="output",
         )
     seconds = time.perf_counter() - start
     if say is not None:
