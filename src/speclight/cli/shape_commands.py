@@ -65,8 +65,9 @@ def shape(
         int,
         typer.Option(
             "--tumbling-starts",
-            help="Also fit torque-free (tumbling) states from "
-            "this many random starts, the scenario's target as the EGI (0: off).",
+            help="Also fit torque-free (tumbling) states from this many random starts, the "
+            "scenario's target as the light model: its reflectivity map (--map, else built "
+            "and cached) or, with --no-map or DAMIT input, its mesh's convex model (0: off).",
         ),
     ] = 0,
     tumbling_map: Annotated[

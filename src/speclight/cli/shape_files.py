@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from contextlib import ExitStack
+from dataclasses import replace
 from pathlib import Path
 
 import xarray as xr
@@ -97,12 +98,14 @@ def shape_files(
 
             loaded = load_scenario(scenario)
         data = read_shape_input(lc, fmt, loaded, bands)
+        # DAMIT light curves: the scenario given only for its target (the tumbling fit's)
+        tumbling_data = data if data.loaded is not None else replace(data, loaded=loaded)
         light = None
         if tumbling_starts > 0:  # the light model first: its errors before the long run
             from speclight.estimate.shape.tumbling_run import tumbling_light
 
             light = tumbling_light(
-                data, resolve_law(options, data), map_path=tumbling_map, no_map=no_map,
+                tumbling_data, resolve_law(options, data), map_path=tumbling_map, no_map=no_map,
                 map_resolution=map_resolution, progress=options.progress, say=say,
             )  # fmt: skip
             if say is not None:
@@ -113,7 +116,7 @@ def shape_files(
             from speclight.estimate.shape.tumbling_run import add_tumbling, tumbling_fit
 
             fit = tumbling_fit(
-                data, light.model, min_period_h=options.min_period_h,
+                tumbling_data, light.model, min_period_h=options.min_period_h,
                 max_period_h=options.max_period_h, n_starts=tumbling_starts, seed=options.seed,
             )  # fmt: skip
             ds = add_tumbling(ds, fit, light)

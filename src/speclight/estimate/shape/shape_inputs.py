@@ -63,8 +63,7 @@ class ShapeInput:
     source
         What was read, in words.
     loaded
-        The scenario (speclight input; with a DAMIT file the one given, for its target),
-        else None.
+        The scenario (speclight input), else None.
     bands
         The chosen bands' responses (speclight input), else None.
     """
@@ -99,8 +98,7 @@ def read_shape_input(
     check_format(fmt)
     src = str(path)
     if fmt == "damit":
-        # the scenario, when given, only for its target (the tumbling fit's convex model)
-        return ShapeInput(from_damit(read_damit_lc(path), src), [], None, None, "1", src, loaded)
+        return ShapeInput(from_damit(read_damit_lc(path), src), [], None, None, "1", src)
     return _speclight_input(Path(path), loaded, bands)
 
 
