@@ -88,8 +88,8 @@ def shape(
             metavar="NSIDE",
             help="Resolution of the reflectivity map built from the scenario without --map: "
             "the HEALPix nside of its 12 NSIDE^2 phase-vector directions (1, 2, 4, 8 or 16; "
-            "default 8), with 32 rolls, phase angles every 10 deg around the light curves' "
-            "and renders of 64 px. Cached: a rerun does not render again.",
+            "default 16: minutes to build), with 32 rolls, phase angles every 10 deg around "
+            "the light curves' and renders of 64 px. Cached: a rerun does not render again.",
         ),
     ] = None,
     no_map: Annotated[

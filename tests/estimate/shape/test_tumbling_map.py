@@ -160,7 +160,7 @@ def test_no_map_and_contradictions(scenario, tmp_path):
     with pytest.raises(InputError, match="1, 2, 4, 8, 16") as err:
         MapResolution.of_nside(3)
     assert err.value.field == "nside"
-    assert MapResolution.of_nside() == MapResolution(8, 32, 10.0, 64)  # docs/shape.md
+    assert MapResolution.of_nside() == MapResolution(16, 32, 10.0, 64)  # docs/shape.md
 
 
 def test_map_phase_angles_cover_the_data():

@@ -12,10 +12,19 @@ and does not render again; an interrupted build resumes where it stopped (the wr
 resume). ``speclight shape --tumbling-starts N`` uses it for its light model
 (:mod:`speclight.estimate.shape.tumbling_run`).
 
-The default resolution (HEALPix nside 8, 32 rolls, phase angles every 10 deg, 64 px) is the
-one measured on the rendered box-wing of the shape tests (BENCHMARKS.md, "a reflectivity
-map as the light model"): the map's own error there is a chi-square of about 750 on 120
-points (the render's own pixel error at 64 px is of that size), the convex model's 7,500.
+The default resolution, HEALPix nside 16 (3,072 phase-vector directions), 32 rolls, phase
+angles every 10 deg and 64 px, is the one measured to be enough on speclight's own light
+curves of the box-wing example made torque-free (``bench/bench_tumbling_map_resolution.py``,
+BENCHMARKS.md "Tumbling: the map built from the scenario"): it has the smallest error at
+the true state (chi-square 1,199 on 54 points, median relative error 3 %), and refitted
+from the true state the fit stays in the truth's family (chi-square 906, moment ratios
+0.463 and 0.799 for 0.45 and 0.80, rate +0.14 %). Coarser maps are not reliably so: nside
+4 stayed (2,768), nside 8 left it (15,161, rate -15 %), its error at the truth (33,880)
+mostly one point, most likely a glint of the wings (cover glass, roughness 0.05) that falls
+between its nodes. The rolls (16 or 32) and the render (32 or 64 px) changed the error at
+nside 8 little there; on the white box-wing the rolls mattered most (the shadows' edges).
+The build took 431 s wall on 2 busy cores (786,432 renders, 368 MB in the cache); nside 8
+82 s (71 MB), nside 4 26 s.
 """
 
 from __future__ import annotations
@@ -41,7 +50,7 @@ CACHE_KIND = "tumbling-maps"
 #: Accepted values of :meth:`MapResolution.of_nside` (the HEALPix nside of the map).
 MAP_NSIDES = (1, 2, 4, 8, 16)
 #: Default of :meth:`MapResolution.of_nside` (the measured one, module doc).
-DEFAULT_MAP_NSIDE = 8
+DEFAULT_MAP_NSIDE = 16
 #: Rolls, phase-angle step [deg] and render size [px] of :meth:`MapResolution.of_nside`.
 DEFAULT_ROLLS, DEFAULT_PHASE_STEP_DEG, DEFAULT_RESOLUTION_PX = 32, 10.0, 64
 #: Scenario sections a map depends on (the rest, time, orbit, attitude and site, not).
