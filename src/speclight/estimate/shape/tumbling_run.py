@@ -197,7 +197,7 @@ def tumbling_light(
                 )
         return _convex(loaded, law, "DAMIT light curves have no band rates to read a map with")
     if map_path is None and no_map:
-        return _convex(loaded, law, "asked for (no_map=True)")
+        return _convex(loaded, law, "asked for instead of a map")
     note = "given"
     render = loaded.scenario.render
     if map_path is None and render.mode == "map" and render.map_file is not None:
