@@ -167,3 +167,18 @@ def test_map_phase_angles_cover_the_data():
     assert map_phase_angles_deg(np.array([31.0, 106.0]), 10.0) == [30.0 + 10 * k for k in range(9)]
     assert map_phase_angles_deg(np.array([40.0, 70.0]), 80.0) == [0.0, 80.0]
     assert map_phase_angles_deg(np.array([150.0, 175.0]), 20.0) == [140.0, 160.0, 179.0]
+
+
+def test_scenario_rendering_from_its_map_uses_that_map(built, scenario):
+    """A scenario with ``render.mode: map`` has its map: that one is the light model (no
+    build), and a resolution for a map to build is refused."""
+    from speclight.scenario.overrides import with_overrides
+
+    first, *_ = built
+    _, loaded = scenario
+    mapped = with_overrides(loaded, {"render.mode": "map", "render.map_file": str(first.map_path)})
+    light = tumbling_light(_inputs(mapped), LAW, cache_dir=Path("/nonexistent"))
+    assert light.map_path == first.map_path and "render.map_file" in light.note
+    with pytest.raises(InputError) as err:
+        tumbling_light(_inputs(mapped), LAW, map_resolution=TINY)
+    assert err.value.field == "map_resolution"
