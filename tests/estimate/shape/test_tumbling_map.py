@@ -161,6 +161,10 @@ def test_no_map_and_contradictions(scenario, tmp_path):
         MapResolution.of_nside(3)
     assert err.value.field == "nside"
     assert MapResolution.of_nside() == MapResolution(16, 32, 10.0, 64)  # docs/shape.md
+    for args, field in (((3, 4, 10.0, 8), "nside"), ((2, 4, 0.0, 8), "phase_step_deg")):
+        with pytest.raises(InputError) as err:
+            MapResolution(*args)
+        assert err.value.field == field
 
 
 def test_map_phase_angles_cover_the_data():

@@ -80,6 +80,17 @@ class MapResolution:
     phase_step_deg: float
     resolution_px: int
 
+    def __post_init__(self) -> None:
+        if not (self.nside >= 1 and self.nside & (self.nside - 1) == 0):
+            raise InputError(
+                f"nside = {self.nside} must be a power of 2 (a HEALPix nside)", field="nside"
+            )
+        if not 0 < self.phase_step_deg <= MAX_PHASE_ANGLE_DEG:
+            raise InputError(
+                f"phase_step_deg = {self.phase_step_deg} must be in (0, {MAX_PHASE_ANGLE_DEG:g}]",
+                field="phase_step_deg",
+            )
+
     @classmethod
     def of_nside(cls, nside: int = DEFAULT_MAP_NSIDE) -> MapResolution:
         """HEALPix ``nside`` (``12 nside^2`` phase-vector directions) with
