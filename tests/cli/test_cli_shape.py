@@ -39,6 +39,15 @@ def _lc(tmp_path: Path) -> Path:
     return path
 
 
+def _scenario(tmp_path: Path) -> Path:
+    """The box-wing example as a file (its target: the tumbling fit's light model)."""
+    from speclight.scenario import example_text
+
+    path = tmp_path / "box-wing.yaml"
+    path.write_text(example_text("box-wing"))
+    return path
+
+
 def test_shape_writes_dataset_obj_and_figure(tmp_path):
     lc = _lc(tmp_path)
     out = tmp_path / "shape.nc"
@@ -81,6 +90,23 @@ def test_shape_bad_input_exits_2(tmp_path):
         (["--format", "damit", "--nside", "3"], "nside"),
         (["--format", "damit", "--map", str(tmp_path / "m.zarr")], "--tumbling-starts"),
         (["--format", "damit", "--tumbling-starts", "1", "--map", str(lc)], "Zarr"),
+        (["--format", "damit", "--map-nside", "4"], "--tumbling-starts"),
+        (["--format", "damit", "--no-map"], "--tumbling-starts"),
+        (["--format", "damit", "--tumbling-starts", "1", "--map-nside", "3"], "1, 2, 4"),
+        (["--format", "damit", "--tumbling-starts", "1"], "--scenario"),
+        (
+            [
+                "--format",
+                "damit",
+                "--tumbling-starts",
+                "1",
+                "--map-nside",
+                "2",
+                "--scenario",
+                str(_scenario(tmp_path)),
+            ],
+            "DAMIT",
+        ),
     ):
         result = CliRunner().invoke(app, [*base, *extra])
         assert result.exit_code == 2, result.output

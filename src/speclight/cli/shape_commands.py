@@ -17,6 +17,7 @@ SHAPE_FLAGS = {
     "fmt": "--format", "period_range_h": "--period-range-h", "law": "--law",
     "bands": "--bands", "nside": "--nside", "pole_step_deg": "--pole-step-deg",
     "loaded": "--scenario", "n_starts": "--tumbling-starts", "map_path": "--map",
+    "map_resolution": "--map-nside", "no_map": "--no-map",
 }  # fmt: skip
 
 
@@ -64,8 +65,9 @@ def shape(
         int,
         typer.Option(
             "--tumbling-starts",
-            help="Also fit torque-free (tumbling) states from "
-            "this many random starts, the scenario's target as the EGI (0: off).",
+            help="Also fit torque-free (tumbling) states from this many random starts, the "
+            "scenario's target as the light model: its reflectivity map (--map, else built "
+            "and cached) or, with --no-map or DAMIT input, its mesh's convex model (0: off).",
         ),
     ] = 0,
     tumbling_map: Annotated[
@@ -74,10 +76,30 @@ def shape(
             "--map",
             metavar="MAP.zarr",
             help="Reflectivity map of the scenario's target (speclight reflectivity-map) as "
-            "the tumbling fit's light model, with the shadows (default: the mesh's convex "
-            "model). Needs --tumbling-starts.",
+            "the tumbling fit's light model, with the shadows (default: the scenario's "
+            "render.map_file, else a map built from the scenario and cached). Needs "
+            "--tumbling-starts.",
         ),
     ] = None,
+    map_nside: Annotated[
+        int | None,
+        typer.Option(
+            "--map-nside",
+            metavar="NSIDE",
+            help="Resolution of the reflectivity map built from the scenario without --map: "
+            "the HEALPix nside of its 12 NSIDE^2 phase-vector directions (1, 2, 4, 8 or 16; "
+            "default 16: minutes to build), with 32 rolls, phase angles every 10 deg around "
+            "the light curves' and renders of 64 px. Cached: a rerun does not render again.",
+        ),
+    ] = None,
+    no_map: Annotated[
+        bool,
+        typer.Option(
+            "--no-map",
+            help="Fit tumbling states with the convex model of the scenario's mesh (no "
+            "shadows, no map built).",
+        ),
+    ] = False,
     plot_file: Plot = None,
     force: Force = False,
 ) -> None:
@@ -91,6 +113,7 @@ def shape(
     def run() -> None:
         from speclight.cli.shape_files import shape_files
         from speclight.estimate.shape.shape_run import ShapeOptions
+        from speclight.maps.writer.cached_map import MapResolution
 
         for name, value, ok in (
             ("--nside", nside, nside in (1, 2, 4, 8, 16)),
@@ -102,12 +125,17 @@ def shape(
                     f"{name} = {value} is not accepted (nside: 1, 2, 4, 8 or 16; the others: >= 0)",
                     field=name,
                 )
-        if tumbling_map is not None and tumbling_starts == 0:
-            raise InputError(
-                f"--map {tumbling_map} is the tumbling fit's light model: give it with "
-                "--tumbling-starts N (N > 0)",
-                field="--map",
-            )
+        for flag, given, text in (
+            ("--map", tumbling_map is not None, f"--map {tumbling_map}"),
+            ("--map-nside", map_nside is not None, f"--map-nside {map_nside}"),
+            ("--no-map", no_map, "--no-map"),
+        ):
+            if given and tumbling_starts == 0:
+                raise InputError(
+                    f"{text} is about the tumbling fit's light model: give it with "
+                    "--tumbling-starts N (N > 0)",
+                    field=flag,
+                )
         names = [b.strip() for b in bands.split(",") if b.strip()] if bands else None
         options = ShapeOptions(
             *period_range_h,
@@ -119,16 +147,22 @@ def shape(
             seed=seed,
             progress=True,
         )
+        resolution = None
+        if map_nside is not None:
+            with flag_names(nside="--map-nside"):
+                resolution = MapResolution.of_nside(map_nside)
         with flag_names(**SHAPE_FLAGS):
             ds, _ = shape_files(
                 lc=lc, fmt=fmt, scenario=scenario, options=options, output=output,
                 plot=plot_file, force=force, bands=names, tumbling_starts=tumbling_starts,
-                tumbling_map=tumbling_map,
+                tumbling_map=tumbling_map, no_map=no_map, map_resolution=resolution,
+                say=lambda line: typer.echo(line, err=True),
             )  # fmt: skip
         a = ds.attrs
         if "tumbling_families" in a:
             typer.echo(
-                f"tumbling: {a['tumbling_families']} solution families (SHAPE.nc tumbling_*)"
+                f"tumbling: {a['tumbling_families']} solution families (SHAPE.nc tumbling_*), "
+                f"light model: {a['tumbling_light_model']} ({a['tumbling_light_note']})"
             )
         typer.echo(
             f"period {a['period_h']:.7g} +- {a['period_std_h']:.2g} h, pole (lambda, "

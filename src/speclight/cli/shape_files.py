@@ -7,7 +7,9 @@ the data constrain a shape) and the figure.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from contextlib import ExitStack
+from dataclasses import replace
 from pathlib import Path
 
 import xarray as xr
@@ -16,7 +18,8 @@ from speclight.errors import InputError
 from speclight.estimate.shape.minkowski import format_obj
 from speclight.estimate.shape.shape_dataset import shape_dataset
 from speclight.estimate.shape.shape_inputs import check_format, read_shape_input
-from speclight.estimate.shape.shape_run import ShapeOptions, ShapeRun, run_shape
+from speclight.estimate.shape.shape_run import ShapeOptions, ShapeRun, resolve_law, run_shape
+from speclight.maps.writer.cached_map import MapResolution
 
 
 def obj_path(output: str | Path) -> Path:
@@ -36,6 +39,9 @@ def shape_files(
     bands: list[str] | None = None,
     tumbling_starts: int = 0,
     tumbling_map: Path | None = None,
+    no_map: bool = False,
+    map_resolution: MapResolution | None = None,
+    say: Callable[[str], None] | None = None,
 ) -> tuple[xr.Dataset, ShapeRun]:
     """Read ``lc``, invert it, write ``output``, its OBJ and the figure ``plot``.
 
@@ -58,8 +64,15 @@ def shape_files(
     tumbling_starts
         Random starts of the tumbling fit (:mod:`speclight.estimate.shape.tumbling_run`; 0: none).
     tumbling_map
-        Reflectivity map of the target as the tumbling fit's light model (None: the convex
-        model of the scenario's mesh); its header is checked before the run.
+        Reflectivity map of the target as the tumbling fit's light model; its header is
+        checked before the run. None: the scenario's map, or one built from the scenario
+        and cached (:func:`speclight.estimate.shape.tumbling_run.tumbling_light`).
+    no_map
+        True: the convex model of the scenario's mesh instead of a map.
+    map_resolution
+        Resolution of the map built from the scenario (None: the default).
+    say
+        Where the light model's messages go (the map's build, which model is used).
     """
     from speclight.io.netcdf import dataset_bytes
     from speclight.io.output import OutputClaim
@@ -85,23 +98,28 @@ def shape_files(
 
             loaded = load_scenario(scenario)
         data = read_shape_input(lc, fmt, loaded, bands)
+        # DAMIT light curves: the scenario given only for its target (the tumbling fit's)
+        tumbling_data = data if data.loaded is not None else replace(data, loaded=loaded)
+        light = None
+        if tumbling_starts > 0:  # the light model first: its errors before the long run
+            from speclight.estimate.shape.tumbling_run import tumbling_light
+
+            light = tumbling_light(
+                tumbling_data, resolve_law(options, data), map_path=tumbling_map, no_map=no_map,
+                map_resolution=map_resolution, progress=options.progress, say=say,
+            )  # fmt: skip
+            if say is not None:
+                say(light.describe())
         run = run_shape(data, options)
         ds = shape_dataset(run, str(obj) if run.polyhedron is not None else None)
-        if tumbling_starts > 0:
+        if light is not None:
             from speclight.estimate.shape.tumbling_run import add_tumbling, tumbling_fit
 
-            ds = add_tumbling(
-                ds,
-                tumbling_fit(
-                    data,
-                    run.law,
-                    min_period_h=options.min_period_h,
-                    max_period_h=options.max_period_h,
-                    n_starts=tumbling_starts,
-                    seed=options.seed,
-                    map_path=tumbling_map,
-                ),
-            )
+            fit = tumbling_fit(
+                tumbling_data, light.model, min_period_h=options.min_period_h,
+                max_period_h=options.max_period_h, n_starts=tumbling_starts, seed=options.seed,
+            )  # fmt: skip
+            ds = add_tumbling(ds, fit, light)
         claim.write(dataset_bytes(ds))
         if run.polyhedron is not None:
             obj_claim.write(format_obj(run.polyhedron, f"speclight shape: EGI of {lc}").encode())

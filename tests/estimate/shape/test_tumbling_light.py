@@ -150,7 +150,7 @@ def test_tumbling_run_uses_the_map_for_the_chosen_bands(box_wing_map):
     from speclight.estimate.inputs.band_responses import scenario_band_responses
     from speclight.estimate.shape.inversion_data import build_inversion_data
     from speclight.estimate.shape.shape_inputs import ShapeInput
-    from speclight.estimate.shape.tumbling_run import _light
+    from speclight.estimate.shape.tumbling_run import tumbling_light
 
     path, loaded = box_wing_map
     bands = scenario_band_responses(loaded)
@@ -160,7 +160,7 @@ def test_tumbling_run_uses_the_map_for_the_chosen_bands(box_wing_map):
         np.arange(3.0), three, three, one, one, np.zeros(3, int), np.array([True]), "x"
     )  # the light model does not read the points
     inputs = ShapeInput(data, second.band_names, None, None, "m2 sr-1", "x", loaded, second)
-    light = _light(inputs, scattering_law("lambert"), path)
+    light = tumbling_light(inputs, scattering_law("lambert"), map_path=path).model
     alone = band_map_light(path, second.band_names, second.response, bands.wavelength_nm)
     both = band_map_light(path, bands.band_names[:2], bands.response[:2], bands.wavelength_nm)
     sun, obs = sun_observer(healpix_directions(1), np.deg2rad(55.0), 0.4)
@@ -168,5 +168,5 @@ def test_tumbling_run_uses_the_map_for_the_chosen_bands(box_wing_map):
     assert np.array_equal(got, alone(sun, obs, np.zeros(12)))
     assert not np.allclose(got, both(sun, obs, np.zeros(12)), rtol=1e-3)  # bands differ
     with pytest.raises(InputError) as err:
-        _light(replace(inputs, bands=None), scattering_law("lambert"), path)
+        tumbling_light(replace(inputs, bands=None), scattering_law("lambert"), map_path=path)
     assert err.value.field == "map_path"
