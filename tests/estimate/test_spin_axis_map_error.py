@@ -1,0 +1,103 @@
+"""The map-error field's pieces of the spin axis's covariance.
+
+References: the covariance of generalised least squares with correlated errors in closed
+form (``A^-1 J^T Sigma J A^-1``, e.g. Kariya & Kurata 2004, Generalized Least Squares,
+ch. 2) against the draws' propagation; the cross-band statistic by hand and its expectation
+in closed form; the refit on a perturbed map (L-BFGS-B on the nonlinear misfit) against the
+first-order step for a small perturbation.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+from test_spin_axis_grid import _geometry, _map
+
+from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
+from speclight.estimate.spin_axis.spin_axis_jackknife import refit
+from speclight.estimate.spin_axis.spin_axis_map_error import (
+    cross_band_power,
+    field_draws,
+    map_field_covariance,
+    propagated_covariance,
+    residual_perturbations,
+)
+
+
+def test_propagated_covariance_is_the_gls_covariance_of_correlated_errors() -> None:
+    rng = np.random.default_rng(5)
+    m, k, n = 40, 3, 40000
+    jac = rng.normal(size=(m, k))
+    # errors correlated within blocks of 8 (epochs sharing map cells), known covariance
+    idx = np.arange(m) // 8
+    sigma = 0.5 * (idx[:, None] == idx[None, :]) + 0.5 * np.eye(m)
+    dr = rng.multivariate_normal(np.zeros(m), sigma, size=n)
+    got, left = propagated_covariance(jac, dr)
+    a_inv = np.linalg.inv(jac.T @ jac)
+    want = a_inv @ jac.T @ sigma @ jac @ a_inv
+    # n draws: the sample second moment's relative error ~ sqrt(2 / n) = 0.7 % on the
+    # variances; 5 times that
+    np.testing.assert_allclose(np.diag(got), np.diag(want), rtol=5 * np.sqrt(2 / n))
+    # the residuals left are orthogonal to the Jacobian's columns (exact, to rounding)
+    assert np.max(np.abs(left @ jac)) < 1e-10 * np.max(np.abs(dr @ jac))
+
+
+def test_cross_band_power_by_hand_and_noise_free_in_expectation() -> None:
+    rng = np.random.default_rng(8)
+    n_t, n_b = 5, 4
+    r = rng.normal(size=n_t * n_b)
+    e = r.reshape(n_t, n_b)
+    by_hand = sum(
+        e[t, b] * e[t, c] for t in range(n_t) for b in range(n_b) for c in range(n_b) if b != c
+    ) / (n_b - 1)
+    np.testing.assert_allclose(cross_band_power(r, n_t, n_b), by_hand, rtol=1e-12)
+    # r_tb = c_t + noise independent between the bands: E = sum_t B c_t^2 (closed form),
+    # whatever the noise's size
+    common = rng.normal(size=n_t)
+    draws = common[None, :, None] + 3.0 * rng.normal(size=(20000, n_t, n_b))
+    got = cross_band_power(draws.reshape(20000, -1), n_t, n_b)
+    want = n_b * np.sum(common**2)
+    assert abs(np.mean(got) - want) < 5 * np.std(got) / np.sqrt(got.size)
+
+
+def _toy() -> tuple[SpinMisfit, np.ndarray]:
+    """A model on a smooth synthetic map whose data are its own prediction at ``x0``."""
+    bmap = _map(8, [20.0, 50.0, 80.0, 110.0], 6, 3)
+    geo = _geometry(np.random.default_rng(11))
+    x0 = np.array([0.0, 0.0, np.radians(70.0)])
+    model = SpinMisfit.around(bmap, geo, np.ones((geo.t_s.size, 3)), None, 30.0, 40.0)
+    y = bmap.intensity_1au(*model.body_directions(x0))
+    return dataclasses.replace(model, y=y), x0
+
+
+def test_refit_on_a_slightly_perturbed_map_is_the_first_order_step() -> None:
+    model, x0 = _toy()
+    _, jac = model.residuals(x0)
+    assert jac is not None
+    tau = 1e-3
+    eps = field_draws(model, 1, np.random.default_rng(3))
+    bumped = dataclasses.replace(
+        model.bmap, intensity_W_sr_nm=model.bmap.intensity_W_sr_nm * (1 + tau * eps)
+    )
+    shift = refit(dataclasses.replace(model, bmap=bumped), x0) - x0
+    field = dataclasses.replace(model.bmap, intensity_W_sr_nm=eps)
+    dr = residual_perturbations(model, x0, tau * field.intensity_1au(*model.body_directions(x0)))
+    first = -np.linalg.solve(jac.T @ jac, jac.T @ dr[0])
+    # second-order terms: relative O(tau) ~ 1e-3 of the step (the perturbation also changes
+    # the map's float32 rounding, ~1e-7 relative); 2 % of the step's length allows the
+    # optimiser's stopping tolerance (gtol 1e-9 on a misfit ~1e-6 here)
+    assert np.linalg.norm(shift - first) < 0.02 * np.linalg.norm(first)
+
+
+def test_map_field_covariance_zero_without_a_common_misfit_and_repeatable() -> None:
+    model, x0 = _toy()
+    # the data are the map's own prediction: nothing common left, no map-error term
+    np.testing.assert_array_equal(map_field_covariance(model, x0), np.zeros((3, 3)))
+    # data off by a smooth common factor: a positive, repeatable covariance
+    t = model.geo.t_s
+    off = dataclasses.replace(model, y=model.y * (1 + 0.05 * np.sin(t / 7.0))[:, None])
+    c1 = map_field_covariance(off, x0, n_refits=3)
+    c2 = map_field_covariance(off, x0, n_refits=3)
+    np.testing.assert_array_equal(c1, c2)
+    assert np.all(np.linalg.eigvalsh(c1[:2, :2]) > 0)
