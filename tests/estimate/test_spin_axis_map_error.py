@@ -18,10 +18,11 @@ from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
 from speclight.estimate.spin_axis.spin_axis_jackknife import refit
 from speclight.estimate.spin_axis.spin_axis_map_error import (
     cross_band_power,
-    field_draws,
-    map_field_covariance,
+    map_warp_covariance,
+    pixel_rad,
     propagated_covariance,
-    residual_perturbations,
+    warp_scale,
+    warped_map,
 )
 
 
@@ -71,33 +72,52 @@ def _toy() -> tuple[SpinMisfit, np.ndarray]:
     return dataclasses.replace(model, y=y), x0
 
 
-def test_refit_on_a_slightly_perturbed_map_is_the_first_order_step() -> None:
+def test_warped_map_without_a_shift_is_the_map() -> None:
+    # the map's interpolation at its own nodes is the node's value (bilinear weights 1, 0)
+    model, _ = _toy()
+    same = warped_map(model.bmap, np.zeros((model.bmap.direction_body.shape[0], 2)))
+    np.testing.assert_allclose(same.intensity_W_sr_nm, model.bmap.intensity_W_sr_nm, rtol=1e-6)
+
+
+def test_refit_on_a_slightly_warped_map_is_the_first_order_step() -> None:
     model, x0 = _toy()
-    _, jac = model.residuals(x0)
+    r, jac = model.residuals(x0)
     assert jac is not None
-    tau = 1e-3
-    eps = field_draws(model, 1, np.random.default_rng(3))
-    bumped = dataclasses.replace(
-        model.bmap, intensity_W_sr_nm=model.bmap.intensity_W_sr_nm * (1 + tau * eps)
+    u = np.random.default_rng(3).standard_normal((model.bmap.direction_body.shape[0], 2))
+    moved = dataclasses.replace(
+        model, bmap=warped_map(model.bmap, 0.01 * pixel_rad(model.bmap) * u)
     )
-    shift = refit(dataclasses.replace(model, bmap=bumped), x0) - x0
-    field = dataclasses.replace(model.bmap, intensity_W_sr_nm=eps)
-    dr = residual_perturbations(model, x0, tau * field.intensity_1au(*model.body_directions(x0)))
-    first = -np.linalg.solve(jac.T @ jac, jac.T @ dr[0])
-    # second-order terms: relative O(tau) ~ 1e-3 of the step (the perturbation also changes
-    # the map's float32 rounding, ~1e-7 relative); 2 % of the step's length allows the
-    # optimiser's stopping tolerance (gtol 1e-9 on a misfit ~1e-6 here)
-    assert np.linalg.norm(shift - first) < 0.02 * np.linalg.norm(first)
+    shift = refit(moved, x0) - x0
+    dr = moved.residuals(x0, jacobian=False)[0] - r
+    first = -np.linalg.solve(jac.T @ jac, jac.T @ dr)
+    assert np.linalg.norm(first) > 0
+    # second-order terms: relative O(|dr| / |r|-scale) ~ 1e-2 at 1 % of a pixel; 5 % of the
+    # step's length allows them and the optimiser's stopping tolerance
+    assert np.linalg.norm(shift - first) < 0.05 * np.linalg.norm(first)
 
 
-def test_map_field_covariance_zero_without_a_common_misfit_and_repeatable() -> None:
+def test_warp_size_recovers_a_known_displacement_and_zero_without_one() -> None:
     model, x0 = _toy()
+    # bands of one pattern (the map's error then common to them, as the module assumes)
+    v = model.bmap.intensity_W_sr_nm[..., :1] * np.array([1.0, 0.8, 1.2], dtype=np.float32)
+    model = dataclasses.replace(model, bmap=dataclasses.replace(model.bmap, intensity_W_sr_nm=v))
+    y = model.bmap.intensity_1au(*model.body_directions(x0))
+    model = dataclasses.replace(model, y=y)
     # the data are the map's own prediction: nothing common left, no map-error term
-    np.testing.assert_array_equal(map_field_covariance(model, x0), np.zeros((3, 3)))
-    # data off by a smooth common factor: a positive, repeatable covariance
-    t = model.geo.t_s
-    off = dataclasses.replace(model, y=model.y * (1 + 0.05 * np.sin(t / 7.0))[:, None])
-    c1 = map_field_covariance(off, x0, n_refits=3)
-    c2 = map_field_covariance(off, x0, n_refits=3)
-    np.testing.assert_array_equal(c1, c2)
+    np.testing.assert_array_equal(map_warp_covariance(model, x0, 3), np.zeros((3, 3)))
+    # the data from the map displaced by a known field of rms 0.2 pixel per component
+    rng = np.random.default_rng(21)
+    n_d = model.bmap.direction_body.shape[0]
+    true_s = 0.2 * pixel_rad(model.bmap)
+    truth = warped_map(model.bmap, true_s * rng.standard_normal((n_d, 2)))
+    off = dataclasses.replace(model, y=truth.intensity_1au(*model.body_directions(x0)))
+    r, jac = off.residuals(x0)
+    assert jac is not None
+    got = warp_scale(off, x0, r, jac, rng.standard_normal((40, n_d, 2)))
+    # one realisation of the truth's field against 40 probes: its common power scatters by
+    # tens of per cent around the probes' mean (40 epochs see ~40 nodes), so s within a
+    # factor 1.5; a size off by the probe's 0.05 pixel or by a square would be 4-20 times off
+    assert true_s / 1.5 < got < 1.5 * true_s
+    c1 = map_warp_covariance(off, x0, 3)
+    np.testing.assert_array_equal(c1, map_warp_covariance(off, x0, 3))  # repeatable
     assert np.all(np.linalg.eigvalsh(c1[:2, :2]) > 0)

@@ -81,7 +81,7 @@ from speclight.estimate.spin_axis.spin_axis_jackknife import (
     shrunk_jackknife_spread,
 )
 from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, angular_distance_deg
-from speclight.estimate.spin_axis.spin_axis_map_error import map_field_covariance
+from speclight.estimate.spin_axis.spin_axis_map_error import map_warp_covariance
 from speclight.maps.map_lookup import ReflectivityMap
 
 F64 = NDArray[np.float64]
@@ -245,10 +245,10 @@ def _covariance(
     if jac is None or not np.all(np.isfinite(r)) or not np.any(jac):
         return None
     cov, a_inv, lag = sandwich_covariance(r, jac, model.y.shape[0])
-    if method in ("jackknife-shrunk", "jackknife-shrunk-field"):
+    if method in ("jackknife-shrunk", "jackknife-shrunk-warp"):
         cov = cov + shrunk_jackknife_spread(jackknife_refits(model, x0, ranged))[0]
-    if method == "jackknife-shrunk-field":
-        cov = cov + map_field_covariance(model, x0)
+    if method == "jackknife-shrunk-warp":
+        cov = cov + map_warp_covariance(model, x0)
     elif method in ("jackknife", "jackknife-map"):  # plus the sandwich: never below the
         cov = cov + jackknife_covariance(model, x0, ranged)  # local curvature
     if method == "jackknife-map":

@@ -1,33 +1,35 @@
-"""The spin axis's covariance from the map's own error: a random field over the map's nodes,
-its size from the residuals' part common to the bands, its effect on the answer by refits.
+"""The spin axis's covariance from the map's own error: a random displacement of the map's
+directions, its size from the residuals' part common to the bands, its effect on the answer
+by refits.
 
-**The field.** The search map holds its band rates on nodes (HEALPix directions x phase
-angles x rolls) and interpolates between them; its own error (how far the interpolant is
-from the target's true intensity) is modelled as a relative error ``tau eps_n`` per node,
-``eps_n ~ N(0, 1)`` independent between nodes and common to the bands, interpolated as the
-map is: the map's rates become ``M_nb (1 + tau eps_n)``. Two epochs whose geometries fall
-between the same nodes share their errors (correlation length: one node spacing in
-direction, phase angle and roll), which neither the residuals' spread along the pass (the
-jackknife over time blocks) nor their autocorrelation (the sandwich) sees.
+**The field.** The search map holds its band rates on HEALPix directions (x phase angles x
+rolls) and interpolates between them; where the target's intensity has sharp features (a
+panel's glint) the interpolant puts them a fraction of a pixel off. The map's error is
+modelled as such a misplacement: each direction node ``d_n`` displaced by a tangent vector
+``s u_n`` (``u_n`` two independent ``N(0, 1)`` components along the node's east and north,
+independent between the nodes: correlation length one node spacing; common to the phase
+angles, rolls and bands), the map resampled there with its own interpolation
+(:func:`warped_map`). An additive error per node was tried first: it left the bench's
+largest errors (the answer pulled along the direction a glint's position pins) at 5-25
+sigma; BENCHMARKS.md "Spin-axis calibration: the map's error as a field".
 
-**Its size** ``tau^2`` is what the residuals hold in common across the bands
-(:func:`cross_band_power`: noise independent between bands cancels there, so no noise
+**Its size** ``s`` is matched on what the residuals hold in common across the bands
+(:func:`cross_band_power`: noise independent between the bands cancels there, so no noise
 floor is needed; on the calibration bench the residuals above the noise are nearly all
 common to the 32 bands, and this statistic of the refined residuals matches, within ~20 %,
-that of the search map's true error). The field is matched on the same statistic: ``tau^2
-= P(r) / E P((I - H) dr)`` with ``r`` the refined residuals, ``dr`` the residuals' first-order
-change under one unit draw of the field (:func:`residual_perturbations`: ``dp_tb = p_tb
-eps(t)`` through the normalisation by each band's mean), ``H = J A^-1 J^T`` the part the
-parameters absorb (``A = J^T J``) and ``E`` the mean over :data:`N_LINEAR` draws.
+that of the search map's true error): each draw displaced by :data:`PROBE_PIXELS` of a
+pixel changes the refined residuals by ``dr``, the fit leaves ``(I - J A^-1 J^T) dr``
+(:func:`propagated_covariance`) whose common power grows as ``s^2`` for small ``s``, so
+``s^2 = s_probe^2 P(r) / mean P((I - H) dr)``.
 
-**Its effect** (:func:`map_field_covariance`): the answer refitted
-(:func:`.spin_axis_jackknife.refit`, from the refined answer ``x0``) on :data:`N_REFITS`
-maps perturbed by draws of the field, the covariance ``1 / N sum (x_i - x0)(x_i - x0)^T``
-(a parametric bootstrap: the field has zero mean). The refits, not the first-order
-``A^-1 J^T Cov(dr) J A^-1`` (:func:`propagated_covariance`): on the calibration bench the
-search map's true error moves the answer by several times what that first-order step
-predicts (the misfit surface is not quadratic on the scale of the map's cells), and the
-refits see that. Draws from a fixed seed, so the answer is repeatable.
+**Its effect** (:func:`map_warp_deviations`): the answer refitted
+(:func:`.spin_axis_jackknife.refit`, from the refined answer ``x0``) on the map displaced
+by each of :data:`N_DRAWS` draws at that size; the covariance is their second moment about
+``x0`` (the field has zero mean) with its axis block shrunk towards isotropic as far as the
+draws leave its shape unresolved (:func:`map_warp_covariance`). Refits, not the first-order
+``A^-1 J^T Cov(dr) J A^-1``: on the bench the search map's true error moves the answer by
+several times what that first-order step predicts (the misfit surface is not quadratic on
+the scale of the map's pixels). Draws from a fixed seed, so the answer is repeatable.
 """
 
 from __future__ import annotations
@@ -38,14 +40,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
-from speclight.estimate.spin_axis.spin_axis_jackknife import refit
+from speclight.estimate.spin_axis.spin_axis_jackknife import refit, shrunk_second_moment
+from speclight.maps.map_geometry import roll_reference, sun_observer
+from speclight.maps.map_lookup import ReflectivityMap
 
 F64 = NDArray[np.float64]
-#: First-order draws of the field that fix its size.
-N_LINEAR = 256
-#: Refits on perturbed maps (the bootstrap).
-N_REFITS = 10
-#: Seed of the field's draws (the covariance is the same on every run).
+#: Draws of the displacement (each: one probe and one refit).
+N_DRAWS = 10
+#: The probe's displacement [pixels]: small, so the residuals' change is linear in it.
+PROBE_PIXELS = 0.05
+#: Seed of the draws (the covariance is the same on every run).
 SEED = 20261204
 
 
@@ -61,23 +65,6 @@ def cross_band_power(r: F64, n_t: int, n_b: int) -> F64:
     return np.asarray(both / (n_b - 1))
 
 
-def residual_perturbations(model: SpinMisfit, x0: F64, eps: F64) -> F64:
-    """First-order changes ``dr`` (N, M) of ``model``'s residuals at ``x0`` under relative
-    rate errors ``eps`` (T, N) common to the bands (module doc; the ranging residuals, where
-    there are any, unchanged: zeros)."""
-    sun, obs = model.body_directions(x0)
-    p = model.bmap.intensity_1au(sun, obs)  # (T, B)
-    n_t, n_b = p.shape
-    m = np.mean(p, axis=0)
-    dp = p[None] * eps.T[:, :, None]  # (N, T, B)
-    dm = np.mean(dp, axis=1)  # (N, B)
-    dr = ((dp / m - p[None] * (dm / m**2)[:, None, :]) / np.sqrt(n_t * n_b)).reshape(
-        eps.shape[1], n_t * n_b
-    )
-    n_extra = 0 if model.ranging is None else model.ranging.offset_m.size
-    return np.concatenate([dr, np.zeros((dr.shape[0], n_extra))], axis=1)
-
-
 def propagated_covariance(jac: F64, dr: F64) -> tuple[F64, F64]:
     """First order of perturbations ``dr`` (N, M) of the residuals of Jacobian ``jac``
     (M, K): the parameters' covariance ``A^-1 J^T Cov(dr) J A^-1`` (K, K) (``Cov(dr)`` the
@@ -88,45 +75,75 @@ def propagated_covariance(jac: F64, dr: F64) -> tuple[F64, F64]:
     return np.asarray(dx.T @ dx / dr.shape[0]), dr + dx @ jac.T
 
 
-def field_draws(model: SpinMisfit, n_draws: int, rng: np.random.Generator) -> F64:
-    """``n_draws`` unit draws of the field at the map's nodes (D, P, R, N) (float32)."""
-    shape = (*model.bmap.intensity_W_sr_nm.shape[:-1], n_draws)
-    return rng.standard_normal(shape, dtype=np.float32)
+def warped_map(bmap: ReflectivityMap, shift_rad: F64) -> ReflectivityMap:
+    """``bmap`` resampled (its own interpolation) at its directions displaced by the tangent
+    vectors ``shift_rad`` (D, 2) [rad] (east, north of each direction; the roll measured at
+    the displaced direction), on its own nodes."""
+    d = bmap.direction_body
+    e_lon, e_lat = roll_reference(d)
+    p = d + shift_rad[:, :1] * e_lon + shift_rad[:, 1:] * e_lat
+    p /= np.linalg.norm(p, axis=1)[:, None]
+    angles = np.radians(bmap.header.phase_angle_deg)
+    rolls = 2 * np.pi * np.arange(bmap.header.roll_deg.size) / bmap.header.roll_deg.size
+    n_d, n_p, n_r = d.shape[0], angles.size, rolls.size
+    sun, obs = sun_observer(
+        np.repeat(p, n_p * n_r, axis=0), np.tile(np.repeat(angles, n_r), n_d),
+        np.tile(rolls, n_d * n_p),
+    )  # fmt: skip
+    values = bmap.intensity_1au(sun, obs).reshape(n_d, n_p, n_r, -1)
+    return dataclasses.replace(bmap, intensity_W_sr_nm=values.astype(np.float32))
 
 
-def field_variance(model: SpinMisfit, x0: F64, r: F64, jac: F64, rng: np.random.Generator) -> float:
-    """``tau^2`` (module doc) of the refined residuals ``r`` (M,) and their Jacobian ``jac``
-    (M, K); 0 where the residuals hold nothing common to the bands, NaN for one band."""
+def pixel_rad(bmap: ReflectivityMap) -> float:
+    """The map's pixel size ``sqrt(4 pi / D)`` [rad]."""
+    return float(np.sqrt(4 * np.pi / bmap.direction_body.shape[0]))
+
+
+def warp_scale(model: SpinMisfit, x0: F64, r: F64, jac: F64, unit: F64) -> float:
+    """The displacement's size ``s`` [rad] (module doc) of the refined residuals ``r`` (M,),
+    their Jacobian ``jac`` (M, K) and unit draws ``unit`` (N, D, 2); NaN for one band or
+    where the probes change nothing common to the bands."""
     n_t, n_b = model.y.shape
-    unit = dataclasses.replace(model.bmap, intensity_W_sr_nm=field_draws(model, N_LINEAR, rng))
-    eps = unit.intensity_1au(*model.body_directions(x0))  # (T, N)
-    left = propagated_covariance(jac, residual_perturbations(model, x0, eps))[1]
+    probe = PROBE_PIXELS * pixel_rad(model.bmap)
+    dr = []
+    for u in unit:
+        moved = dataclasses.replace(model, bmap=warped_map(model.bmap, probe * u))
+        dr.append(moved.residuals(x0, jacobian=False)[0] - r)
+    left = propagated_covariance(jac, np.array(dr))[1]
     seen = float(cross_band_power(r, n_t, n_b))
-    per_unit = float(np.mean(cross_band_power(left, n_t, n_b)))
-    if not (np.isfinite(seen) and np.isfinite(per_unit) and per_unit > 0):
+    per_probe = float(np.mean(cross_band_power(left, n_t, n_b)))
+    if not (np.isfinite(seen) and np.isfinite(per_probe) and per_probe > 0):
         return float("nan")
-    return max(seen, 0.0) / per_unit
+    return probe * float(np.sqrt(max(seen, 0.0) / per_probe))
 
 
-def map_field_covariance(model: SpinMisfit, x0: F64, n_refits: int = N_REFITS) -> F64:
-    """The parameters' covariance (K, K) from the map's error field (module doc) around the
-    refined answer ``x0``; zeros where the model has no finite residuals or gradient there,
-    or the field's size is not defined (one band)."""
-    k = x0.size
+def map_warp_deviations(model: SpinMisfit, x0: F64, n_draws: int = N_DRAWS) -> F64:
+    """The refits' deviations ``x_i - x0`` (N, K) on the map displaced by draws of the
+    field (module doc) around the refined answer ``x0``; none (0, K) where the model has no
+    finite residuals or gradient there, the size is not defined (one band) or not positive,
+    or a refit ends non-finite."""
+    none = np.zeros((0, x0.size))
     r, jac = model.residuals(x0)
     if jac is None or not np.all(np.isfinite(r)) or not np.any(jac):
-        return np.zeros((k, k))
-    rng = np.random.default_rng(SEED)
-    tau2 = field_variance(model, x0, r, jac, rng)
-    if not (np.isfinite(tau2) and tau2 > 0):
-        return np.zeros((k, k))
-    values = model.bmap.intensity_W_sr_nm
-    dev = []
-    for eps in np.moveaxis(field_draws(model, n_refits, rng), -1, 0):
-        scaled = values * (1.0 + np.float32(np.sqrt(tau2)) * eps)[..., None]
-        bumped = dataclasses.replace(model.bmap, intensity_W_sr_nm=scaled)
-        dev.append(refit(dataclasses.replace(model, bmap=bumped), x0) - x0)
+        return none
+    unit = np.random.default_rng(SEED).standard_normal(
+        (n_draws, model.bmap.direction_body.shape[0], 2)
+    )
+    s = warp_scale(model, x0, r, jac, unit)
+    if not (np.isfinite(s) and s > 0):
+        return none
+    dev = [
+        refit(dataclasses.replace(model, bmap=warped_map(model.bmap, s * u)), x0) - x0 for u in unit
+    ]
     d = np.array(dev)
-    if not np.all(np.isfinite(d)):
-        return np.zeros((k, k))
-    return np.asarray(d.T @ d / n_refits)
+    return d if np.all(np.isfinite(d)) else none
+
+
+def map_warp_covariance(model: SpinMisfit, x0: F64, n_draws: int = N_DRAWS) -> F64:
+    """The parameters' covariance (K, K) from the map's error: the second moment of
+    :func:`map_warp_deviations` with its axis block shrunk towards isotropic
+    (:func:`.spin_axis_jackknife.shrunk_second_moment`); zeros where there are none."""
+    d = map_warp_deviations(model, x0, n_draws)
+    if d.shape[0] == 0:
+        return np.zeros((x0.size, x0.size))
+    return shrunk_second_moment(d)[0]
