@@ -17,10 +17,12 @@ from test_spin_axis_grid import _geometry, _map
 from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
 from speclight.estimate.spin_axis.spin_axis_jackknife import refit
 from speclight.estimate.spin_axis.spin_axis_map_error import (
+    covering_covariance,
     cross_band_power,
     map_warp_covariance,
     pixel_rad,
     propagated_covariance,
+    track_nodes,
     warp_scale,
     warped_map,
 )
@@ -121,3 +123,39 @@ def test_warp_size_recovers_a_known_displacement_and_zero_without_one() -> None:
     c1 = map_warp_covariance(off, x0, 3)
     np.testing.assert_array_equal(c1, map_warp_covariance(off, x0, 3))  # repeatable
     assert np.all(np.linalg.eigvalsh(c1[:2, :2]) > 0)
+
+
+def test_covering_covariance_is_the_larger_variance_in_the_common_basis() -> None:
+    # closed form: a and b diagonal in one rotated basis -> the larger of each pair there
+    rng = np.random.default_rng(4)
+    rot, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    da, db = np.array([1.0, 4.0, 0.5]), np.array([2.0, 1.0, 0.5])
+    a, b = rot @ np.diag(da) @ rot.T, rot @ np.diag(db) @ rot.T
+    want = rot @ np.diag(np.maximum(da, db)) @ rot.T
+    np.testing.assert_allclose(covering_covariance(a, b), want, rtol=1e-12, atol=1e-12)
+    # in general it covers both (C - a, C - b positive semi-definite) and is a where b <= a
+    m = rng.normal(size=(3, 3))
+    g = rng.normal(size=(3, 3))
+    a, b = m @ m.T + 0.1 * np.eye(3), g @ g.T
+    c = covering_covariance(a, b)
+    for other in (a, b):
+        assert np.min(np.linalg.eigvalsh(c - other)) > -1e-12 * np.max(np.abs(c))
+    np.testing.assert_allclose(covering_covariance(a, 0.5 * a), a, rtol=1e-12, atol=1e-12)
+
+
+def test_residuals_at_the_answer_read_only_the_track_nodes() -> None:
+    model, x0 = _toy()
+    n_d = model.bmap.direction_body.shape[0]
+    nodes = track_nodes(model, x0)
+    assert 0 < nodes.size < n_d
+    shift = 0.3 * pixel_rad(model.bmap) * np.random.default_rng(6).standard_normal((n_d, 2))
+    everywhere = dataclasses.replace(model, bmap=warped_map(model.bmap, shift))
+    on_track = dataclasses.replace(model, bmap=warped_map(model.bmap, shift, nodes))
+    # the same lookups of the same node values: equal to rounding
+    np.testing.assert_allclose(
+        on_track.residuals(x0, jacobian=False)[0],
+        everywhere.residuals(x0, jacobian=False)[0],
+        rtol=0,
+        atol=1e-12,
+    )
+    assert not np.allclose(on_track.residuals(x0)[0], model.residuals(x0)[0])

@@ -41,8 +41,8 @@ from numpy.typing import NDArray
 
 from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
 from speclight.estimate.spin_axis.spin_axis_jackknife import refit, shrunk_second_moment
-from speclight.maps.map_geometry import roll_reference, sun_observer
-from speclight.maps.map_lookup import ReflectivityMap
+from speclight.maps.map_geometry import map_coordinates, roll_reference, sun_observer
+from speclight.maps.map_lookup import ReflectivityMap, healpix_weights
 
 F64 = NDArray[np.float64]
 #: Draws of the displacement (each: one probe and one refit).
@@ -75,13 +75,17 @@ def propagated_covariance(jac: F64, dr: F64) -> tuple[F64, F64]:
     return np.asarray(dx.T @ dx / dr.shape[0]), dr + dx @ jac.T
 
 
-def warped_map(bmap: ReflectivityMap, shift_rad: F64) -> ReflectivityMap:
+def warped_map(
+    bmap: ReflectivityMap, shift_rad: F64, nodes: NDArray[np.int64] | None = None
+) -> ReflectivityMap:
     """``bmap`` resampled (its own interpolation) at its directions displaced by the tangent
     vectors ``shift_rad`` (D, 2) [rad] (east, north of each direction; the roll measured at
-    the displaced direction), on its own nodes."""
-    d = bmap.direction_body
+    the displaced direction), on its own nodes; only the directions ``nodes`` (all: None),
+    the others kept as they are."""
+    nodes = np.arange(bmap.direction_body.shape[0]) if nodes is None else nodes
+    d = bmap.direction_body[nodes]
     e_lon, e_lat = roll_reference(d)
-    p = d + shift_rad[:, :1] * e_lon + shift_rad[:, 1:] * e_lat
+    p = d + shift_rad[nodes, :1] * e_lon + shift_rad[nodes, 1:] * e_lat
     p /= np.linalg.norm(p, axis=1)[:, None]
     angles = np.radians(bmap.header.phase_angle_deg)
     rolls = 2 * np.pi * np.arange(bmap.header.roll_deg.size) / bmap.header.roll_deg.size
@@ -90,13 +94,24 @@ def warped_map(bmap: ReflectivityMap, shift_rad: F64) -> ReflectivityMap:
         np.repeat(p, n_p * n_r, axis=0), np.tile(np.repeat(angles, n_r), n_d),
         np.tile(rolls, n_d * n_p),
     )  # fmt: skip
-    values = bmap.intensity_1au(sun, obs).reshape(n_d, n_p, n_r, -1)
-    return dataclasses.replace(bmap, intensity_W_sr_nm=values.astype(np.float32))
+    values = np.array(bmap.intensity_W_sr_nm)
+    values[nodes] = bmap.intensity_1au(sun, obs).reshape(n_d, n_p, n_r, -1)
+    return dataclasses.replace(bmap, intensity_W_sr_nm=values)
 
 
 def pixel_rad(bmap: ReflectivityMap) -> float:
     """The map's pixel size ``sqrt(4 pi / D)`` [rad]."""
     return float(np.sqrt(4 * np.pi / bmap.direction_body.shape[0]))
+
+
+def track_nodes(model: SpinMisfit, x0: F64) -> NDArray[np.int64]:
+    """The map's directions (indices) the epochs' lookups at ``x0`` read (the 4 HEALPix
+    neighbours of each epoch's phase vector): the only ones a change of the residuals at
+    ``x0`` depends on."""
+    sun, obs = model.body_directions(x0)
+    phase_vectors = map_coordinates(sun, obs)[0]
+    pix = healpix_weights(model.bmap.header.nside, phase_vectors)[1]
+    return np.unique(pix)
 
 
 def warp_scale(model: SpinMisfit, x0: F64, r: F64, jac: F64, unit: F64) -> float:
@@ -105,9 +120,10 @@ def warp_scale(model: SpinMisfit, x0: F64, r: F64, jac: F64, unit: F64) -> float
     where the probes change nothing common to the bands."""
     n_t, n_b = model.y.shape
     probe = PROBE_PIXELS * pixel_rad(model.bmap)
+    nodes = track_nodes(model, x0)
     dr = []
     for u in unit:
-        moved = dataclasses.replace(model, bmap=warped_map(model.bmap, probe * u))
+        moved = dataclasses.replace(model, bmap=warped_map(model.bmap, probe * u, nodes))
         dr.append(moved.residuals(x0, jacobian=False)[0] - r)
     left = propagated_covariance(jac, np.array(dr))[1]
     seen = float(cross_band_power(r, n_t, n_b))
@@ -147,3 +163,18 @@ def map_warp_covariance(model: SpinMisfit, x0: F64, n_draws: int = N_DRAWS) -> F
     if d.shape[0] == 0:
         return np.zeros((x0.size, x0.size))
     return shrunk_second_moment(d)[0]
+
+
+def covering_covariance(a: F64, b: F64) -> F64:
+    """The covariance (K, K) whose ellipsoid covers those of ``a`` and ``b`` (K, K)
+    (positive definite ``a``, semi-definite ``b``): ``a^1/2 U max(L, 1) U^T a^1/2`` with
+    ``U L U^T`` the eigendecomposition of ``a^-1/2 b a^-1/2`` (in the basis where both are
+    diagonal, the larger of the two variances on each axis: so ``C >= a`` and ``C >= b``,
+    and ``C = a`` where ``b <= a``); ``a + b`` where ``a`` is not positive definite."""
+    w, v = np.linalg.eigh(a)
+    if not (np.all(np.isfinite(w)) and np.min(w) > 0):
+        return np.asarray(a + b)
+    half = (v * np.sqrt(w)) @ v.T
+    inv_half = (v / np.sqrt(w)) @ v.T
+    lam, u = np.linalg.eigh(inv_half @ b @ inv_half)
+    return np.asarray(half @ (u * np.maximum(lam, 1.0)) @ u.T @ half)
