@@ -107,8 +107,6 @@ MAX_NOISE_RATIO = 10.0
 MODEL_ERROR_RATIO = 2.0
 #: The covariance of :func:`axis_confidence` unless another is asked for (module doc).
 DEFAULT_METHOD = "jackknife-warp"
-#: The methods that count the map's own error (:mod:`.spin_axis_map_error`).
-MAP_ERROR_METHODS = ("jackknife-warp", "sandwich-warp")
 #: How the note of a flat surface starts.
 FLAT_NOTE = "the data do not constrain the axis"
 #: The tangent rotation ``x[:2]`` to the axis's (east, north) offset (:func:`_sigmas`).
@@ -391,12 +389,15 @@ def _model_error_note(out: AxisConfidence) -> str:
         f"the misfit is {out.noise_ratio:.3g} times the noise floor: the map's (or the spin "
         "model's) own error dominates the residuals"
     )
-    if out.method in MAP_ERROR_METHODS:
+    field = "the sigmas count the map's error as its directions displaced by a fraction of a pixel"
+    if out.method == "jackknife-warp":
         return (
-            f"{head}; the sigmas count the map's error as its directions displaced by a "
-            "fraction of a pixel, sized from the residuals (error / sigma 0.8-1.3 on the "
-            "calibration bench), not a wrong spin model (docs/spin-axis.md, Sigmas)"
+            f"{head}; {field}, sized from the residuals (error / sigma standard deviations "
+            "0.76-1.29 on the calibration bench), not a wrong spin model (docs/spin-axis.md, "
+            "Sigmas)"
         )
+    if out.method == "sandwich-warp":
+        return f"{head}; {field}, without the jackknife: they may be too small (docs/spin-axis.md)"
     return (
         f"{head}, and the sigmas count it only as far as the jackknife's refits see it: they "
         "may be too small (docs/spin-axis.md, Sigmas)"
