@@ -159,3 +159,18 @@ def test_residuals_at_the_answer_read_only_the_track_nodes() -> None:
         atol=1e-12,
     )
     assert not np.allclose(on_track.residuals(x0)[0], model.residuals(x0)[0])
+
+
+def test_one_band_has_no_field_size() -> None:
+    # the power common to the bands needs two bands: with one, no map-error term (the
+    # default then keeps the jackknife's covariance)
+    model, x0 = _toy()
+    one = dataclasses.replace(
+        model,
+        bmap=dataclasses.replace(
+            model.bmap, intensity_W_sr_nm=model.bmap.intensity_W_sr_nm[..., :1]
+        ),
+        y=model.y[:, :1] * (1 + 0.05 * np.sin(model.geo.t_s / 7.0))[:, None],
+    )
+    assert np.isnan(cross_band_power(np.ones(6), 6, 1))
+    np.testing.assert_array_equal(map_warp_covariance(one, x0, 3), np.zeros((3, 3)))
