@@ -1,10 +1,12 @@
 """The map-error field's pieces of the spin axis's covariance.
 
-References: the covariance of generalised least squares with correlated errors in closed
-form (``A^-1 J^T Sigma J A^-1``, e.g. Kariya & Kurata 2004, Generalized Least Squares,
-ch. 2) against the draws' propagation; the cross-band statistic by hand and its expectation
-in closed form; the refit on a perturbed map (L-BFGS-B on the nonlinear misfit) against the
-first-order step for a small perturbation.
+References: the covariance of the least-squares estimate under correlated errors in closed
+form (``A^-1 J^T Sigma J A^-1``, e.g. Kariya & Kurata 2004, Generalized Least Squares, ch. 2)
+against the draws' propagation; the cross-band statistic by hand and its expectation in
+closed form; the covering covariance in closed form where both are diagonal in one basis;
+the map's interpolation at its own nodes; the refit on a slightly displaced map (L-BFGS-B on
+the nonlinear misfit) against the first-order step; the size of a known displacement (data
+made from the map displaced by it) recovered from the residuals.
 """
 
 from __future__ import annotations
