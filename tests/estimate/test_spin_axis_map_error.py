@@ -119,9 +119,11 @@ def test_warp_size_recovers_a_known_displacement_and_zero_without_one() -> None:
     assert jac is not None
     got = warp_scale(off, x0, r, jac, rng.standard_normal((40, n_d, 2)))
     # one realisation of the truth's field against 40 probes: its common power scatters by
-    # tens of per cent around the probes' mean (40 epochs see ~40 nodes), so s within a
-    # factor 1.5; a size off by the probe's 0.05 pixel or by a square would be 4-20 times off
-    assert true_s / 1.5 < got < 1.5 * true_s
+    # tens of per cent around the probes' mean (40 epochs see ~40 nodes); over the truth
+    # seeds 0-7 the ratio was 0.82-1.51 (mean 1.2: second-order terms at 0.2 pixel add
+    # power), so within a factor 1.6; a size off by the probe's 0.05 pixel or by a square
+    # would be 4-20 times off
+    assert true_s / 1.6 < got < 1.6 * true_s
     c1 = map_warp_covariance(off, x0, 3)
     np.testing.assert_array_equal(c1, map_warp_covariance(off, x0, 3))  # repeatable
     assert np.all(np.linalg.eigvalsh(c1[:2, :2]) > 0)
