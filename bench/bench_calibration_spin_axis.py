@@ -84,7 +84,7 @@ def _text(px: int, sphere: bool = False, render: str | None = None) -> str:
     return text
 
 
-def _maps(folder: Path, sphere: bool) -> tuple[Path, Path]:
+def calibration_maps(folder: Path, sphere: bool) -> tuple[Path, Path]:
     """(search map, truth map) of the box-wing or the sphere, made once."""
     tag = "sphere" if sphere else "bw"
     out = []
@@ -103,7 +103,7 @@ def _maps(folder: Path, sphere: bool) -> tuple[Path, Path]:
     return out[0], out[1]
 
 
-def _geometry(folder: Path) -> EpochGeometry:
+def pass_geometry(folder: Path) -> EpochGeometry:
     """The example pass's inertial Sun and observer directions (2 s steps)."""
     (folder / "geo.yaml").write_text(
         _text(16, render="render: {mode: map, map_file: bw-32-768.zarr}")
@@ -118,7 +118,9 @@ def _geometry(folder: Path) -> EpochGeometry:
     return EpochGeometry(ep.sun_gcrs[ok], ep.observer_gcrs[ok], ep.t_s[ok], 120.0)
 
 
-def _draw(rng: np.random.Generator, geo_all: EpochGeometry, truth_map, search, args, period_off):
+def truth_draw(rng: np.random.Generator, geo_all: EpochGeometry, truth_map, period_off: str):
+    """One draw's truth (module doc): (RA, Dec) [deg], the period [s], the geometry with the
+    true period, the measured curves, the noise, the period given and its bound."""
     z = rng.normal(size=3)
     z /= np.linalg.norm(z)
     ra, dec = float(np.degrees(np.arctan2(z[1], z[0])) % 360), float(np.degrees(np.arcsin(z[2])))
@@ -140,6 +142,11 @@ def _draw(rng: np.random.Generator, geo_all: EpochGeometry, truth_map, search, a
         bound = 0.05
     elif period_off == "fixed":
         given = period * (1 + rng.choice([-1, 1]) * rng.uniform(0.02, 0.06))
+    return (ra, dec), period, geo, y, noise, given, bound
+
+
+def _draw(rng: np.random.Generator, geo_all: EpochGeometry, truth_map, search, args, period_off):
+    (ra, dec), period, geo, y, noise, given, bound = truth_draw(rng, geo_all, truth_map, period_off)
     bmap, sfm = search
     res = spin_axis_search(
         bmap, sfm, dataclasses.replace(geo, period_s=given), y,
@@ -262,8 +269,8 @@ def main() -> None:
         f"load {os.getloadavg()[0]:.1f})"
     )
     rng = np.random.default_rng(args.seed)
-    search_bw, truth_bw = _maps(args.folder, False)
-    geo = _geometry(args.folder)
+    search_bw, truth_bw = calibration_maps(args.folder, False)
+    geo = pass_geometry(args.folder)
     b16 = load_band_map(search_bw)
     search = (b16, spin_frame_map(b16, None, args.phases))
     truth = load_band_map(truth_bw)
@@ -277,7 +284,7 @@ def main() -> None:
     _report("box-wing, period 2-6 % off and fixed (the period check)", rows)
     rows = [_draw(rng, geo, truth, search, args, "free") for _ in range(args.period_draws)]
     _report("box-wing, period 1-4 % off and free", rows)
-    search_s, truth_s = _maps(args.folder, True)
+    search_s, truth_s = calibration_maps(args.folder, True)
     s16 = load_band_map(search_s)
     sph = (s16, spin_frame_map(s16, None, args.phases))
     rows = [

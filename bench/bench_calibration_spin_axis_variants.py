@@ -3,7 +3,10 @@
 Per draw (:func:`parts`), around the refined answer ``x0`` (the tangent parametrisation of
 :class:`speclight.estimate.spin_axis.spin_axis_gradient.SpinMisfit`): the sandwich, the
 jackknife refits on the search's map and on that map at half its ``nside`` (``xs``, ``xcs``),
-the refit on the half map (``xc``; the shift ``s = xc - x0``) and, as a diagnostic a user
+the refit on the half map (``xc``; the shift ``s = xc - x0``), the refits on the map
+displaced by draws of the map-error field (``warp``:
+:func:`speclight.estimate.spin_axis.spin_axis_map_error.map_warp_deviations`) and, as a
+diagnostic a user
 cannot have, the refit on the truth's own finer map (``xt``: ``x0 - xt`` is what the search
 map's error does to the answer). Every variant of :data:`VARIANTS` is then a sum of these
 (:func:`variant`), so all are compared on the same searches.
@@ -32,12 +35,20 @@ from speclight.estimate.spin_axis.spin_axis_jackknife import (
     jackknife_spread,
     refit,
     shrunk_jackknife_spread,
+    shrunk_second_moment,
+)
+from speclight.estimate.spin_axis.spin_axis_map_error import (
+    covering_covariance,
+    map_warp_deviations,
 )
 
 VARIANTS = {
-    "default": "jackknife + sandwich (default)",
+    "default": "jackknife + sandwich (method jackknife)",
     "sandwich": "sandwich (HAC) alone",
-    "shrunk": "sandwich + jackknife, its axis block shrunk to isotropic (Ledoit-Wolf)",
+    "shrunk": "sandwich + jackknife, its axis block shrunk to isotropic (jackknife-shrunk)",
+    "sandwich-warp": "sandwich + the map's displaced-direction field (sandwich-warp)",
+    "jackknife-warp": "covering jackknife-shrunk and sandwich-warp (jackknife-warp)",
+    "warp-sum": "jackknife-shrunk + the map's displaced-direction field (their sum)",
     "map-iso": "default + |s|^2 / 9 isotropic (jackknife-map)",
     "map-iso-half": "default + |s|^2 / 18 per component (isotropic: E|m|^2 = |s|^2 / 9)",
     "sandwich-iso-half": "sandwich + |s|^2 / 18 per component (no jackknife)",
@@ -45,6 +56,8 @@ VARIANTS = {
     "richardson": "answer - s / 3; sandwich + jackknife of the corrected answer",
     "richardson-rank1": "answer - s / 3; that + s s^T / 9 (the correction's size as its error)",
 }
+#: The variants built on the map-error field's refits.
+WARP = ("sandwich-warp", "jackknife-warp", "warp-sum")
 
 
 def parts(bmap, geo, y, res, free_period: bool, truth_map) -> dict:
@@ -61,6 +74,7 @@ def parts(bmap, geo, y, res, free_period: bool, truth_map) -> dict:
     out["r"], out["jac"] = r, jac  # for variants tried on the saved draws
     out["sandwich"], out["a_inv"], out["lag"] = sandwich_covariance(r, jac, y.shape[0])
     out["xs"] = jackknife_refits(model, x0, False)
+    out["warp"] = map_warp_deviations(model, x0)
     coarse = half_resolution(model)
     if coarse is not None:
         out["xc"] = refit(coarse, x0)
@@ -95,11 +109,22 @@ def _rank1(s: np.ndarray) -> np.ndarray:
 
 
 def _covariance(p: dict, key: str) -> np.ndarray | None:
-    if "xs" not in p or (key not in ("default", "sandwich", "shrunk") and "xc" not in p):
+    if "xs" not in p or (key not in ("default", "sandwich", "shrunk", *WARP) and "xc" not in p):
+        return None
+    if key in WARP and "warp" not in p:
         return None
     sand = p["sandwich"]
     if key == "sandwich":
         return sand
+    if key in WARP:
+        d = p["warp"]
+        field = sand + (shrunk_second_moment(d)[0] if d.shape[0] else 0.0)
+        shrunk = sand + shrunk_jackknife_spread(p["xs"])[0]
+        if key == "sandwich-warp":
+            return field
+        return (
+            covering_covariance(shrunk, field) if key == "jackknife-warp" else shrunk + field - sand
+        )
     default = sand + jackknife_spread(p["xs"])
     if key == "default":
         return default

@@ -142,9 +142,16 @@ def test_cli_run_and_bad_input(folder) -> None:
     with xr.open_dataset(folder / "cont.nc", engine="h5netcdf") as ds:
         assert ds.attrs["refine_method"] == "gradient-continuation"
         assert ds.attrs["refine_gradient_evaluations"] > 0
-        # the scenario's (true) period, fixed: checked, and no other period preferred
-        assert ds.attrs["period_check"] == "passed", ds.attrs["axis_note"]
-        assert ds.attrs["period_check_n_periods"] > 3
+        # the map (192 directions, 15 deg apart) against the rendered truth: the answer is
+        # ~6 deg off the scenario's axis, and the sigmas count the map's error (the
+        # jackknife-shrunk ones alone were ~2.2 deg: 3 sigma off), so the truth is within
+        # the 95 % ellipse's 2.45 sigma of the largest axis; the region is then wide
+        # (> 5 % of the sphere: not constrained) and the period check is not run (the true
+        # period passing it: test_spin_axis.py)
+        a = ds.attrs
+        err = angular_distance_deg(a["refined_ra_deg"], a["refined_dec_deg"], 30.0, 45.0)
+        assert err <= 2.45 * a["sigma_axis_deg"], (err, a["sigma_axis_deg"])
+        assert a["period_check"] == "not run" and a["axis_constrained"] == 0, a["axis_note"]
     # the same noisy rates as a CSV (eq. 5 applied to them with the scenario's geometry, the
     # scenario run on the map): the same misfits, to the CSV's 7 significant digits
     with xr.open_dataset(measured, engine="h5netcdf") as sim:

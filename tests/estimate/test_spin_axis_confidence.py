@@ -116,12 +116,19 @@ def test_verdicts() -> None:
     ok, note = _verdict(good)
     assert ok and "times the noise floor" in note
     # a misfit a few times the noise floor (the map's own error; the calibration's draws sit
-    # near 4.5): still constrained, the sigmas given first, then the warning that they may be
-    # too small; near the floor (1.2) nothing more is said
+    # near 4.5): still constrained, the sigmas given first, then what they count of it (the
+    # default's: the map's error as a field) or, with the jackknife alone, the warning that
+    # they may be too small; near the floor (1.2) nothing more is said
     near = dict(contrast=8.0, region95_fraction=0.001, sigma_axis_deg=2.0, noise_floor=1e-3)
     ok, note = _verdict(AxisConfidence(region95_max_sep_deg=4.0, noise_ratio=4.5, **near))
     assert ok and note.startswith("axis sigma 2 deg")
-    assert "4.5 times the noise floor" in note and "may be too small" in note
+    assert "4.5 times the noise floor" in note and "directions displaced" in note
+    assert "too small" not in note
+    shrunk = AxisConfidence(
+        region95_max_sep_deg=4.0, noise_ratio=4.5, method="jackknife-shrunk", **near
+    )
+    ok, note = _verdict(shrunk)
+    assert ok and "4.5 times the noise floor" in note and "may be too small" in note
     ok, note = _verdict(AxisConfidence(region95_max_sep_deg=4.0, noise_ratio=1.2, **near))
     assert ok and note.startswith("axis sigma 2 deg") and "noise floor" not in note
 

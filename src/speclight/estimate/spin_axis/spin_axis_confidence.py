@@ -1,23 +1,26 @@
 """How well the data pin the spin axis: sigmas, a confidence region, and what cannot be trusted.
 
-**Sigmas** (``method="jackknife"``, the default): the delete-a-block jackknife
-(:func:`.spin_axis_jackknife.jackknife_covariance`) plus the sandwich below. The jackknife
-sees what the residuals along the pass do to the answer, noise and map error alike (on the
-calibration bench, where the map's error is almost the whole error, it gives its size), but
-on a flat or one-sided surface its refits may not move (a singular covariance); the
-sandwich adds the local curvature's floor. The sum counts the noise twice, a conservative
-choice (BENCHMARKS.md "Spin-axis calibration": robust error / sigma ~1 over 50 blind draws
-of one seed, 1.1-2.0 over another, with a heavier tail where the map's error pulls the
-answer). Ten refits cannot resolve the shape of the axis block: a thin ellipse can be a
-chance of the ten, the map's error then lying across it (19 sigma in one draw).
-``method="jackknife-shrunk"`` (the default since 2026-12-04) shrinks the jackknife's axis
-block towards isotropic by Ledoit and Wolf's intensity
-(:func:`.spin_axis_jackknife.shrunk_jackknife_spread`), keeping the refits' shape only as
-far as they resolve it: better on both calibration seeds (error / sigma standard deviations
-1.88 / 1.10 -> 1.15 / 1.03 and 1.82 / 4.81 -> 1.41 / 2.19) but not within 0.8-1.25 on the
-second: the default all the same, being the better on every seed measured (``"jackknife"``
-keeps the unshrunk block). ``"jackknife-map"`` adds the map-error term below, ``"sandwich"`` is
-the sandwich alone.
+**Sigmas** (``method="jackknife-warp"``, the default since 2026-12-05): the covariance that
+covers (:func:`.spin_axis_map_error.covering_covariance`: the larger of the two in their
+common eigenbasis) two estimates of the same error: the sandwich below plus the
+delete-a-block jackknife's spread (:func:`.spin_axis_jackknife.jackknife_refits`) with its
+axis block shrunk towards isotropic by Ledoit and Wolf's intensity
+(:func:`.spin_axis_jackknife.shrunk_jackknife_spread`), and the sandwich plus the map's own
+error as a random displacement of its directions, sized from the residuals and propagated
+by refits (:func:`.spin_axis_map_error.map_warp_covariance`). The jackknife sees what the
+residuals along the pass do to the answer; the field sees what a map that misplaces its
+features by a fraction of a pixel does to it, an error epochs in the same map cells share
+and the jackknife over time blocks does not see. Over blind draws of three seeds (the third
+not tuned on) error / sigma has standard deviations east / north 0.76 / 0.78, 0.86 / 1.29
+and 0.77 / 1.06, the 95 % region holding the truth in 0.96, 0.95 and 0.93 of the draws
+(BENCHMARKS.md "Spin-axis calibration: the map's error as a field"), against 1.15 / 1.03,
+1.41 / 2.19 and 1.53 / 1.39 (0.93, 0.74, 0.71) for ``"jackknife-shrunk"`` (the sandwich
+plus the shrunk jackknife alone, the default before); about twice its CPU.
+``"sandwich-warp"`` is the sandwich plus the field (no jackknife: 0.83 / 0.85, 1.22 / 1.92,
+0.92 / 1.18), ``"jackknife"`` the sandwich plus the unshrunk jackknife (ten refits cannot
+resolve the axis block's shape: a thin ellipse, the map's error 19 sigma across it),
+``"jackknife-map"`` that plus the half-resolution term below, ``"sandwich"`` the sandwich
+alone.
 
 **Sandwich** (White 1980, Econometrica 48, 817, doi:10.2307/1912934;
 Newey & West 1987, Econometrica 55, 703, doi:10.2307/1913610): at the refined solution the
@@ -31,13 +34,10 @@ to a lag chosen from the scores' lag-1 correlation (Andrews 1991, Econometrica 5
 doi:10.2307/2938229, eq. 6.4). No noise level is assumed; where the residuals are white
 this is the usual ``sigma^2 (J^T J)^-1``.
 
-**The map's own error** (``method="jackknife-map"``, not the default): the answer's shift
+**The map at half its resolution** (``method="jackknife-map"``, not used): the answer's shift
 on the map at half its resolution over 3 as an isotropic variance on the axis
-(:func:`.spin_axis_jackknife.map_error_covariance`). The bench found the shift no measure
-of the map's error: against the answer refitted on the truth's finer map, its east and
-north components correlate -0.02 and -0.45 (50 draws; -0.36, -0.07 over 50 others), so the
-Richardson-corrected answer (minus the shift / 3) is worse (median error 1.2 against 0.6
-deg) and the term only widens every sigma.
+(:func:`.spin_axis_jackknife.map_error_covariance`): no measure of the map's error (its
+components correlate -0.45 to -0.02 with the truth-map refit's; BENCHMARKS.md).
 
 **Region**: with ``C_aa`` the axis block of ``C`` and ``(A^-1)_aa`` that of ``A^-1``, a
 misfit rise of ``Delta e`` over the grid (the phase minimised, as the surface is) is
@@ -81,6 +81,10 @@ from speclight.estimate.spin_axis.spin_axis_jackknife import (
     shrunk_jackknife_spread,
 )
 from speclight.estimate.spin_axis.spin_axis_lookup import EpochGeometry, angular_distance_deg
+from speclight.estimate.spin_axis.spin_axis_map_error import (
+    covering_covariance,
+    map_warp_covariance,
+)
 from speclight.maps.map_lookup import ReflectivityMap
 
 F64 = NDArray[np.float64]
@@ -101,6 +105,8 @@ MAX_NOISE_RATIO = 10.0
 #: "Spin-axis calibration: the map's error and the shrunk jackknife": the map's error is
 #: then nearly the whole error and the sigmas may understate it).
 MODEL_ERROR_RATIO = 2.0
+#: The covariance of :func:`axis_confidence` unless another is asked for (module doc).
+DEFAULT_METHOD = "jackknife-warp"
 #: How the note of a flat surface starts.
 FLAT_NOTE = "the data do not constrain the axis"
 #: The tangent rotation ``x[:2]`` to the axis's (east, north) offset (:func:`_sigmas`).
@@ -131,6 +137,7 @@ class AxisConfidence:
     hac_lag: int = 0
     constrained: bool = False
     note: str = ""
+    method: str = DEFAULT_METHOD  # the covariance's (axis_confidence)
 
 
 def noise_floor(y: F64) -> float:
@@ -186,7 +193,7 @@ def axis_confidence(
     ra_deg: F64,
     free_period: bool = False,
     ranging: object | None = None,
-    method: str = "jackknife-shrunk",
+    method: str = DEFAULT_METHOD,
 ) -> AxisConfidence:
     """Sigmas, regions and flags of the refined solution (module doc).
 
@@ -211,9 +218,11 @@ def axis_confidence(
     ranging
         The range-offset term (:class:`.spin_axis_ranging.RangingTerm`), or None.
     method
-        The covariance (module doc): ``jackknife`` (the sandwich plus
-        :func:`jackknife_covariance`), ``jackknife-shrunk`` (the sandwich plus
-        :func:`shrunk_jackknife_spread`), ``jackknife-map`` (that plus
+        The covariance (module doc): ``jackknife-warp`` (the default: covering
+        ``jackknife-shrunk`` and ``sandwich-warp``), ``jackknife-shrunk`` (the sandwich plus
+        :func:`shrunk_jackknife_spread`), ``sandwich-warp`` (the sandwich plus
+        :func:`map_warp_covariance`), ``jackknife`` (the sandwich plus
+        :func:`jackknife_covariance`), ``jackknife-map`` (that plus
         :func:`map_error_covariance`) or ``sandwich`` (:func:`sandwich_covariance`).
     """
     cov = a_inv = None
@@ -231,7 +240,7 @@ def axis_confidence(
             step = np.array([0, 0, 0, 1e-6])
             period_scale = abs(model.period_s(x0 + step) - model.period_s(x0)) / 1e-6
     return confidence_from_covariance(
-        cov, a_inv, error, dec_deg, ra_deg, refined, y, lag, period_scale
+        cov, a_inv, error, dec_deg, ra_deg, refined, y, lag, period_scale, method
     )
 
 
@@ -246,6 +255,11 @@ def _covariance(
     cov, a_inv, lag = sandwich_covariance(r, jac, model.y.shape[0])
     if method == "jackknife-shrunk":
         cov = cov + shrunk_jackknife_spread(jackknife_refits(model, x0, ranged))[0]
+    elif method == "sandwich-warp":
+        cov = cov + map_warp_covariance(model, x0)
+    elif method == "jackknife-warp":
+        shrunk = shrunk_jackknife_spread(jackknife_refits(model, x0, ranged))[0]
+        cov = covering_covariance(cov + shrunk, cov + map_warp_covariance(model, x0))
     elif method in ("jackknife", "jackknife-map"):  # plus the sandwich: never below the
         cov = cov + jackknife_covariance(model, x0, ranged)  # local curvature
     if method == "jackknife-map":
@@ -263,6 +277,7 @@ def confidence_from_covariance(
     y: F64,
     hac_lag: int = 0,
     period_scale: float = float("nan"),
+    method: str = DEFAULT_METHOD,
 ) -> AxisConfidence:
     """Sigmas, regions and verdict from the parameters' covariance ``cov`` (K, K) and
     ``A^-1`` (K, K) (None: no sigmas; module doc), the grid's misfit surface ``error``
@@ -363,13 +378,30 @@ def _verdict(out: AxisConfidence) -> tuple[bool, str]:
             "of the sphere"
         )
         if out.noise_ratio > MODEL_ERROR_RATIO:
-            notes.append(
-                f"the misfit is {out.noise_ratio:.3g} times the noise floor: the map's (or the "
-                "spin model's) own error dominates the residuals, and the sigmas count it only "
-                "as far as the jackknife's refits see it: they may be too small "
-                "(docs/spin-axis.md, Sigmas)"
-            )
+            notes.append(_model_error_note(out))
     return constrained, "; ".join(notes)
+
+
+def _model_error_note(out: AxisConfidence) -> str:
+    """What a refined misfit above :data:`MODEL_ERROR_RATIO` times the noise means for the
+    sigmas of ``out.method``."""
+    head = (
+        f"the misfit is {out.noise_ratio:.3g} times the noise floor: the map's (or the spin "
+        "model's) own error dominates the residuals"
+    )
+    field = "the sigmas count the map's error as its directions displaced by a fraction of a pixel"
+    if out.method == "jackknife-warp":
+        return (
+            f"{head}; {field}, sized from the residuals (error / sigma standard deviations "
+            "0.76-1.29 on the calibration bench), not a wrong spin model (docs/spin-axis.md, "
+            "Sigmas)"
+        )
+    if out.method == "sandwich-warp":
+        return f"{head}; {field}, without the jackknife: they may be too small (docs/spin-axis.md)"
+    return (
+        f"{head}, and the sigmas count it only as far as the jackknife's refits see it: they "
+        "may be too small (docs/spin-axis.md, Sigmas)"
+    )
 
 
 def with_period(geo: EpochGeometry, period_s: float) -> EpochGeometry:

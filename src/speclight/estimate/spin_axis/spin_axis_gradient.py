@@ -175,6 +175,13 @@ class SpinMisfit:
         dv = np.stack(cols, axis=-1)
         return v @ self.spin_to_body.T, np.einsum("ij,tjk->tik", self.spin_to_body, dv)
 
+    def body_directions(self, x: ArrayLike) -> tuple[F64, F64]:
+        """Body-frame Sun and observer unit vectors (T, 3) of the epochs under ``x``."""
+        x = np.asarray(x, dtype=float)
+        return self._directions(x, self.geo.sun_gcrs)[0], self._directions(
+            x, self.geo.observer_gcrs
+        )[0]
+
     def residuals(self, x: ArrayLike, jacobian: bool = True) -> tuple[F64, F64 | None]:
         """Residuals (M,) whose sum of squares is the misfit, and their Jacobian (M, K)
         (None unless ``jacobian``); all infinite where the map gives no value or a band's

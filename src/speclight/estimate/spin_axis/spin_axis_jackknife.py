@@ -66,16 +66,23 @@ def jackknife_spread(xs: F64) -> F64:
 
 def shrunk_jackknife_spread(xs: F64) -> tuple[F64, float]:
     """:func:`jackknife_spread` of refits ``xs`` (G, K) with its axis block shrunk towards
-    the isotropic ``mu I`` (``mu`` half its trace) by Ledoit & Wolf's (2004, J. Multivar.
-    Anal. 88, 365, doi:10.1016/S0047-259X(03)00096-4, Lemma 3.2 / Theorem 3.2) intensity
-    ``lambda = min(beta^2, delta^2) / delta^2`` estimated from the refits themselves:
-    ``delta^2 = ||S - mu I||^2`` (the block's anisotropy), ``beta^2 = 1 / G^2 sum_g
-    ||d_g d_g^T - S||^2`` (how much of it G refits can resolve), ``S = 1 / G sum_g d_g d_g^T``
-    of the axis components of the deviations ``d_g``. Returns the covariance (K, K)
-    ``(G - 1) (lambda T + (1 - lambda) S_full)``, ``T`` the block ``mu I`` and zero
-    elsewhere (positive semi-definite), and ``lambda`` (1: only the size is kept)."""
+    the isotropic (:func:`shrunk_second_moment` of the deviations from the refits' mean,
+    times ``G - 1``). Returns the covariance (K, K) and the intensity ``lambda``."""
     g = xs.shape[0]
-    d = xs - xs.mean(axis=0)
+    s, lam = shrunk_second_moment(xs - xs.mean(axis=0))
+    return (g - 1) * s, lam
+
+
+def shrunk_second_moment(d: F64) -> tuple[F64, float]:
+    """``S = 1 / G sum_g d_g d_g^T`` (K, K) of deviations ``d`` (G, K) with its axis block
+    shrunk towards the isotropic ``mu I`` (``mu`` half its trace) by Ledoit & Wolf's (2004,
+    J. Multivar. Anal. 88, 365, doi:10.1016/S0047-259X(03)00096-4, Lemma 3.2 / Theorem 3.2)
+    intensity ``lambda = min(beta^2, delta^2) / delta^2`` estimated from the deviations
+    themselves: ``delta^2 = ||S_aa - mu I||^2`` (the block's anisotropy), ``beta^2 = 1 / G^2
+    sum_g ||d_g d_g^T - S_aa||^2`` (how much of it G deviations can resolve), ``S_aa`` the
+    axis block of ``S``. Returns ``lambda T + (1 - lambda) S`` (``T`` the block ``mu I`` and
+    zero elsewhere; positive semi-definite) and ``lambda`` (1: only the size is kept)."""
+    g = d.shape[0]
     s = d.T @ d / g
     block = s[:2, :2]
     mu = float(np.trace(block)) / 2.0
@@ -84,7 +91,7 @@ def shrunk_jackknife_spread(xs: F64) -> tuple[F64, float]:
     lam = min(beta2, delta2) / delta2 if delta2 > 0 else 1.0
     target = np.zeros_like(s)
     target[:2, :2] = mu * np.eye(2)
-    return np.asarray((g - 1) * (lam * target + (1 - lam) * s)), lam
+    return np.asarray(lam * target + (1 - lam) * s), lam
 
 
 def jackknife_covariance(model: SpinMisfit, x0: F64, ranged: bool) -> F64:
