@@ -45,8 +45,10 @@ from speclight.estimate.shape.tumbling_principal import ALPHA as PRINCIPAL_ALPHA
 from speclight.estimate.shape.tumbling_principal import lag1_correlation, principal_axis_test
 from speclight.estimate.shape.tumbling_search import (
     N_CARRY,
+    grid_rates,
     grid_starts,
     moments_from_u,
+    searched_period_range_h,
     window_schedule,
 )
 from speclight.estimate.shape.tumbling_state import TumblingState
@@ -79,6 +81,7 @@ class TumblingFit:
     t0_jd: float
     principal_axis_chi2: float = float("nan")
     p_value: float = float("nan")
+    searched_period_h: tuple[float, float] = (float("nan"), float("nan"))
 
     @property
     def detected(self) -> bool:
@@ -177,9 +180,11 @@ def _fit_tumbling(
     rng = np.random.default_rng(seed)
     seed_data = data.subset(in_seed)
     seed_prob = _Problem(seed_data, light, t0_jd)
+    searched = searched_period_range_h(data, min_period_h, max_period_h)
     x_starts = [_state_vector(s, 1.0) for s in initial_states or []]
-    x_starts += [_random_start(rng, min_period_h, max_period_h) for _ in range(n_starts)]
-    first = _continued(seed_prob, x_starts, min_period_h, max_period_h, grid, rng)
+    x_starts += [_random_start(rng, *searched) for _ in range(n_starts)]
+    rates = grid_rates(data, min_period_h, max_period_h) if grid else np.empty(0)
+    first = _continued(seed_prob, x_starts, min_period_h, rates, rng)
     seeds = [fam[0] for fam in _families(_within(first, seed_prob))][:N_SEEDS]
     prob = _Problem(data, light, t0_jd)
     if data.n_curves == 1:
@@ -204,18 +209,18 @@ def _fit_tumbling(
     kept = _within(final, prob)
     n_par = 9 if prob.calibrated else 8
     chi_pa, p = principal_axis_test(prob.residuals, _state_vector(kept[0], 1.0)[:n_par], n_par)
-    return TumblingFit(_families(kept), kept[-1].chi2, final, t0_jd, chi_pa, p)
+    return TumblingFit(_families(kept), kept[-1].chi2, final, t0_jd, chi_pa, p, searched)
 
 
 def _continued(
     prob: _Problem,
     x_starts: list[F64],
     min_period_h: float,
-    max_period_h: float,
-    grid: bool,
+    grid_rates_rad_s: F64,
     rng: np.random.Generator,
 ) -> list[TumblingState]:
-    """The starts (plus, with ``grid``, the grid's, :mod:`.tumbling_search`) fitted to
+    """The starts (plus the grid's at the rates ``grid_rates_rad_s``, none when empty,
+    :mod:`.tumbling_search`) fitted to
     windows around ``t0`` growing to the whole of ``prob``'s points (continuation); the
     best of each window's :data:`N_CARRY` best families (and every given start) go on to
     the next."""
@@ -225,14 +230,9 @@ def _continued(
     for k, half in enumerate(halves):
         index = np.flatnonzero(np.abs(prob.t_s) <= half)
         window = _Problem(d.subset(index), prob.light, t0_jd)
-        if k == 0 and grid:
+        if k == 0 and grid_rates_rad_s.size:
             starts += grid_starts(
-                window.data,
-                window.t_s,
-                prob.light,
-                min_period_h=min_period_h,
-                max_period_h=max_period_h,
-                rng=rng,
+                window.data, window.t_s, prob.light, rates_rad_s=grid_rates_rad_s, rng=rng
             )
         sols = _fit_all(window, starts, FIRST_EVALUATIONS if k == 0 else MAX_EVALUATIONS)
         carried = [fam[0] for fam in _families(sols)][: max(N_CARRY, len(x_starts))]
