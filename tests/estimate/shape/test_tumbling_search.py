@@ -124,3 +124,39 @@ def test_searched_periods_reach_the_longest_curves_span():
     jd_rounding_h = 2 * np.spacing(2459000.5) * 24.0  # two epochs' float64 rounding [h]
     assert lo == 0.03 and abs(hi - 590.0 / 3600.0) < jd_rounding_h
     assert searched_period_range_h(d, 0.03, 0.5) == (0.03, 0.5)
+
+
+def test_refinement_jacobian_is_scipys_forward_differences(monkeypatch):
+    """The fit's Jacobian (attitude columns on the state's own motion) against scipy's own
+    2-point differences of the same residuals (scipy.optimize's ``approx_derivative``, the
+    rule ``least_squares`` used before), at a state with ``u`` at its bound (a backward
+    step): equal to float rounding, with 5 propagations beyond the state's own where
+    scipy's takes 8."""
+    from scipy.optimize._numdiff import approx_derivative
+
+    from speclight.estimate.shape import tumbling
+    from speclight.estimate.shape.tumbling_light import ConvexLight
+
+    t_s = np.concatenate([np.arange(0, 600, 10.0), 5400 + np.arange(0, 600, 10.0)])
+    d = _box_curve(t_s, MOMENTS, np.array([0.01, 0.03, 0.02]), np.repeat([0, 1], 60))
+    light = ConvexLight(NORMALS, AREAS, scattering_law("lambert"))
+    prob = tumbling._Problem(d, light, float(d.time_jd[0]))
+    x = np.array([0.3, -0.2, 1.0, 0.012, 0.028, 0.019, 0.4, tumbling.MOMENT_BOUND])
+    upper = np.full(8, np.inf)
+    upper[6:8] = tumbling.MOMENT_BOUND
+    lower = -upper
+    reference = approx_derivative(prob.residuals, x, method="2-point", bounds=(lower, upper))
+    calls = []
+    real = tumbling.torque_free_attitude
+    monkeypatch.setattr(
+        tumbling, "torque_free_attitude", lambda *a, **k: calls.append(1) or real(*a, **k)
+    )
+    prob = tumbling._Problem(d, light, float(d.time_jd[0]))
+    jac = prob.jacobian(x, lower, upper)
+    n_propagations = len(calls)
+    # a hundred roundings of a residual (the propagation's, the light's) over the step
+    rounding = 100 * np.finfo(float).eps / np.sqrt(np.finfo(float).eps)
+    assert np.max(np.abs(jac - reference)) <= rounding * np.max(np.abs(prob.residuals(x)))
+    # the state's own motion (kept from its residuals inside least_squares), then one per
+    # rate and moment parameter
+    assert n_propagations == 6
