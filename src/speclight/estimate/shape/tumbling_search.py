@@ -168,15 +168,14 @@ def light_curve_frequencies(
 
 def grid_rates(d: InversionData, min_period_h: float, max_period_h: float) -> F64:
     """Body rates [rad/s] of the grid: :data:`N_RATES` log-uniform over
-    ``min_period_h..max_period_h``, continued at the same ratio up to the searched range's
-    end (:func:`searched_period_range_h`), and from each independent light-curve frequency
-    ``f`` (:func:`light_curve_frequencies`) the rates ``2 pi f`` and ``pi f`` (a light
-    curve's strongest frequency is often twice the rotation's: a body shows two like
-    halves a turn) that lie in the searched range."""
+    ``min_period_h..max_period_h``, and from each independent light-curve frequency ``f``
+    (:func:`light_curve_frequencies`) the rates ``2 pi f`` and ``pi f`` (a light curve's
+    strongest frequency is often twice the rotation's: a body shows two like halves a turn)
+    that lie in the searched range (:func:`searched_period_range_h`: up to the longest
+    curve's span). The log-uniform rates are not continued to the span: slow rates fit the
+    short first window too easily and crowd out the right one (BENCHMARKS.md)."""
     lo_h, hi_h = searched_period_range_h(d, min_period_h, max_period_h)
-    ratio = (max_period_h / min_period_h) ** (1.0 / (N_RATES - 1))
-    n = max(N_RATES, int(np.ceil(np.log(hi_h / lo_h) / np.log(ratio) - 1e-9)) + 1)
-    periods_s = 3600.0 * np.geomspace(lo_h, hi_h, n)
+    periods_s = 3600.0 * np.geomspace(min_period_h, max_period_h, N_RATES)
     f = light_curve_frequencies(d, lo_h, hi_h)
     seeded = np.concatenate([f, 0.5 * f])
     seeded = seeded[(seeded >= 1 / (3600.0 * hi_h)) & (seeded <= 1 / (3600.0 * lo_h))]
