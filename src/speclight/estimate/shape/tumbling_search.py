@@ -5,8 +5,9 @@ Random starts hit the narrow basin of the true state rarely (docs/shape.md, "Lim
 :func:`grid_starts` scores many states at once, using that a torque-free motion's attitude
 is ``q(t) = q0 q_ref(t)`` where ``q_ref`` is the same motion started from the identity
 (the body-frame rates do not depend on the attitude): for each dynamic (second moments
-``u`` on a grid, body rates ``omega0`` from directions on a sphere times rates spread
-log-uniform over the period range) one propagation serves every attitude ``q0`` of a
+``u`` on a grid, body rates ``omega0`` from directions on a sphere times the rates of
+:func:`grid_rates`: log-uniform over the period range and seeded from the light curves'
+periodogram) one propagation serves every attitude ``q0`` of a
 quasi-uniform set in SO(3), and the misfit of all of them is one array operation. The
 grid is scored on a short window around ``t0`` (a turn or two: there the motion is close
 to a uniform rotation and the rate error costs little phase), the best
