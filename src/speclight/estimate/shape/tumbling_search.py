@@ -5,8 +5,9 @@ Random starts hit the narrow basin of the true state rarely (docs/shape.md, "Lim
 :func:`grid_starts` scores many states at once, using that a torque-free motion's attitude
 is ``q(t) = q0 q_ref(t)`` where ``q_ref`` is the same motion started from the identity
 (the body-frame rates do not depend on the attitude): for each dynamic (second moments
-``u`` on a grid, body rates ``omega0`` from directions on a sphere times rates spread
-log-uniform over the period range) one propagation serves every attitude ``q0`` of a
+``u`` on a grid, body rates ``omega0`` from directions on a sphere times the rates of
+:func:`grid_rates`: log-uniform over the period range and seeded from the light curves'
+periodogram) one propagation serves every attitude ``q0`` of a
 quasi-uniform set in SO(3), and the misfit of all of them is one array operation. The
 grid is scored on a short window around ``t0`` (a turn or two: there the motion is close
 to a uniform rotation and the rate error costs little phase), the best
@@ -29,10 +30,20 @@ F64 = NDArray[np.float64]
 SECONDS_PER_DAY = 86400.0
 #: Second-moment parameters ``u`` of the grid (each of the two), [1].
 GRID_U = (-1.0, 0.0, 1.0)
+#: Extra grid moments near the sphere ``u = 0``, triaxial, with the sorted moment ratios
+#: (0.74, 0.89), (0.86, 0.94), (0.91, 0.96), (0.95, 0.98): there the grid's step of 1 in
+#: ``u`` is a step of 0.3 or more in the ratios.
+NEAR_SYMMETRIC_U = ((0.3, -0.3), (0.3, 0.15), (-0.2, -0.1), (0.1, 0.05))
 #: Directions of the body rates on the grid (Fibonacci sphere).
 N_DIRECTIONS = 26
 #: Rates of the grid over the period range (log-uniform).
 N_RATES = 6
+#: Independent light-curve frequencies that seed grid rates (:func:`light_curve_frequencies`).
+N_FREQUENCIES = 2
+#: Periodogram frequencies per resolution ``1 / T`` of the longest curve.
+OVERSAMPLING = 10
+#: Harmonics (and subharmonics) of a stronger peak that do not count as independent.
+MAX_HARMONIC = 4
 #: Attitudes of the grid (quasi-uniform in SO(3), fixed seed).
 N_ATTITUDES = 300
 #: Grid states refined in the first window.
@@ -92,43 +103,120 @@ def _misfit(d: InversionData, lum: F64) -> F64:
     return np.asarray(np.sum(((d.brightness - model) * w) ** 2, axis=1))
 
 
+def searched_period_range_h(
+    d: InversionData, min_period_h: float, max_period_h: float
+) -> tuple[float, float]:
+    """The periods the search covers [h]: ``min_period_h`` up to ``max_period_h`` or, when
+    longer, the longest light curve's span (a body that turns once a curve still shows its
+    turn there; the bench's slow draws lay beyond a fixed upper end)."""
+    spans_s = [float(np.ptp(d.time_jd[d.curve == c])) * SECONDS_PER_DAY for c in range(d.n_curves)]
+    return min_period_h, max(max_period_h, max(spans_s) / 3600.0)
+
+
+def grid_moments() -> list[F64]:
+    """The grid's second-moment parameters ``u``: :data:`GRID_U` squared and
+    :data:`NEAR_SYMMETRIC_U`."""
+    square = [np.array([u1, u2]) for u1 in GRID_U for u2 in GRID_U]
+    return square + [np.array(u) for u in NEAR_SYMMETRIC_U]
+
+
+def light_curve_frequencies(
+    d: InversionData, min_period_h: float, max_period_h: float, n: int = N_FREQUENCIES
+) -> F64:
+    """The ``n`` strongest independent frequencies [Hz] of the light curves' periodogram.
+
+    A tumbler's light curve is quasi-periodic with two fundamental frequencies, those of
+    the precession and of the rotation (or nutation), and their combinations (Pravec et al.
+    2005, Icarus 173, 108, doi:10.1016/j.icarus.2004.07.021). The power is the
+    Lomb-Scargle periodogram (astropy, one harmonic, standard normalisation) of each light
+    curve on its own (the gaps between curves would alias), summed with the curves' point
+    counts as weights, from ``1 / max_period`` to ``4 / min_period`` (a four-fold light
+    curve), at most the curves' Nyquist frequency, :data:`OVERSAMPLING` frequencies per
+    resolution ``1 / T`` of the longest curve. Its local maxima, strongest first, are
+    taken when no ratio ``a / b`` (``a, b <=`` :data:`MAX_HARMONIC`) to a frequency taken
+    before lies within half a resolution: harmonics and subharmonics of one motion count
+    once. Fewer than ``n`` when the periodogram has fewer such peaks.
+    """
+    from astropy.timeseries import LombScargle
+
+    t_s = (d.time_jd - d.time_jd[0]) * SECONDS_PER_DAY
+    curves = [np.flatnonzero(d.curve == c) for c in range(d.n_curves)]
+    curves = [k for k in curves if k.size > 2 * MAX_HARMONIC]
+    if not curves:
+        return np.empty(0)
+    span_s = max(float(np.ptp(t_s[k])) for k in curves)
+    step_s = min(float(np.median(np.diff(t_s[k]))) for k in curves)
+    f_hi = min(MAX_HARMONIC / (3600.0 * min_period_h), 0.5 / step_s)
+    f_lo = 1.0 / (3600.0 * max_period_h)
+    freq = np.arange(f_lo, f_hi, 1.0 / (OVERSAMPLING * span_s))
+    if freq.size < 3:
+        return np.empty(0)
+    power = np.zeros(freq.size)
+    for k in curves:
+        ls = LombScargle(t_s[k], d.brightness[k], d.sigma[k])
+        power += k.size * ls.power(freq, normalization="standard")
+    peak = np.flatnonzero((power[1:-1] > power[:-2]) & (power[1:-1] >= power[2:])) + 1
+    orders = np.arange(1, MAX_HARMONIC + 1)
+    ratios = (orders[:, None] / orders[None, :]).ravel()
+    taken: list[float] = []
+    for i in peak[np.argsort(power[peak])[::-1]]:
+        if all(np.min(np.abs(freq[i] - ratios * f)) > 0.5 / span_s for f in taken):
+            taken.append(float(freq[i]))
+        if len(taken) == n:
+            break
+    return np.array(taken)
+
+
+def grid_rates(d: InversionData, min_period_h: float, max_period_h: float) -> F64:
+    """Body rates [rad/s] of the grid: :data:`N_RATES` log-uniform over
+    ``min_period_h..max_period_h``, and from each independent light-curve frequency ``f``
+    (:func:`light_curve_frequencies`) the rates ``2 pi f`` and ``pi f`` (a light curve's
+    strongest frequency is often twice the rotation's: a body shows two like halves a turn)
+    that lie in the searched range (:func:`searched_period_range_h`: up to the longest
+    curve's span). The log-uniform rates are not continued to the span: slow rates fit the
+    short first window too easily and crowd out the right one (BENCHMARKS.md)."""
+    lo_h, hi_h = searched_period_range_h(d, min_period_h, max_period_h)
+    periods_s = 3600.0 * np.geomspace(min_period_h, max_period_h, N_RATES)
+    f = light_curve_frequencies(d, lo_h, hi_h)
+    seeded = np.concatenate([f, 0.5 * f])
+    seeded = seeded[(seeded >= 1 / (3600.0 * hi_h)) & (seeded <= 1 / (3600.0 * lo_h))]
+    return np.concatenate([2 * np.pi / periods_s, 2 * np.pi * seeded])
+
+
 def grid_starts(
     d: InversionData,
     t_s: F64,
     light: LightModel,
     *,
-    min_period_h: float,
-    max_period_h: float,
+    rates_rad_s: F64,
     rng: np.random.Generator,
     n_keep: int = N_KEEP,
 ) -> list[F64]:
     """The ``n_keep`` best grid states (module doc) for the points ``d`` at ``t_s`` [s]
-    from ``t0`` under the light model ``light`` (:mod:`.tumbling_light`), as the fit's
-    state vectors (rotation vector, body rates [rad/s], ``u``, log scale)."""
+    from ``t0`` under the light model ``light`` (:mod:`.tumbling_light`), the body rates'
+    magnitudes ``rates_rad_s`` [rad/s] (:func:`grid_rates`), as the fit's state vectors
+    (rotation vector, body rates [rad/s], ``u``, log scale)."""
     rot = Rotation.random(N_ATTITUDES, rng=rng)
     r_mat = rot.as_matrix()  # (S, 3, 3) body-to-ecliptic at t0
     sun = np.einsum("skj,nk->snj", r_mat, d.sun_ecliptic)  # R^T s, (S, N, 3)
     obs = np.einsum("skj,nk->snj", r_mat, d.observer_ecliptic)
     chp = np.tile(d.cos_half_phase, N_ATTITUDES)
-    rates = 2 * np.pi / (3600.0 * np.geomspace(min_period_h, max_period_h, N_RATES))
     best: list[tuple[float, F64]] = []
-    for u1 in GRID_U:
-        for u2 in GRID_U:
-            u = np.array([u1, u2])
-            moments = moments_from_u(u)
-            for direction in fibonacci_sphere(N_DIRECTIONS):
-                for rate in rates:
-                    w0 = rate * direction
-                    q, _ = torque_free_attitude(t_s, moments, np.array([1.0, 0, 0, 0]), w0)
-                    m_ref = quat_to_matrix(q)  # (N, 3, 3) body at t to body at t0
-                    s_b = np.einsum("nkj,snk->snj", m_ref, sun).reshape(-1, 3)
-                    o_b = np.einsum("nkj,snk->snj", m_ref, obs).reshape(-1, 3)
-                    lum = light(s_b, o_b, chp)
-                    chi2 = _misfit(d, lum.reshape(N_ATTITUDES, -1))
-                    for s in np.argsort(chi2)[:n_keep]:
-                        x = np.concatenate([rot[int(s)].as_rotvec(), w0, u, [0.0]])
-                        best.append((float(chi2[s]), x))
-            best = sorted(best, key=lambda b: b[0])[: 4 * n_keep]
+    for u in grid_moments():
+        moments = moments_from_u(u)
+        for direction in fibonacci_sphere(N_DIRECTIONS):
+            for rate in rates_rad_s:
+                w0 = rate * direction
+                q, _ = torque_free_attitude(t_s, moments, np.array([1.0, 0, 0, 0]), w0)
+                m_ref = quat_to_matrix(q)  # (N, 3, 3) body at t to body at t0
+                s_b = np.einsum("nkj,snk->snj", m_ref, sun).reshape(-1, 3)
+                o_b = np.einsum("nkj,snk->snj", m_ref, obs).reshape(-1, 3)
+                lum = light(s_b, o_b, chp)
+                chi2 = _misfit(d, lum.reshape(N_ATTITUDES, -1))
+                for s in np.argsort(chi2)[:n_keep]:
+                    x = np.concatenate([rot[int(s)].as_rotvec(), w0, u, [0.0]])
+                    best.append((float(chi2[s]), x))
+        best = sorted(best, key=lambda b: b[0])[: 4 * n_keep]
     return [x for _, x in _distinct(best, n_keep)]
 
 
