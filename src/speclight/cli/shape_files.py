@@ -120,6 +120,9 @@ def shape_files(
                 max_period_h=options.max_period_h, n_starts=tumbling_starts, seed=options.seed,
             )  # fmt: skip
             ds = add_tumbling(ds, fit, light)
+            if say is not None:
+                lo_h, hi_h = fit.searched_period_h
+                say(f"tumbling search: periods {lo_h:.4g}-{hi_h:.4g} h (given range, to the span)")
         claim.write(dataset_bytes(ds))
         if run.polyhedron is not None:
             obj_claim.write(format_obj(run.polyhedron, f"speclight shape: EGI of {lc}").encode())

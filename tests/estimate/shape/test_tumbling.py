@@ -269,6 +269,11 @@ def test_principal_axis_rotation_is_not_tumbling_fast():
     assert np.all(np.isfinite(ds.tumbling_rate_std)) and np.all(ds.tumbling_rate_std > 0)
     assert np.all(np.isfinite(ds.tumbling_moment_ratio_std))
     assert ds.tumbling_momentum_direction_std.dims == ("family", "east_north")
+    # the searched periods: the given lower end; the upper one the longer pass's span (from
+    # the epochs in JD: float64 resolves 4e-5 s there, 1e-7 of the 580 s span)
+    span_h = max(np.ptp(t_s[:30]), np.ptp(t_s[30:])) / 3600.0
+    assert ds.attrs["tumbling_searched_period_h"][0] == pytest.approx(0.03)
+    assert ds.attrs["tumbling_searched_period_h"][1] == pytest.approx(max(0.1, span_h), rel=1e-6)
 
 
 def test_body_symmetry_keeps_the_family():

@@ -23,7 +23,9 @@ block jackknife with a model-error term), ``tumbling_members``, the best state's
 map comes from: given, the scenario's, built in this run or from the cache, with its
 resolution) and, with a map, ``tumbling_map`` (its path), ``tumbling_map_nside``,
 ``tumbling_map_rolls``, ``tumbling_map_phase_angle_deg`` and
-``tumbling_map_resolution_px`` (read from the map).
+``tumbling_map_resolution_px`` (read from the map); ``tumbling_searched_period_h`` (the
+grid's period range [h]: the given range, its upper end raised to the longest light curve's
+span).
 """
 
 from __future__ import annotations
@@ -301,6 +303,7 @@ def add_tumbling(
     out.attrs["tumbling_families"] = len(fit.families)
     out.attrs["tumbling_detected"] = int(fit.detected)
     out.attrs["tumbling_p_value"] = fit.p_value
+    out.attrs["tumbling_searched_period_h"] = np.asarray(fit.searched_period_h, dtype=float)
     if light is not None:
         out.attrs.update(light.attrs())
     return out
