@@ -152,6 +152,7 @@ def test_cli_run_and_bad_input(folder) -> None:
         err = angular_distance_deg(a["refined_ra_deg"], a["refined_dec_deg"], 30.0, 45.0)
         assert err <= 2.45 * a["sigma_axis_deg"], (err, a["sigma_axis_deg"])
         assert a["period_check"] == "not run" and a["axis_constrained"] == 0, a["axis_note"]
+        assert a["sigma_method"] == "jackknife-warp"  # the default, recorded
     # the same noisy rates as a CSV (eq. 5 applied to them with the scenario's geometry, the
     # scenario run on the map): the same misfits, to the CSV's 7 significant digits
     with xr.open_dataset(measured, engine="h5netcdf") as sim:

@@ -103,6 +103,7 @@ def _with_confidence(ds: xr.Dataset, r: SpinAxisResult) -> xr.Dataset:
     c = r.confidence
     for name in CONFIDENCE_ATTRS:
         ds.attrs[name] = float("nan") if c is None else getattr(c, name)
+    ds.attrs["sigma_method"] = "none" if c is None else c.method
     ds.attrs["axis_constrained"] = int(c is not None and c.constrained)
     ds.attrs["axis_note"] = "not refined: no sigmas" if c is None else c.note
     scale = float("nan") if c is None else c.misfit_per_chi2
