@@ -126,6 +126,12 @@ class ReflectivityMap:
     range_bin_edges_m: F64 | None = None
     range_offset_m: NDArray[np.float32] | None = None
 
+    @functools.cached_property
+    def roll_frames(self) -> tuple[F64, F64]:
+        """``(e_lon, e_lat)`` (D, 3): the roll reference axes of the map's directions
+        (:func:`.map_geometry.roll_reference`), made once per loaded map."""
+        return roll_reference(self.direction_body)
+
     def intensity_1au(self, sun_body: ArrayLike, observer_body: ArrayLike) -> F64:
         """Interpolated intensity (N, L) [W sr-1 nm-1] under the Sun at 1 AU.
 
@@ -151,7 +157,7 @@ class ReflectivityMap:
         for i in range(4):
             # the roll in the reference frame of this pixel centre (the frames of neighbouring
             # pixels differ by their longitude difference, much near the poles)
-            e_lon, e_lat = roll_reference(self.direction_body[pix[i]])
+            e_lon, e_lat = self.roll_frames[0][pix[i]], self.roll_frames[1][pix[i]]
             roll = np.arctan2(np.sum(u * e_lat, axis=1), np.sum(u * e_lon, axis=1))
             k, w_roll = roll_weights(self.header.roll_deg.size, roll)
             for jj in range(2):
