@@ -31,7 +31,7 @@ import time
 import numpy as np
 from scipy.optimize import least_squares
 
-from bench_tumbling_far import WHITE, draw_truth, geometry, render
+from bench_tumbling_far import WHITE, draw_truth, geometry, map_light, render
 from speclight.attitude import torque_free_attitude
 from speclight.attitude.quaternion import quat_conjugate, quat_rotate
 from speclight.estimate.shape.convex_model import facet_brightness
@@ -48,8 +48,6 @@ from speclight.estimate.shape.tumbling import (
 from speclight.estimate.shape.tumbling_light import (
     ConvexLight,
     LightModel,
-    MapLight,
-    tabulated_map,
 )
 from speclight.estimate.shape.tumbling_uncertainty import (
     MODEL_ERROR_WEIGHT,
@@ -119,13 +117,7 @@ def main() -> None:
     law = scattering_law("lambert")
     light: LightModel = ConvexLight(normals, areas, law)
     if a.model == "map":
-        start = time.perf_counter()
-        rmap = tabulated_map(
-            lambda s_b, o_b: render(mesh, s_b, o_b, 64), nside=8,
-            phase_angle_deg=np.arange(30.0, 120.0, 10.0), n_rolls=32,
-        )  # fmt: skip
-        light = MapLight(rmap)
-        print(f"map built in {time.perf_counter() - start:.1f} s (wall)", flush=True)
+        light = map_light(mesh, 64, 8, 32)
     t_s, sun, obs = geometry()
     chp = np.sqrt(0.5 * (1 + np.sum(sun * obs, axis=1)))
     t_jd = 2459000.5 + t_s / 86400.0

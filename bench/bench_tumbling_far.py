@@ -75,6 +75,18 @@ def render(mesh: Target, sun_body: np.ndarray, obs_body: np.ndarray, px: int) ->
     return np.asarray(res.intensity_W_sr_nm[:, 0])
 
 
+def map_light(mesh: Target, px: int, nside: int, n_rolls: int) -> MapLight:
+    """The light model of ``mesh``'s map rendered at ``px`` on HEALPix ``nside`` directions,
+    phase angles 30-110 deg every 10 deg and ``n_rolls`` rolls; says its build time."""
+    start = time.perf_counter()
+    rmap = tabulated_map(
+        lambda s_b, o_b: render(mesh, s_b, o_b, px), nside=nside,
+        phase_angle_deg=np.arange(30.0, 120.0, 10.0), n_rolls=n_rolls,
+    )  # fmt: skip
+    print(f"map built in {time.perf_counter() - start:.1f} s (wall)", flush=True)
+    return MapLight(rmap)
+
+
 def describe(s: TumblingState) -> str:
     """Period ``2 pi / rate`` [s], sorted moment ratios, momentum direction (ecliptic)."""
     h = s.momentum_direction
@@ -119,13 +131,7 @@ def main() -> None:
     mesh = Target(parts=(Part("body", np.vstack([v for v, _ in parts]), faces, WHITE),))
     light: LightModel = ConvexLight(normals, areas, law)
     if a.model == "map":
-        start = time.perf_counter()
-        rmap = tabulated_map(
-            lambda s_b, o_b: render(mesh, s_b, o_b, a.map_px), nside=a.map_nside,
-            phase_angle_deg=np.arange(30.0, 120.0, 10.0), n_rolls=a.map_rolls,
-        )  # fmt: skip
-        light = MapLight(rmap)
-        print(f"map built in {time.perf_counter() - start:.1f} s (wall)", flush=True)
+        light = map_light(mesh, a.map_px, a.map_nside, a.map_rolls)
     t_s, sun, obs = geometry()
     chp = np.sqrt(0.5 * (1 + np.sum(sun * obs, axis=1)))
     t_jd = 2459000.5 + t_s / 86400.0
