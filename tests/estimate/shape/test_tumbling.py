@@ -49,7 +49,7 @@ def _two_passes():
 
 
 #: The far-start searches and the full principal-axis check run the grid search (about a
-#: CPU minute each, ~4 for the null case, ~2.5 with the reflectivity map: its 73,728 node
+#: CPU minute each, ~4 for the null case, ~2.5 with the reflectivity map: its 221,184 node
 #: renders and lookups): too long for the suite's 12-minute budget. They
 #: run where SPECLIGHT_LONG_TESTS=1 is set (a fast null test runs always);
 #: bench/bench_tumbling_far.py measures the search over random draws.
