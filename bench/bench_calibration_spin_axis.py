@@ -255,7 +255,12 @@ def main() -> None:
     ap.add_argument("--phases", type=int, default=36)
     ap.add_argument("--folder", type=Path, default=Path("/tmp/bench_calibration_spin_axis"))
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--save", type=Path, default=None, help="pickle the period-known draws")
+    ap.add_argument(
+        "--save",
+        type=Path,
+        default=None,
+        help="pickle the period-known draws (the free-period ones to FILE.free.pkl)",
+    )
     ap.add_argument("--load", type=Path, default=None, help="report saved draws, run none")
     args = ap.parse_args()
     if args.load is not None:
@@ -284,6 +289,8 @@ def main() -> None:
     _report("box-wing, period 2-6 % off and fixed (the period check)", rows)
     rows = [_draw(rng, geo, truth, search, args, "free") for _ in range(args.period_draws)]
     _report("box-wing, period 1-4 % off and free", rows)
+    if args.save is not None and rows:
+        args.save.with_suffix(".free.pkl").write_bytes(pickle.dumps(rows))
     search_s, truth_s = calibration_maps(args.folder, True)
     s16 = load_band_map(search_s)
     sph = (s16, spin_frame_map(s16, None, args.phases))
