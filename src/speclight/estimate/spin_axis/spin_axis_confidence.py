@@ -109,6 +109,13 @@ MODEL_ERROR_RATIO = 2.0
 DEFAULT_METHOD = "jackknife-warp"
 #: How the note of a flat surface starts.
 FLAT_NOTE = "the data do not constrain the axis"
+#: What the calibration bench showed of the sigmas with a free period (said after them;
+#: BENCHMARKS.md "Spin-axis calibration: a free period").
+FREE_PERIOD_NOTE = (
+    "the period free: the sigmas are marginal over it (on the calibration bench, the period "
+    "given 1-4 % off, error / sigma standard deviations east / north FREE_NUMBERS; "
+    "docs/spin-axis.md, Sigmas)"
+)
 #: The tangent rotation ``x[:2]`` to the axis's (east, north) offset (:func:`_sigmas`).
 EAST_NORTH = np.array([[0.0, 1.0], [-1.0, 0.0]])
 
@@ -379,6 +386,8 @@ def _verdict(out: AxisConfidence) -> tuple[bool, str]:
         )
         if out.noise_ratio > MODEL_ERROR_RATIO:
             notes.append(_model_error_note(out))
+        if np.isfinite(out.sigma_period_s):
+            notes.append(FREE_PERIOD_NOTE)
     return constrained, "; ".join(notes)
 
 
