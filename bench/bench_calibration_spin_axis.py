@@ -3,8 +3,10 @@
 Run: ``.venv/bin/python bench/bench_calibration_spin_axis.py [--draws 50] [--wrong-draws 10]
 [--period-draws 10] [--sphere-draws 10] [--grid-deg 4]
 [--phases 36] [--folder DIR] [--seed 0] [--save FILE.pkl] [--load FILE.pkl]``
-(``--save`` keeps the period-known draws' refits; ``--load`` reports them again, no search:
-every covariance variant of ``bench_calibration_spin_axis_variants.py`` side by side)
+(``--save`` keeps the period-known draws' refits, the free-period ones in ``FILE.free.pkl``
+for ``bench_calibration_spin_axis_free_period.py``; ``--load`` reports the period-known
+ones again, no search: every covariance variant of ``bench_calibration_spin_axis_variants.py``
+side by side)
 
 Targets and maps (built once in ``--folder``, reused): the box-wing example at 100 nm bins;
 the search uses a passive map at 32 px of 768 directions (HEALPix nside 8, 7.3 deg apart) x

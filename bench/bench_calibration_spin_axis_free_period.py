@@ -82,14 +82,15 @@ def main() -> None:
         f"{np.median(abs(rho[:, 1])):.2f}; above 0.5 in {int(np.sum(abs(rho) > 0.5))} of "
         f"{rho.size}"
     )
+    zm, zn = mp / sig, (err - mp) / sig
     print(
-        f"the map's part / sigma: std east {np.std(mp[:, 0] / sig[:, 0]):.2f}, north "
-        f"{np.std(mp[:, 1] / sig[:, 1]):.2f}; the rest (noise) / sigma: std east "
-        f"{np.std((err - mp)[:, 0] / sig[:, 0]):.2f}, north {np.std((err - mp)[:, 1] / sig[:, 1]):.2f}"
+        f"the map's part / sigma: std east {zm[:, 0].std():.2f}, north {zm[:, 1].std():.2f}; "
+        f"the rest (noise) / sigma: std east {zn[:, 0].std():.2f}, north {zn[:, 1].std():.2f}"
     )
     print(
         f"(error - period-predicted) / period-known sigma: std east {rest[:, 0].std():.2f} "
-        f"(mean {rest[:, 0].mean():+.2f}), north {rest[:, 1].std():.2f} (mean {rest[:, 1].mean():+.2f})"
+        f"(mean {rest[:, 0].mean():+.2f}), north {rest[:, 1].std():.2f} "
+        f"(mean {rest[:, 1].mean():+.2f})"
     )
 
 
