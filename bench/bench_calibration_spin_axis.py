@@ -3,8 +3,10 @@
 Run: ``.venv/bin/python bench/bench_calibration_spin_axis.py [--draws 50] [--wrong-draws 10]
 [--period-draws 10] [--sphere-draws 10] [--grid-deg 4]
 [--phases 36] [--folder DIR] [--seed 0] [--save FILE.pkl] [--load FILE.pkl]``
-(``--save`` keeps the period-known draws' refits; ``--load`` reports them again, no search:
-every covariance variant of ``bench_calibration_spin_axis_variants.py`` side by side)
+(``--save`` keeps the period-known draws' refits, the free-period ones in ``FILE.free.pkl``
+for ``bench_calibration_spin_axis_free_period.py``; ``--load`` reports the period-known
+ones again, no search: every covariance variant of ``bench_calibration_spin_axis_variants.py``
+side by side)
 
 Targets and maps (built once in ``--folder``, reused): the box-wing example at 100 nm bins;
 the search uses a passive map at 32 px of 768 directions (HEALPix nside 8, 7.3 deg apart) x
@@ -255,7 +257,12 @@ def main() -> None:
     ap.add_argument("--phases", type=int, default=36)
     ap.add_argument("--folder", type=Path, default=Path("/tmp/bench_calibration_spin_axis"))
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--save", type=Path, default=None, help="pickle the period-known draws")
+    ap.add_argument(
+        "--save",
+        type=Path,
+        default=None,
+        help="pickle the period-known draws (the free-period ones to FILE.free.pkl)",
+    )
     ap.add_argument("--load", type=Path, default=None, help="report saved draws, run none")
     args = ap.parse_args()
     if args.load is not None:
@@ -284,6 +291,8 @@ def main() -> None:
     _report("box-wing, period 2-6 % off and fixed (the period check)", rows)
     rows = [_draw(rng, geo, truth, search, args, "free") for _ in range(args.period_draws)]
     _report("box-wing, period 1-4 % off and free", rows)
+    if args.save is not None and rows:
+        args.save.with_suffix(".free.pkl").write_bytes(pickle.dumps(rows))
     search_s, truth_s = calibration_maps(args.folder, True)
     s16 = load_band_map(search_s)
     sph = (s16, spin_frame_map(s16, None, args.phases))

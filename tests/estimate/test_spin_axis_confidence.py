@@ -230,3 +230,26 @@ def test_ledoit_wolf_shrinkage_by_hand_and_consistent() -> None:
     np.testing.assert_allclose(np.trace(cov[:2, :2]), np.trace(plain[:2, :2]), rtol=1e-12)
     assert lam < 0.01
     np.testing.assert_allclose(cov, plain, rtol=0.02, atol=0.02 * plain[0, 0])
+
+
+def test_free_period_sigmas_are_marginal_and_said() -> None:
+    # reference: the marginal variance of a Gaussian's component is its diagonal entry, the
+    # conditional (the period known) the Schur complement C_ee - C_ef^2 / C_ff, smaller where
+    # they correlate; the tangent parameter x[1] is the axis's east (EAST_NORTH)
+    from speclight.estimate.spin_axis.spin_axis_confidence import confidence_from_covariance
+
+    cov = np.diag([1e-4, 4e-4, 1e-3, 2e-2])
+    cov[1, 3] = cov[3, 1] = 0.8 * np.sqrt(4e-4 * 2e-2)  # east with the extra turn: rho 0.8
+    err = np.ones((5, 10))
+    err[2, 3] = 0.01
+    y = 1.0 + 0.01 * np.random.default_rng(1).normal(size=(20, 2))
+    refined = (108.0, 0.0, 0.0, noise_floor(y))  # the best cell; a misfit at the noise floor
+    args = (err, np.linspace(-60, 60, 5), np.arange(10) * 36.0, refined)
+    got = confidence_from_covariance(cov, np.eye(4), *args, y, 0, 2.0)
+    conditional = np.sqrt(4e-4 * (1 - 0.8**2))
+    np.testing.assert_allclose(got.sigma_east_deg, np.degrees(np.sqrt(4e-4)), rtol=1e-12)
+    assert got.sigma_east_deg > 1.5 * np.degrees(conditional)  # 1 / sqrt(1 - 0.64)
+    np.testing.assert_allclose(got.sigma_period_s, 2.0 * np.sqrt(2e-2), rtol=1e-12)
+    assert got.constrained and "the period free: the sigmas are marginal" in got.note
+    fixed = confidence_from_covariance(cov[:3, :3], np.eye(3), *args, y)
+    assert fixed.constrained and "period free" not in fixed.note
