@@ -232,6 +232,27 @@ def test_ledoit_wolf_shrinkage_by_hand_and_consistent() -> None:
     np.testing.assert_allclose(cov, plain, rtol=0.02, atol=0.02 * plain[0, 0])
 
 
+def test_shrinkage_leaves_the_period_variance_alone() -> None:
+    # by hand for deviations (a_e, a_n, phase, f) = (+-1, 0, 0, +-2), (0, 0, 0, +-1): the
+    # axis block is the worked example above (lambda = 1/2, block diag(3/8, 1/8)); the plain
+    # second moment 1/G sum d d^T has S_ff = (4 + 4 + 1 + 1) / 4 = 5/2 and S_ef = 4 / 4 = 1:
+    # only the axis block is shrunk, so S_ff stays 5/2 (it was halved, (1 - lambda) S_ff,
+    # with the target zero there) and the cross term goes with 1 - lambda
+    from speclight.estimate.spin_axis.spin_axis_jackknife import shrunk_second_moment
+
+    d = np.array([[1.0, 0, 0, 2], [-1.0, 0, 0, -2], [0.0, 0, 0, 1], [0.0, 0, 0, -1]])
+    got, lam = shrunk_second_moment(d)
+    np.testing.assert_allclose(lam, 0.5, rtol=1e-12)
+    np.testing.assert_allclose(got[:2, :2], np.diag([3 / 8, 1 / 8]), rtol=1e-12)
+    np.testing.assert_allclose(got[3, 3], 5 / 2, rtol=1e-12)
+    np.testing.assert_allclose(got[0, 3], 1 / 2, rtol=1e-12)
+    np.testing.assert_allclose(got[2, :], 0.0, atol=1e-15)
+    # a convex sum of two positive semi-definite matrices: no negative eigenvalue beyond
+    # rounding of entries of order 1
+    r = np.random.default_rng(5).normal(size=(6, 4)) * [1.0, 0.2, 0.5, 3.0]
+    assert np.min(np.linalg.eigvalsh(shrunk_second_moment(r)[0])) > -1e-12
+
+
 def test_free_period_sigmas_are_marginal_and_said() -> None:
     # reference: the marginal variance of a Gaussian's component is its diagonal entry, the
     # conditional (the period known) the Schur complement C_ee - C_ef^2 / C_ff, smaller where

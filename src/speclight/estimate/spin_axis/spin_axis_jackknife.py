@@ -80,8 +80,10 @@ def shrunk_second_moment(d: F64) -> tuple[F64, float]:
     intensity ``lambda = min(beta^2, delta^2) / delta^2`` estimated from the deviations
     themselves: ``delta^2 = ||S_aa - mu I||^2`` (the block's anisotropy), ``beta^2 = 1 / G^2
     sum_g ||d_g d_g^T - S_aa||^2`` (how much of it G deviations can resolve), ``S_aa`` the
-    axis block of ``S``. Returns ``lambda T + (1 - lambda) S`` (``T`` the block ``mu I`` and
-    zero elsewhere; positive semi-definite) and ``lambda`` (1: only the size is kept)."""
+    axis block of ``S``. Returns ``lambda T + (1 - lambda) S`` and ``lambda`` (1: only the
+    axis block's size is kept); ``T`` is the block ``mu I`` beside ``S``'s own other block
+    (phase, period): only the axis block is shrunk and the cross terms go with ``1 - lambda``;
+    ``T`` and ``S`` are positive semi-definite, so is the sum."""
     g = d.shape[0]
     s = d.T @ d / g
     block = s[:2, :2]
@@ -91,6 +93,7 @@ def shrunk_second_moment(d: F64) -> tuple[F64, float]:
     lam = min(beta2, delta2) / delta2 if delta2 > 0 else 1.0
     target = np.zeros_like(s)
     target[:2, :2] = mu * np.eye(2)
+    target[2:, 2:] = s[2:, 2:]
     return np.asarray(lam * target + (1 - lam) * s), lam
 
 
