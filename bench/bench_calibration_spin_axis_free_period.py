@@ -76,7 +76,10 @@ def main() -> None:
         f"error / sigma: east mean {z[:, 0].mean():+.2f} std {z[:, 0].std():.2f}, north mean "
         f"{z[:, 1].mean():+.2f} std {z[:, 1].std():.2f}"
     )
-    print(f"period pull: mean {pull_f.mean():+.2f} std {pull_f.std():.2f}")
+    print(
+        f"period pull: mean {pull_f.mean():+.2f} std {pull_f.std():.2f}, beyond 2.5 in "
+        f"{int(np.sum(abs(pull_f) > 2.5))}"
+    )
     print(
         f"|rho(axis, period)| median east {np.median(abs(rho[:, 0])):.2f}, north "
         f"{np.median(abs(rho[:, 1])):.2f}; above 0.5 in {int(np.sum(abs(rho) > 0.5))} of "

@@ -116,8 +116,8 @@ FLAT_NOTE = "the data do not constrain the axis"
 #: BENCHMARKS.md "Spin-axis calibration: a free period").
 FREE_PERIOD_NOTE = (
     "the period free: the sigmas are marginal over it (on the calibration bench, the period "
-    "given 1-4 % off, error / sigma standard deviations east / north 0.97 / 0.89 and "
-    "0.92 / 0.68 on 14 and 15 draws of two seeds, the truth in the 95 % region in all; "
+    "given 1-4 % off, error / sigma standard deviations east / north 0.97 / 0.90 and "
+    "0.93 / 0.68 on 14 and 15 draws of two seeds, the truth in the 95 % region in all; "
     "1.89 / 1.15 on 8 draws of a third, one 5 sigma off; "
     "docs/spin-axis.md, Sigmas)"
 )
