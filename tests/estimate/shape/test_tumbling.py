@@ -48,6 +48,30 @@ def _two_passes():
     return t_s, sun, obs
 
 
+def _convex_case(moments, w0, seed, name, every=1):
+    """Convex-model light curves (Lambert, 1 % noise from ``seed``) of the dishless box-wing
+    turning torque-free from ``Q0`` with ``moments`` and body rates ``w0`` over
+    :func:`_two_passes` (every ``every``-th point): the data, the convex light model, the
+    epochs [s]."""
+    tgt = shapes.box_wing(WHITE, dish=False)
+    normals, areas = mesh_facets([(p.vertices_m, p.faces) for p in tgt.parts])
+    t_s, sun, obs = (a[::every] for a in _two_passes())
+    q, _ = torque_free_attitude(t_s, moments, Q0, w0)
+    qc = quat_conjugate(q)
+    law = scattering_law("lambert")
+    chp = np.sqrt(0.5 * (1 + np.sum(sun * obs, axis=1)))
+    y = facet_brightness(quat_rotate(qc, sun), quat_rotate(qc, obs), normals, areas, law, chp)
+    rng = np.random.default_rng(seed)
+    sigma = 0.01 * np.mean(y)
+    t_jd = 2459000.5 + t_s / 86400.0
+    half = t_s.size // 2
+    data = build_inversion_data(
+        t_jd, y + sigma * rng.normal(size=y.size), np.full(y.size, sigma), sun, obs,
+        np.repeat([0, 1], half), np.array([False, False]), name,
+    )  # fmt: skip
+    return data, ConvexLight(normals, areas, law), t_s
+
+
 #: The far-start searches and the full principal-axis check run the grid search (about a
 #: CPU minute each, ~4 for the null case, ~2.5 with the reflectivity map: its 221,184 node
 #: renders and lookups): too long for the suite's 12-minute budget. They
@@ -143,24 +167,10 @@ def test_far_start_recovers_the_state_when_the_model_is_right():
     fitted model, no shadows; 1 % noise): the truth's family is reported and tumbling is
     detected. Where the model is right the search reaches the state; on the rendered
     light curves the model error moves the best fit (the xfail below)."""
-    tgt = shapes.box_wing(WHITE, dish=False)
-    normals, areas = mesh_facets([(p.vertices_m, p.faces) for p in tgt.parts])
-    t_s, sun, obs = _two_passes()
-    q, _ = torque_free_attitude(t_s, MOMENTS, Q0, W0)
-    qc = quat_conjugate(q)
-    law = scattering_law("lambert")
-    chp = np.sqrt(0.5 * (1 + np.sum(sun * obs, axis=1)))
-    y = facet_brightness(quat_rotate(qc, sun), quat_rotate(qc, obs), normals, areas, law, chp)
-    rng = np.random.default_rng(0)
-    sigma = 0.01 * np.mean(y)
-    t_jd = 2459000.5 + t_s / 86400.0
-    data = build_inversion_data(
-        t_jd, y + sigma * rng.normal(size=y.size), np.full(y.size, sigma), sun, obs,
-        np.repeat([0, 1], 60), np.array([False, False]), "tf",
-    )  # fmt: skip
+    data, light, _ = _convex_case(MOMENTS, W0, 0, "tf")
     fit = fit_tumbling(
-        data, ConvexLight(normals, areas, law), min_period_h=0.03, max_period_h=0.1, n_starts=0,
-        initial_states=[_far_start()], t0_jd=t_jd[0], rate_span=0.015,
+        data, light, min_period_h=0.03, max_period_h=0.1, n_starts=0,
+        initial_states=[_far_start()], t0_jd=data.time_jd[0], rate_span=0.015,
     )  # fmt: skip
     assert any(same_family(f[0], TumblingState(Q0, W0, MOMENTS, 0.0)) for f in fit.families)
     assert fit.detected
@@ -209,27 +219,11 @@ def test_far_start_with_the_reflectivity_map_recovers_the_state():
 def test_principal_axis_rotation_is_not_tumbling():
     """A box-wing spinning about its axis of largest moment (no nutation): the torque-free
     fit must not claim a tumbling state (F-test against a principal-axis rotation)."""
-    tgt = shapes.box_wing(WHITE, dish=False)
-    normals, areas = mesh_facets([(p.vertices_m, p.faces) for p in tgt.parts])
-    t_s, sun, obs = _two_passes()
     w0 = np.array([0.0, 0.0, 0.035])  # about body z, the largest moment of MOMENTS
-    q, _ = torque_free_attitude(t_s, MOMENTS[[1, 0, 2]], Q0, w0)
-    qc = quat_conjugate(q)
-    law = scattering_law("lambert")
-    chp = np.sqrt(0.5 * (1 + np.sum(sun * obs, axis=1)))
-    from speclight.estimate.shape.convex_model import facet_brightness
-
-    y = facet_brightness(quat_rotate(qc, sun), quat_rotate(qc, obs), normals, areas, law, chp)
-    rng = np.random.default_rng(1)
-    sigma = 0.01 * np.mean(y)
-    t_jd = 2459000.5 + t_s / 86400.0
-    data = build_inversion_data(
-        t_jd, y + sigma * rng.normal(size=y.size), np.full(y.size, sigma), sun, obs,
-        np.repeat([0, 1], 60), np.array([False, False]), "pa",
-    )  # fmt: skip
+    data, light, _ = _convex_case(MOMENTS[[1, 0, 2]], w0, 1, "pa")
     fit = fit_tumbling(
-        data, ConvexLight(normals, areas, law), min_period_h=0.03, max_period_h=0.1, n_starts=0,
-        t0_jd=t_jd[0], rate_span=0.015,
+        data, light, min_period_h=0.03, max_period_h=0.1, n_starts=0,
+        t0_jd=data.time_jd[0], rate_span=0.015,
     )  # fmt: skip
     assert not fit.detected
 
@@ -240,28 +234,13 @@ def test_principal_axis_rotation_is_not_tumbling_fast():
     other moments) without the grid. The torque-free fit's 4 extra parameters fit the noise
     a little better (chi-square lower by about chi2(4)); the F-test against the best
     principal-axis rotation must not call that tumbling (p >= 0.001)."""
-    tgt = shapes.box_wing(WHITE, dish=False)
-    normals, areas = mesh_facets([(p.vertices_m, p.faces) for p in tgt.parts])
-    t_s, sun, obs = (a[::2] for a in _two_passes())  # a point every 20 s
-    moments = MOMENTS[[1, 0, 2]]
     w0 = np.array([0.0, 0.0, 0.035])  # about body z, the largest moment
-    q, _ = torque_free_attitude(t_s, moments, Q0, w0)
-    qc = quat_conjugate(q)
-    law = scattering_law("lambert")
-    chp = np.sqrt(0.5 * (1 + np.sum(sun * obs, axis=1)))
-    y = facet_brightness(quat_rotate(qc, sun), quat_rotate(qc, obs), normals, areas, law, chp)
-    rng = np.random.default_rng(2)
-    sigma = 0.01 * np.mean(y)
-    t_jd = 2459000.5 + t_s / 86400.0
-    data = build_inversion_data(
-        t_jd, y + sigma * rng.normal(size=y.size), np.full(y.size, sigma), sun, obs,
-        np.repeat([0, 1], 30), np.array([False, False]), "pa",
-    )  # fmt: skip
+    data, light, t_s = _convex_case(MOMENTS[[1, 0, 2]], w0, 2, "pa", every=2)  # every 20 s
     tilt = Rotation.from_rotvec(np.deg2rad(20.0) * np.array([1.0, 0.0, 0.0]))
     start = TumblingState(Q0, tilt.apply(w0), np.array([0.6, 0.9, 1.0]), 0.0)
     fit = fit_tumbling(
-        data, ConvexLight(normals, areas, law), min_period_h=0.03, max_period_h=0.1, n_starts=0,
-        initial_states=[start], t0_jd=t_jd[0], rate_span=0.0, grid=False,
+        data, light, min_period_h=0.03, max_period_h=0.1, n_starts=0,
+        initial_states=[start], t0_jd=data.time_jd[0], rate_span=0.0, grid=False,
     )  # fmt: skip
     assert not fit.detected
     ds = add_tumbling(xr.Dataset(), fit)  # SHAPE.nc's variables, the std ones finite
