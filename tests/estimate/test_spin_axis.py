@@ -186,16 +186,26 @@ def test_a_map_without_attitude_signal_is_said_not_to_constrain_the_axis() -> No
     assert res.confidence.note.startswith("the data do not constrain the axis")
 
 
+#: The period [s] of :func:`_noisy_pass`.
+P_TRUE_S = 37.0
+
+
+def _noisy_pass() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The sweeping pass made with the axis RA 40, Dec 25 deg, phase 50 deg and the period
+    :data:`P_TRUE_S`, 1 % noise (seed 4): epochs [s], lines of sight, rates."""
+    t, los = _sweeping_pass()
+    rng = np.random.default_rng(4)
+    y = _rates(_body_directions(los, 40.0, 25.0, 50.0, t, P_TRUE_S))
+    return t, los, y * (1 + 0.01 * rng.normal(size=y.shape))
+
+
 @pytest.mark.parametrize("wrong", [False, True])
 def test_a_wrong_fixed_period_is_warned_and_the_true_one_is_not(wrong) -> None:
     # the pass made with P = 37 s and 1 % noise; searched with the period fixed at the truth
     # and at 6 % off (a phase drift of 86 deg over the pass's four turns: the reference
     # that decides is the period the data were made with)
-    ra, dec, phase0, p_true = 40.0, 25.0, 50.0, 37.0
-    t, los = _sweeping_pass()
-    rng = np.random.default_rng(4)
-    y = _rates(_body_directions(los, ra, dec, phase0, t, p_true))
-    y = y * (1 + 0.01 * rng.normal(size=y.shape))
+    t, los, y = _noisy_pass()
+    p_true = P_TRUE_S
     given = p_true * 1.06 if wrong else p_true
     bmap = _closed_form_map(16)
     res = spin_axis_search(
@@ -222,11 +232,8 @@ def test_a_free_period_stopped_by_its_bound_is_said(bound) -> None:
     # period free within `bound`: within 3 % the truth is out of reach and the answer sits
     # on the bound's edge (said, axis not called constrained); within 10 % the truth is
     # inside and found (no edge note)
-    ra, dec, phase0, p_true = 40.0, 25.0, 50.0, 37.0
-    t, los = _sweeping_pass()
-    rng = np.random.default_rng(4)
-    y = _rates(_body_directions(los, ra, dec, phase0, t, p_true))
-    y = y * (1 + 0.01 * rng.normal(size=y.shape))
+    t, los, y = _noisy_pass()
+    p_true = P_TRUE_S
     given = p_true * 1.06
     bmap = _closed_form_map(16)
     res = spin_axis_search(
