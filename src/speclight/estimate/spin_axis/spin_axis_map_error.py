@@ -42,7 +42,7 @@ from numpy.typing import NDArray
 
 from speclight.estimate.spin_axis.spin_axis_gradient import SpinMisfit
 from speclight.estimate.spin_axis.spin_axis_jackknife import refit, shrunk_second_moment
-from speclight.maps.map_geometry import map_coordinates, roll_reference, sun_observer
+from speclight.maps.map_geometry import map_coordinates, sun_observer
 from speclight.maps.map_lookup import ReflectivityMap, healpix_weights
 
 F64 = NDArray[np.float64]
@@ -85,7 +85,7 @@ def warped_map(
     the others kept as they are."""
     nodes = np.arange(bmap.direction_body.shape[0]) if nodes is None else nodes
     d = bmap.direction_body[nodes]
-    e_lon, e_lat = roll_reference(d)
+    e_lon, e_lat = bmap.roll_frames[0][nodes], bmap.roll_frames[1][nodes]
     p = d + shift_rad[nodes, :1] * e_lon + shift_rad[nodes, 1:] * e_lat
     p /= np.linalg.norm(p, axis=1)[:, None]
     angles = np.radians(bmap.header.phase_angle_deg)
