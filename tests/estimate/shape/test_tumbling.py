@@ -13,6 +13,7 @@ from scipy.spatial.transform import Rotation
 from conftest import WHITE, render_mesh
 from speclight.attitude import torque_free_attitude
 from speclight.attitude.quaternion import quat_conjugate, quat_rotate
+from speclight.estimate.shape import tumbling
 from speclight.estimate.shape.convex_model import facet_brightness
 from speclight.estimate.shape.egi import mesh_facets
 from speclight.estimate.shape.inversion_data import build_inversion_data
@@ -315,3 +316,30 @@ def test_mirror_state_gives_the_same_light_curve_in_a_plane():
         )
     assert np.allclose(curves[0], curves[1], rtol=1e-9, atol=1e-12 * np.max(curves[0]))
     assert not same_family(truth, mirror)  # a different state, not a body symmetry
+
+
+def test_draws_around_a_short_fit_find_the_cycle_count_over_the_gap():
+    """The hop (``tumbling._hopped``, :func:`.tumbling_search.local_draws`): a fit to the
+    first 15 points (150 s, 0.75 of a turn) from a start one turn off over the 90-min gap
+    leaves the rate 4 % off; least squares on both passes from there ends in another
+    cycle count (chi-square over 100 times the truth's minimum), while draws around the
+    short fit from its own covariance, scored on both passes, and the best refined reach
+    the truth's minimum (the refit from the truth, to 0.1 %), for each of 3 draw seeds
+    (8 of 8 when tried).
+    Convex model, no model error: the state is identifiable."""
+    data, light, _ = _convex_case(MOMENTS, W0, 2, "hop")
+    truth = TumblingState(Q0, W0, MOMENTS, 0.0)
+    t0 = float(data.time_jd[0])
+    both = tumbling._Problem(data, light, t0)
+    short = tumbling._Problem(data.subset(np.arange(15)), light, t0)
+    at_truth = tumbling._fit_all(both, [tumbling._state_vector(truth, 1.0)])[0].chi2
+    turns_over_gap = 5400.0 * truth.rate_rad_s / (2 * np.pi)
+    start = tumbling._state_vector(truth, 1.0 + 1.0 / turns_over_gap)
+    short_fit = tumbling._fit_all(short, [start])[0]
+    assert abs(short_fit.rate_rad_s / truth.rate_rad_s - 1.0) > 0.02
+    direct = tumbling._fit_all(both, [tumbling._state_vector(short_fit, 1.0)])[0]
+    assert direct.chi2 > 100 * at_truth
+    for r in range(3):
+        hopped = tumbling._hopped(short, both, [short_fit], np.random.default_rng(r))
+        assert hopped[0].chi2 == pytest.approx(at_truth, rel=1e-3)
+        assert same_family(hopped[0], truth)

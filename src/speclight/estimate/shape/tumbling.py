@@ -44,9 +44,12 @@ from speclight.estimate.shape.tumbling_mirror import mirror_plane, mirror_state
 from speclight.estimate.shape.tumbling_principal import ALPHA as PRINCIPAL_ALPHA
 from speclight.estimate.shape.tumbling_principal import lag1_correlation, principal_axis_test
 from speclight.estimate.shape.tumbling_search import (
+    HOP_REFINE,
     N_CARRY,
+    POINTS_PER_PARAMETER,
     grid_rates,
     grid_starts,
+    local_draws,
     moments_from_u,
     searched_period_range_h,
     window_schedule,
@@ -222,6 +225,8 @@ def _fit_tumbling(
     rates = grid_rates(data, min_period_h, max_period_h) if grid else np.empty(0)
     first = _continued(seed_prob, x_starts, min_period_h, rates, rng)
     seeds = [fam[0] for fam in _families(_within(first, seed_prob))][:N_SEEDS]
+    first = sorted(first + _hopped(seed_prob, seed_prob, seeds, rng), key=lambda s: s.chi2)
+    seeds = [fam[0] for fam in _families(_within(first, seed_prob))][:N_SEEDS]
     prob = _Problem(data, light, t0_jd)
     if data.n_curves == 1:
         final = first
@@ -233,7 +238,9 @@ def _fit_tumbling(
             dc = PHASE_DRIFT * period_s / gap_s
             for j in np.arange(-np.floor(rate_span / dc), np.floor(rate_span / dc) + 1):
                 x_next.append(_state_vector(sol, 1.0 + j * dc))
-        final = _fit_all(prob, x_next)
+        final = sorted(
+            _fit_all(prob, x_next) + _hopped(seed_prob, prob, seeds, rng), key=lambda s: s.chi2
+        )
     # each family's mirror image (tumbling_mirror.py) fitted too: a start the search
     # rarely reaches, as good as the family where the geometry is nearly coplanar
     normal, _ = mirror_plane(data.sun_ecliptic, data.observer_ecliptic)
@@ -256,13 +263,31 @@ def _continued(
     rng: np.random.Generator,
 ) -> list[TumblingState]:
     """The starts (plus the grid's at the rates ``grid_rates_rad_s``, none when empty,
-    :mod:`.tumbling_search`) fitted to
-    windows around ``t0`` growing to the whole of ``prob``'s points (continuation); the
-    best of each window's :data:`N_CARRY` best families (and every given start) go on to
-    the next."""
-    halves = window_schedule(prob.t_s, 3600.0 * min_period_h)
+    :mod:`.tumbling_search`) fitted to windows around ``t0`` growing to the whole of
+    ``prob``'s points (continuation); the best of each window's :data:`N_CARRY` best
+    families (and every given start) go on to the next. With a grid, once for each first
+    window of :data:`.tumbling_search.POINTS_PER_PARAMETER` (the starts in the first
+    only), the solutions of all together."""
+    n_par = 9 if prob.calibrated else 8
+    passes = POINTS_PER_PARAMETER if grid_rates_rad_s.size else POINTS_PER_PARAMETER[:1]
+    sols: list[TumblingState] = []
+    for i, per_parameter in enumerate(passes):
+        halves = window_schedule(prob.t_s, 3600.0 * min_period_h, per_parameter * n_par)
+        sols += _continued_once(prob, x_starts if i == 0 else [], halves, grid_rates_rad_s, rng)
+    return sorted(sols, key=lambda s: s.chi2)
+
+
+def _continued_once(
+    prob: _Problem,
+    x_starts: list[F64],
+    halves: list[float],
+    grid_rates_rad_s: F64,
+    rng: np.random.Generator,
+) -> list[TumblingState]:
+    """One continuation of :func:`_continued` through the windows ``halves`` [s]."""
     d, t0_jd = prob.data, prob.t0_jd
     starts = list(x_starts)
+    sols: list[TumblingState] = []
     for k, half in enumerate(halves):
         index = np.flatnonzero(np.abs(prob.t_s) <= half)
         window = _Problem(d.subset(index), prob.light, t0_jd)
@@ -274,6 +299,25 @@ def _continued(
         carried = [fam[0] for fam in _families(sols)][: max(N_CARRY, len(x_starts))]
         starts = [_state_vector(s, 1.0) for s in carried]
     return sols
+
+
+def _hopped(
+    around: _Problem, prob: _Problem, states: list[TumblingState], rng: np.random.Generator
+) -> list[TumblingState]:
+    """For each state, draws around it from its covariance on ``around``'s points
+    (:func:`.tumbling_search.local_draws`), scored on ``prob``'s, the best
+    :data:`.tumbling_search.HOP_REFINE` of them fitted to ``prob``."""
+    n_par = 9 if prob.calibrated else 8
+    lower, upper = np.full(n_par, -np.inf), np.full(n_par, np.inf)
+    lower[6:8], upper[6:8] = -MOMENT_BOUND, MOMENT_BOUND
+    starts = []
+    for s in states:
+        x = _state_vector(s, 1.0)[:n_par]
+        draws = local_draws(x, around.jacobian(x, lower, upper), around.residuals(x), rng)
+        draws[:, 6:8] = np.clip(draws[:, 6:8], -MOMENT_BOUND, MOMENT_BOUND)
+        chi2 = np.array([np.sum(prob.residuals(v) ** 2) for v in draws])
+        starts += [np.append(draws[i], 0.0) for i in np.argsort(chi2)[:HOP_REFINE]]
+    return _fit_all(prob, starts)
 
 
 def _random_start(rng: np.random.Generator, min_period_h: float, max_period_h: float) -> F64:

@@ -54,6 +54,19 @@ N_CARRY = 24
 WINDOW_TURNS = 1.5
 #: Each window this many times longer than the one before.
 GROWTH = 2.0
+#: The grid and the continuation run once for each entry: the first window
+#: :data:`WINDOW_TURNS` turns wide, widened to hold at least this many points per fitted
+#: parameter. On a short window wrong states fit as well as the truth and crowd it out
+#: of the kept ones; on a long one the coarse grid has no state near enough to rank the
+#: truth's basin first; which one keeps the truth varies from case to case, so both run
+#: (BENCHMARKS.md, "the grid's first window").
+POINTS_PER_PARAMETER = (0, 3)
+#: States drawn around a local minimum to hop out of it (:func:`local_draws`).
+HOP_DRAWS = 2000
+#: Their spread, in standard deviations of the minimum's covariance.
+HOP_SPREAD = 3.0
+#: The best draws refined.
+HOP_REFINE = 4
 
 
 def moments_from_u(u: F64) -> F64:
@@ -73,11 +86,14 @@ def fibonacci_sphere(n: int) -> F64:
     return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
 
 
-def window_schedule(time_s: F64, fastest_period_s: float) -> list[float]:
+def window_schedule(time_s: F64, fastest_period_s: float, min_points: int = 0) -> list[float]:
     """Half widths [s] of the continuation's windows around ``t = 0``, the last covering
-    every point."""
+    every point: the first :data:`WINDOW_TURNS` turns of the fastest period wide, widened
+    to hold ``min_points`` points (:data:`POINTS_PER_PARAMETER`)."""
     reach = float(np.max(np.abs(time_s)))
-    half = 0.5 * WINDOW_TURNS * fastest_period_s
+    distance = np.sort(np.abs(time_s))
+    enough = float(distance[min(max(min_points, 1), distance.size) - 1])
+    half = max(0.5 * WINDOW_TURNS * fastest_period_s, enough)
     out = []
     while half < reach:
         out.append(half)
@@ -230,3 +246,29 @@ def _distinct(scored: list[tuple[float, F64]], n: int) -> list[tuple[float, F64]
         if len(out) == n:
             break
     return out
+
+
+def local_draws(
+    x: F64,
+    jacobian: F64,
+    residuals: F64,
+    rng: np.random.Generator,
+    *,
+    n: int = HOP_DRAWS,
+    spread: float = HOP_SPREAD,
+) -> F64:
+    """(n, p) states drawn around the least-squares solution ``x`` (p,) from a normal of
+    ``spread`` times its covariance ``s^2 (J^T J)^+`` (``J`` the (N, p) ``jacobian``,
+    ``s^2`` the ``residuals``' (N,) mean square per degree of freedom).
+
+    A fit that ends in the right family but a turn of one angle off (a local minimum
+    next to the truth's: a nutation or precession phase slipped over the curve, or the
+    cycle count over a gap between curves wrong) lies within a few of its standard
+    deviations of the truth, along the directions the data constrain least; scoring
+    draws there and refining the best finds the neighbouring minima that a local
+    optimiser started at ``x`` cannot reach (BENCHMARKS.md)."""
+    dof = max(residuals.size - x.size, 1)
+    cov = float(np.sum(residuals**2)) / dof * np.linalg.pinv(jacobian.T @ jacobian)
+    w, v = np.linalg.eigh(0.5 * (cov + cov.T))
+    root = v * np.sqrt(np.clip(w, 0.0, None))
+    return np.asarray(x + spread * rng.normal(size=(n, x.size)) @ root.T)
