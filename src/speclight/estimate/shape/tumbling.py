@@ -167,13 +167,20 @@ def fit_tumbling(
     """Multi-start fit of the torque-free state and its families (module doc).
 
     The state's epoch ``t0`` is the middle of the longest light curve (the seed). Stage 1:
-    ``n_starts`` random starts fitted to the seed curve alone (a few rotations: a smoother
-    misfit). Stage 2: the seed's solutions within its threshold (at most
-    :data:`N_SEEDS`, one per family) are carried to all curves; over a gap of ``T`` the
+    ``n_starts`` random starts and the grid's (:mod:`.tumbling_search`, two
+    continuations) fitted to the seed curve alone (a few rotations: a smoother misfit);
+    around each of its solutions within its threshold (at most :data:`N_SEEDS`, one per
+    family), states drawn from the solution's covariance are scored and the best refined
+    (the hop, :func:`.tumbling_search.local_draws`: a neighbouring minimum a turn of one
+    angle away). Stage 2: the seeds, now the best of the hop's families, are carried to
+    all curves; over a gap of ``T`` the
     rotation phase drifts by ``T / P`` turns per unit of relative rate error, so each starts
     at rate scales ``1 + j dc``, ``dc =`` :data:`PHASE_DRIFT` ``P / T``, ``|j dc| <=``
     :data:`RATE_SPAN` (a torque-free motion with its rates scaled by ``c`` is the same
-    motion ``c`` times faster), and the lowest of all is kept as in stage 1. Last, the
+    motion ``c`` times faster), and from the hop's draws around each seed (its covariance
+    on the seed curve) scored on all curves: where the gap's cycle count depends on more
+    than the rate (the moments set the second frequency), the rate scales alone miss it.
+    The lowest of all is kept as in stage 1. Last, the
     mirror image of each kept family's best (at most :data:`N_SEEDS`;
     :mod:`.tumbling_mirror`) is fitted to all curves and joins the solutions.
 

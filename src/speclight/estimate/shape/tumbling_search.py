@@ -12,7 +12,10 @@ quasi-uniform set in SO(3), and the misfit of all of them is one array operation
 grid is scored on a short window around ``t0`` (a turn or two: there the motion is close
 to a uniform rotation and the rate error costs little phase), the best
 :data:`N_KEEP` are refined there by least squares and carried, window by window
-(each :data:`GROWTH` times longer), to the whole curve (continuation).
+(each :data:`GROWTH` times longer), to the whole curve (continuation). It runs twice:
+from a first window of 1.5 turns and from one holding 3 points per parameter
+(:data:`POINTS_PER_PARAMETER`). Around a continuation's solutions,
+:func:`local_draws` gives states to score for a neighbouring minimum (the hop).
 """
 
 from __future__ import annotations
