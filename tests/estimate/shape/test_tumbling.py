@@ -73,10 +73,10 @@ def _convex_case(moments, w0, seed, name, every=1):
     return data, ConvexLight(normals, areas, law), t_s
 
 
-#: The far-start searches and the full principal-axis check run the grid search (about a
-#: CPU minute each, ~4 for the null case, ~2.5 with the reflectivity map: its 221,184 node
-#: renders and lookups): too long for the suite's 12-minute budget. They
-#: run where SPECLIGHT_LONG_TESTS=1 is set (a fast null test runs always);
+#: The far-start searches and the full principal-axis check run the grid search (1.5-2
+#: CPU minutes each, ~9 wall minutes on busy cores for the null case, ~4 with the
+#: reflectivity map: its 221,184 node renders and lookups): too long for the suite's
+#: 12-minute budget. They run where SPECLIGHT_LONG_TESTS=1 is set (a fast null test runs always);
 #: bench/bench_tumbling_far.py measures the search over random draws.
 LONG = pytest.mark.skipif(
     not os.environ.get("SPECLIGHT_LONG_TESTS"),
