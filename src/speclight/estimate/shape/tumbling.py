@@ -103,6 +103,17 @@ class _Problem:
         self._motion_key = b""
         self._motion = np.empty((0, 4))
 
+    @property
+    def n_parameters(self) -> int:
+        """Parameters of the state vector: attitude, rates, ``u`` and, calibrated, the scale."""
+        return 9 if self.calibrated else 8
+
+    def bounds(self) -> tuple[F64, F64]:
+        """Lower and upper bounds of the state vector (``u`` within :data:`MOMENT_BOUND`)."""
+        lower, upper = np.full(self.n_parameters, -np.inf), np.full(self.n_parameters, np.inf)
+        lower[6:8], upper[6:8] = -MOMENT_BOUND, MOMENT_BOUND
+        return lower, upper
+
     def state(self, x: F64) -> tuple[F64, F64, F64, float]:
         q = Rotation.from_rotvec(x[:3]).as_quat(scalar_first=True)
         scale = float(np.exp(x[8])) if self.calibrated else 1.0
@@ -257,7 +268,7 @@ def _fit_tumbling(
         key=lambda s: s.chi2,
     )
     kept = _within(final, prob)
-    n_par = 9 if prob.calibrated else 8
+    n_par = prob.n_parameters
     chi_pa, p = principal_axis_test(prob.residuals, _state_vector(kept[0], 1.0)[:n_par], n_par)
     return TumblingFit(_families(kept), kept[-1].chi2, final, t0_jd, chi_pa, p, searched)
 
@@ -275,7 +286,7 @@ def _continued(
     families (and every given start) go on to the next. With a grid, once for each first
     window of :data:`.tumbling_search.POINTS_PER_PARAMETER` (the starts in the first
     only), the solutions of all together."""
-    n_par = 9 if prob.calibrated else 8
+    n_par = prob.n_parameters
     passes = POINTS_PER_PARAMETER if grid_rates_rad_s.size else POINTS_PER_PARAMETER[:1]
     sols: list[TumblingState] = []
     for i, per_parameter in enumerate(passes):
@@ -314,9 +325,8 @@ def _hopped(
     """For each state, draws around it from its covariance on ``around``'s points
     (:func:`.tumbling_search.local_draws`), scored on ``prob``'s, the best
     :data:`.tumbling_search.HOP_REFINE` of them fitted to ``prob``."""
-    n_par = 9 if prob.calibrated else 8
-    lower, upper = np.full(n_par, -np.inf), np.full(n_par, np.inf)
-    lower[6:8], upper[6:8] = -MOMENT_BOUND, MOMENT_BOUND
+    n_par = prob.n_parameters
+    lower, upper = prob.bounds()
     starts = []
     for s in states:
         x = _state_vector(s, 1.0)[:n_par]
@@ -355,9 +365,8 @@ def _state_vector(s: TumblingState, rate_scale: float) -> F64:
 def _fit_all(
     prob: _Problem, starts: list[F64], max_evaluations: int = MAX_EVALUATIONS
 ) -> list[TumblingState]:
-    n_par = 9 if prob.calibrated else 8
-    lower, upper = np.full(n_par, -np.inf), np.full(n_par, np.inf)
-    lower[6:8], upper[6:8] = -MOMENT_BOUND, MOMENT_BOUND
+    n_par = prob.n_parameters
+    lower, upper = prob.bounds()
     out = []
     for x0 in starts:
         x = x0[:n_par].copy()
@@ -382,7 +391,7 @@ def _within(states: list[TumblingState], prob: _Problem) -> list[TumblingState]:
     """The states within ``chi2_min + delta s^2`` (module doc), ``s^2`` the best's
     residual variance times ``(1 + rho) / (1 - rho)``, ``rho`` its residuals' lag-1
     correlation (model error: fewer independent points, as in :mod:`.tumbling_principal`)."""
-    n_par = 9 if prob.calibrated else 8
+    n_par = prob.n_parameters
     rho = max(lag1_correlation(prob.residuals(_state_vector(states[0], 1.0)[:n_par])), 0.0)
     s2 = states[0].chi2 / max(prob.data.n_points - n_par, 1) * (1 + rho) / (1 - rho)
     threshold = states[0].chi2 + float(stats.chi2.ppf(0.99, n_par)) * s2

@@ -62,7 +62,7 @@ GROWTH = 2.0
 #: parameter. On a short window wrong states fit as well as the truth and crowd it out
 #: of the kept ones; on a long one the coarse grid has no state near enough to rank the
 #: truth's basin first; which one keeps the truth varies from case to case, so both run
-#: (BENCHMARKS.md, "the grid's first window").
+#: (BENCHMARKS.md, "Tumbling from far starts", seventh session).
 POINTS_PER_PARAMETER = (0, 3)
 #: States drawn around a local minimum to hop out of it (:func:`local_draws`).
 HOP_DRAWS = 2000
